@@ -1,0 +1,137 @@
+// vff/reader.h - opening and reading .vff files.
+//
+// The reader is safe on untrusted input: every offset and size is checked (overflow-safe) against
+// the file size and the caller's limits before anything is allocated, and every failure is returned
+// as an Error with the validation ID of the rule that failed (spec/validation.md).
+//
+//   vff::Result<vff::File> f = vff::File::open("bunny.vff");
+//   if (!f) { fprintf(stderr, "%s\n", f.error().toString().c_str()); return 1; }
+//   auto map = f->mapData(vff::Plane::kDistance, 17);  // zero-copy for stored blocks
+//
+// Thread safety: a File may be read from several threads at once (decoded blocks are cached under a
+// lock and never move once decoded).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "vff/error.h"
+#include "vff/format.h"
+
+namespace vff {
+
+enum class Plane : uint8_t { kDistance = 0, kNormal = 1 };
+const char* planeName(Plane p) noexcept;  // "distance", "normal"
+
+enum class ChecksumPolicy : uint8_t {
+  kVerifyAll = 0,  // header, every section and every block at open (XXH3 runs at > 10 GB/s)
+  kLazy = 1,       // header and non-plane sections at open; each block when it is first decoded
+  kNone = 2,       // only structural checks (for files already validated)
+};
+
+// Limits that protect a reader from hostile files. Zero-initialised fields are not "no limit":
+// use the defaults below, or tighten them.
+struct ReadOptions {
+  uint32_t maxSections = 64;
+  uint64_t maxMaps = uint64_t{1} << 24;         // positional samples (the largest scheme count)
+  uint32_t maxMapResolution = 4096;             // M
+  uint64_t maxPayloadBytes = uint64_t{1} << 36;  // raw bytes of all planes together (64 GiB)
+  uint64_t maxSectionBytes = uint64_t{64} << 20;  // raw size of a non-plane section
+  ChecksumPolicy checksums = ChecksumPolicy::kVerifyAll;
+};
+
+struct SectionInfo {
+  uint32_t tag = 0;
+  uint32_t flags = 0;
+  uint64_t offset = 0;
+  uint64_t storedSize = 0;
+  uint64_t rawSize = 0;
+  Codec codec = Codec::kStored;
+  uint16_t sectionVersion = 0;
+  uint64_t checksum = 0;
+  bool known = false;  // a tag this reader understands
+};
+
+struct BlockInfo {
+  uint64_t offset = 0;  // absolute file offset of the stored bytes
+  uint64_t storedSize = 0;
+  uint32_t rawSize = 0;
+  uint32_t firstMap = 0;
+  uint32_t mapCount = 0;
+  Codec codec = Codec::kStored;
+  Filter filter = Filter::kNone;
+  uint64_t checksum = 0;
+};
+
+struct PlaneInfo {
+  bool present = false;
+  uint32_t mapBytes = 0;      // raw bytes per map
+  uint32_t mapsPerBlock = 0;  // G; the last block may hold fewer
+  uint64_t rawBytes = 0;      // mapCount * mapBytes: the payload
+  uint64_t storedBytes = 0;   // sum of the blocks' stored sizes
+  std::vector<BlockInfo> blocks;
+};
+
+struct FileInfo {
+  uint16_t versionMajor = 0;
+  uint16_t versionMinor = 0;
+  uint64_t fileSize = 0;
+  uint64_t incompatFeatures = 0;
+  uint64_t roCompatFeatures = 0;
+  ChecksumAlgorithm checksumAlgorithm = ChecksumAlgorithm::kInvalid;
+  uint64_t headerChecksum = 0;
+  std::vector<SectionInfo> sections;  // in table order
+};
+
+class File {
+ public:
+  // Maps the file read-only. The file must not change while the File is alive.
+  static Result<File> open(const std::string& path, const ReadOptions& options = {});
+  // Borrows caller memory; `bytes` must outlive the File and every view it returns.
+  static Result<File> openMemory(std::span<const uint8_t> bytes, const ReadOptions& options = {});
+  // Takes ownership of a buffer.
+  static Result<File> openBuffer(std::vector<uint8_t> bytes, const ReadOptions& options = {});
+
+  File(File&&) noexcept;
+  File& operator=(File&&) noexcept;
+  ~File();
+
+  const FileInfo& info() const noexcept;
+  const FieldDesc& field() const noexcept;
+  const LayoutDesc& layout() const noexcept;
+  const PlaneInfo& plane(Plane p) const noexcept;
+  bool hasNormals() const noexcept { return plane(Plane::kNormal).present; }
+  // The metadata JSON text (canonical: sorted keys, UTF-8), or empty when there is no META section.
+  std::string_view metadata() const noexcept;
+  // The whole file's bytes (mapped or borrowed).
+  std::span<const uint8_t> bytes() const noexcept;
+
+  // The raw bytes of one map: a view into the file for stored blocks (zero-copy), or into the
+  // decoded-block cache for compressed ones (decoded once, on first use). The view lives as long as
+  // the File. Errors: kOutOfRange, kPlanePresence, kBlockChecksum (kLazy), kBlockDecode.
+  Result<std::span<const uint8_t>> mapData(Plane p, uint32_t map) const;
+  // The raw bytes of one block (all its maps, in order), with the same lifetime rules.
+  Result<std::span<const uint8_t>> blockData(Plane p, uint32_t block) const;
+  // Decodes a block into caller memory without touching the cache (out.size() == rawSize).
+  Status decodeBlock(Plane p, uint32_t block, std::span<uint8_t> out) const;
+
+  // Bytes of one packed slice of a plane: sliceWidth * sliceHeight * texel size, where the texel
+  // size is 1 (kUnorm8*), 2 (kUnorm16Diameter), 4 (normals); for kBit1 a row holds sliceWidth/8
+  // bytes. The slice's rows are tightly packed, top row first.
+  uint64_t sliceBytes(Plane p) const noexcept;
+  // Composes slice `slice` into `out` (size sliceBytes(p)): each map at its placement, gutters
+  // replicate the nearest edge texel, unused tiles hold the miss code (distance) or zero (normals).
+  Status readSlice(Plane p, uint32_t slice, std::span<uint8_t> out) const;
+
+  struct Impl;  // opaque
+  explicit File(std::unique_ptr<Impl> impl);  // used by the library only
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace vff

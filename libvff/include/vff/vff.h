@@ -1,0 +1,12 @@
+// vff/vff.h - everything in libvff. See README.md for an overview and spec/ for the format.
+#pragma once
+
+#include "vff/direction.h"
+#include "vff/encoding.h"
+#include "vff/error.h"
+#include "vff/format.h"
+#include "vff/positions.h"
+#include "vff/reader.h"
+#include "vff/validate.h"
+#include "vff/version.h"
+#include "vff/writer.h"

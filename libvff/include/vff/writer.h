@@ -1,0 +1,76 @@
+// vff/writer.h - writing .vff files: streaming, deterministic, crash-safe.
+//
+// The writer streams maps into a temporary file in the destination folder and renames it into
+// place only when finish() succeeds, so a crash or an error never leaves a partial file under the
+// destination name (an existing file there stays untouched until the rename). The same field, maps
+// and options always give the same bytes: nothing depends on time, threads or the host.
+//
+//   vff::Result<vff::Writer> w = vff::Writer::create("out.vff", field, options);
+//   w->writeMaps(vff::Plane::kDistance, distanceBytes);   // any number of whole maps, in order
+//   w->writeMaps(vff::Plane::kNormal, normalBytes);       // after all distance maps
+//   vff::Status s = w->finish();
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "vff/error.h"
+#include "vff/format.h"
+#include "vff/reader.h"
+
+namespace vff {
+
+struct WriteOptions {
+  Codec codec = Codec::kStored;  // block codec of both planes
+  int zstdLevel = 19;            // 1..22, used when codec is kZstd
+  uint32_t mapsPerBlock = 0;     // G; 0 picks the largest G with G * mapBytes <= 256 KiB (>= 1)
+  LayoutLimits layout;           // limits for the packed slice layout
+  // Metadata as a JSON object text, or empty for none. It is stored canonically (sorted keys,
+  // no insignificant whitespace), so equal objects give equal bytes. Keys starting with "vff."
+  // are reserved for the names in spec/format.md.
+  std::string metadataJson;
+  bool sync = true;  // fsync the file and its folder before and after the rename
+};
+
+class Writer {
+ public:
+  // Starts a file at `path` ("-" is not supported: files need seeking). Fails with
+  // kInvalidArgument for an invalid field or options, kIoWrite when the temporary cannot be made.
+  static Result<Writer> create(const std::string& path, const FieldDesc& field,
+                               const WriteOptions& options = {});
+  // Same, but the result is kept in memory; take it with finishToMemory().
+  static Result<Writer> createInMemory(const FieldDesc& field, const WriteOptions& options = {});
+
+  Writer(Writer&&) noexcept;
+  Writer& operator=(Writer&&) noexcept;
+  ~Writer();  // removes the temporary file unless finish() succeeded
+
+  // Appends whole maps (bytes.size() must be a multiple of the plane's map size). All distance
+  // maps come first, then (if the field has a normal encoding) all normal maps.
+  Status writeMaps(Plane p, std::span<const uint8_t> bytes);
+  // Completes the file: writes the indexes, header and checksums, syncs and renames into place.
+  Status finish();
+  Result<std::vector<uint8_t>> finishToMemory();
+  // Gives up: removes the temporary file. Safe to call more than once.
+  void abort() noexcept;
+
+  const LayoutDesc& layout() const noexcept;
+
+  struct Impl;  // opaque
+  explicit Writer(std::unique_ptr<Impl> impl);  // used by the library only
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+// One call for a field held in memory.
+Status writeFile(const std::string& path, const FieldDesc& field, std::span<const uint8_t> distance,
+                 std::span<const uint8_t> normals = {}, const WriteOptions& options = {});
+Result<std::vector<uint8_t>> writeMemory(const FieldDesc& field, std::span<const uint8_t> distance,
+                                         std::span<const uint8_t> normals = {},
+                                         const WriteOptions& options = {});
+
+}  // namespace vff

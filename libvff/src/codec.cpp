@@ -1,0 +1,86 @@
+#include "codec.h"
+
+#include <xxhash.h>
+#include <zstd.h>
+
+#include <cstring>
+#include <string>
+
+namespace vff::detail {
+
+uint64_t xxh3(std::span<const uint8_t> bytes) noexcept {
+  return XXH3_64bits(bytes.data(), bytes.size());
+}
+
+Xxh3Stream::Xxh3Stream() : state_(XXH3_createState()) {
+  XXH3_64bits_reset(static_cast<XXH3_state_t*>(state_));
+}
+Xxh3Stream::~Xxh3Stream() { XXH3_freeState(static_cast<XXH3_state_t*>(state_)); }
+void Xxh3Stream::update(std::span<const uint8_t> bytes) noexcept {
+  XXH3_64bits_update(static_cast<XXH3_state_t*>(state_), bytes.data(), bytes.size());
+}
+uint64_t Xxh3Stream::digest() const noexcept {
+  return XXH3_64bits_digest(static_cast<const XXH3_state_t*>(state_));
+}
+
+Status compress(Codec codec, int level, std::span<const uint8_t> raw, std::vector<uint8_t>* out) {
+  switch (codec) {
+    case Codec::kStored:
+      out->assign(raw.begin(), raw.end());
+      return {};
+    case Codec::kZstd: {
+      out->resize(ZSTD_compressBound(raw.size()));
+      ZSTD_CCtx* cctx = ZSTD_createCCtx();
+      if (!cctx) return makeError(Code::kOutOfMemory, "cannot create a zstd context");
+      // Fixed parameters: the output depends only on the input, the level and the zstd version.
+      ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, level);
+      ZSTD_CCtx_setParameter(cctx, ZSTD_c_contentSizeFlag, 1);
+      ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 0);
+      ZSTD_CCtx_setParameter(cctx, ZSTD_c_dictIDFlag, 0);
+      size_t n = ZSTD_compress2(cctx, out->data(), out->size(), raw.data(), raw.size());
+      ZSTD_freeCCtx(cctx);
+      if (ZSTD_isError(n))
+        return makeError(Code::kInvalidArgument, std::string("zstd: ") + ZSTD_getErrorName(n));
+      out->resize(n);
+      return {};
+    }
+  }
+  return makeError(Code::kInvalidArgument, "unknown codec");
+}
+
+Status decompress(Codec codec, std::span<const uint8_t> stored, std::span<uint8_t> out,
+                  Code failCode) {
+  switch (codec) {
+    case Codec::kStored:
+      if (stored.size() != out.size())
+        return makeError(failCode, "stored size " + std::to_string(stored.size()) +
+                                       " differs from raw size " + std::to_string(out.size()));
+      if (!out.empty()) std::memcpy(out.data(), stored.data(), out.size());
+      return {};
+    case Codec::kZstd: {
+      unsigned long long content = ZSTD_getFrameContentSize(stored.data(), stored.size());
+      if (content == ZSTD_CONTENTSIZE_ERROR)
+        return makeError(failCode, "not a zstd frame");
+      if (content == ZSTD_CONTENTSIZE_UNKNOWN)
+        return makeError(failCode, "zstd frame does not declare its content size");
+      if (content != out.size())
+        return makeError(failCode, "zstd frame declares " + std::to_string(content) +
+                                       " bytes, expected " + std::to_string(out.size()));
+      size_t frame = ZSTD_findFrameCompressedSize(stored.data(), stored.size());
+      if (ZSTD_isError(frame) || frame != stored.size())
+        return makeError(failCode, "stored bytes are not exactly one zstd frame");
+      ZSTD_DCtx* dctx = ZSTD_createDCtx();
+      if (!dctx) return makeError(Code::kOutOfMemory, "cannot create a zstd context");
+      size_t n = ZSTD_decompressDCtx(dctx, out.data(), out.size(), stored.data(), stored.size());
+      ZSTD_freeDCtx(dctx);
+      if (ZSTD_isError(n)) return makeError(failCode, std::string("zstd: ") + ZSTD_getErrorName(n));
+      if (n != out.size())
+        return makeError(failCode, "zstd frame decoded to " + std::to_string(n) + " bytes, expected " +
+                                       std::to_string(out.size()));
+      return {};
+    }
+  }
+  return makeError(failCode, "unknown codec " + std::to_string(unsigned(codec)));
+}
+
+}  // namespace vff::detail
