@@ -1,0 +1,197 @@
+// cli.cpp - the shared command-line helpers (see cli.h).
+#include "cli.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cinttypes>
+#include <cstdio>
+#include <cstring>
+
+#include "vff/format.h"
+#include "vff/version.h"
+
+namespace vff::cli {
+
+int exitCodeFor(Code code) noexcept {
+  const auto c = static_cast<uint32_t>(code);
+  if (c == 0) return kExitSuccess;
+  if (c >= 1000 && c < 2000) return kExitIo;
+  if (c >= 2000 && c < 9000) return kExitInvalidFile;
+  if (code == Code::kUnsupported) return kExitUnsupported;
+  if (code == Code::kMeshFormat || code == Code::kMeshUnsupported) return kExitUnsupported;
+  if (c >= 10000 && c < 11000) return kExitInvalidFile;
+  return kExitRuntime;
+}
+
+std::string exitCodeHelp() {
+  return "Exit codes:\n"
+         "  0  success\n"
+         "  1  command-line error (unknown option, missing or invalid argument)\n"
+         "  2  I/O error (a file cannot be opened, read or written)\n"
+         "  3  invalid input file (not a .vff file, corrupt, or fails validation)\n"
+         "  4  runtime error\n"
+         "  5  unsupported (a valid request this tool or field does not support)";
+}
+
+std::string versionString(std::string_view prog) {
+  return std::string(prog) + " " + kLibraryVersion + " (libvff " + kLibraryVersion + ", .vff format " +
+         std::to_string(kVersionMajor) + "." + std::to_string(kVersionMinor) + ")";
+}
+
+std::string formatDiagnostic(std::string_view prog, std::string_view severity, std::string_view file,
+                             const Error& error) {
+  std::string place(file);
+  if (error.offset != kNoOffset) place += "@" + hex(error.offset);
+  if (error.section != 0) {
+    if (!place.empty()) place += ' ';
+    place += "[" + sectionTagName(error.section) + "]";
+  }
+  std::string s = std::string(prog) + ": " + std::string(severity) + ": ";
+  if (!place.empty()) s += place + ": ";
+  s += codeName(error.code);
+  s += " (" + std::to_string(static_cast<uint32_t>(error.code)) + "): " + error.message;
+  return s;
+}
+
+int reportError(std::string_view prog, std::string_view file, const Error& error) {
+  (void)std::fprintf(stderr, "%s\n", formatDiagnostic(prog, "error", file, error).c_str());
+  const int rc = exitCodeFor(error.code);
+  return rc == kExitSuccess ? kExitRuntime : rc;  // an Error with kOk is still a failure
+}
+
+void reportWarning(std::string_view prog, std::string_view file, const Error& error) {
+  (void)std::fprintf(stderr, "%s\n", formatDiagnostic(prog, "warning", file, error).c_str());
+}
+
+void usageError(std::string_view prog, std::string_view message) {
+  const std::string p(prog), m(message);
+  (void)std::fprintf(stderr, "%s: error: %s\nRun with --help for more information.\n", p.c_str(), m.c_str());
+}
+
+void printError(std::string_view prog, std::string_view message) {
+  const std::string p(prog), m(message);
+  (void)std::fprintf(stderr, "%s: error: %s\n", p.c_str(), m.c_str());
+}
+
+void addVersionFlag(CLI::App& app, std::string_view prog) {
+  app.set_version_flag("--version", versionString(prog), "print the version and exit");
+}
+
+void addFormatOption(CLI::App& app, OutputFormat& format) {
+  app.add_option_function<std::string>(
+         "--format",
+         [&format](const std::string& v) { format = v == "json" ? OutputFormat::kJson : OutputFormat::kText; },
+         "output format: text, or json (one JSON object on stdout)")
+      ->check(CLI::IsMember({"text", "json"}))
+      ->option_text("text|json");
+}
+
+void addCommonOptions(CLI::App& app, std::string_view prog, CommonOptions& options) {
+  addVersionFlag(app, prog);
+  addFormatOption(app, options.format);
+}
+
+std::optional<int> parse(CLI::App& app, std::string_view prog, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) {  // --help, --version: CLI11 prints them to stdout
+      app.exit(e);
+      return kExitSuccess;
+    }
+    usageError(prog, e.what());
+    return kExitUsage;
+  }
+  return std::nullopt;
+}
+
+std::string formatBytes(uint64_t bytes) {
+  char buf[64];
+  (void)std::snprintf(buf, sizeof buf, "%" PRIu64 " bytes (%.3f MiB)", bytes,
+                      static_cast<double>(bytes) / (1024.0 * 1024.0));
+  return buf;
+}
+
+std::string hex(uint64_t value) {
+  char buf[24];
+  (void)std::snprintf(buf, sizeof buf, "0x%" PRIx64, value);
+  return buf;
+}
+
+std::string hex64(uint64_t value) {
+  char buf[24];
+  (void)std::snprintf(buf, sizeof buf, "0x%016" PRIx64, value);
+  return buf;
+}
+
+Result<std::vector<uint8_t>> readStdin() {
+  std::vector<uint8_t> bytes;
+  uint8_t buf[1 << 16];
+  for (;;) {
+    const ssize_t n = ::read(STDIN_FILENO, buf, sizeof buf);
+    if (n == 0) break;
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return makeError(Code::kIoRead, std::string("standard input: ") + std::strerror(errno));
+    }
+    bytes.insert(bytes.end(), buf, buf + n);
+  }
+  return bytes;
+}
+
+namespace {
+
+// Writes all of `bytes` to `fd`; false with errno set on failure.
+bool writeAll(int fd, std::span<const uint8_t> bytes) {
+  size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return false;
+    }
+    done += static_cast<size_t>(n);
+  }
+  return true;
+}
+
+Error writeError(const std::string& path, const char* what) {
+  return makeError(Code::kIoWrite, path + ": " + what + ": " + std::strerror(errno));
+}
+
+}  // namespace
+
+Status writeFileAtomic(const std::string& path, std::span<const uint8_t> bytes) {
+  if (path == "-") {
+    if (!writeAll(STDOUT_FILENO, bytes)) return writeError("standard output", "cannot write");
+    return {};
+  }
+  // The temporary lives next to the destination so that the rename stays within one file system.
+  std::string tmp = path + ".tmp-XXXXXX";
+  const int fd = ::mkstemp(tmp.data());
+  if (fd < 0) return writeError(path, "cannot create a temporary file");
+  // mkstemp creates the file 0600; give it the mode a plain create would (0666 less the umask).
+  const mode_t mask = ::umask(0);
+  ::umask(mask);
+  const bool wrote = writeAll(fd, bytes) && ::fchmod(fd, 0666 & ~mask) == 0;
+  int err = errno;
+  const bool closed = ::close(fd) == 0;
+  if (wrote && !closed) err = errno;
+  if (!wrote || !closed) {
+    ::unlink(tmp.c_str());
+    errno = err;
+    return writeError(path, "cannot write");
+  }
+  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int e = errno;
+    ::unlink(tmp.c_str());
+    errno = e;
+    return writeError(path, "cannot rename the temporary file into place");
+  }
+  return {};
+}
+
+}  // namespace vff::cli

@@ -1,0 +1,107 @@
+// cli.h - what every vff-* command-line tool shares: exit codes, diagnostics, --version, --format,
+// reading "-" from stdin and writing output files atomically.
+//
+// Conventions (KTX-Software style, see STYLE.md):
+//   - data goes to stdout, diagnostics to stderr;
+//   - a diagnostic reads "vff-inspect: error: file.vff@0x40 [DIST]: header-checksum (3005): message";
+//   - every tool returns one of the documented exit codes below and prints exitCodeHelp() in --help;
+//   - every tool has --help and --version; tools with a report take --format text|json.
+//
+//   int main(int argc, char** argv) {
+//     CLI::App app{"Does things.\n" + vff::cli::exitCodeHelp()};
+//     vff::cli::CommonOptions common;
+//     vff::cli::addCommonOptions(app, "vff-thing", common);
+//     if (auto rc = vff::cli::parse(app, "vff-thing", argc, argv)) return *rc;
+//     auto f = vff::File::open(path);
+//     if (!f) return vff::cli::reportError("vff-thing", path, f.error());
+//   }
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "vff/error.h"
+
+namespace vff::cli {
+
+// ---- Exit codes ---------------------------------------------------------------------------------
+inline constexpr int kExitSuccess = 0;      // the command did what was asked (a file may still have warnings)
+inline constexpr int kExitUsage = 1;        // bad command line: unknown option, missing or invalid argument
+inline constexpr int kExitIo = 2;           // a file cannot be opened, read or written
+inline constexpr int kExitInvalidFile = 3;  // an input file is not valid (not a .vff, corrupt, fails validation)
+inline constexpr int kExitRuntime = 4;      // any other failure while running (out of memory, internal error)
+inline constexpr int kExitUnsupported = 5;  // a valid request this build or this field does not support
+
+// The exit code for a libvff error code:
+//   1xxx (I/O) -> 2; 2xxx..8xxx (file problems) -> 3; 9005 (unsupported) -> 5;
+//   10xxx (mesh input): 10001 unknown mesh format and 10003 unsupported mesh content -> 5,
+//   the other 10xxx (an unparsable or unusable mesh) -> 3; everything else (9xxx API, unknown) -> 4.
+int exitCodeFor(Code code) noexcept;
+
+// The "Exit codes:" paragraph for the end of every tool's --help text.
+std::string exitCodeHelp();
+
+// "vff-inspect 0.1.0 (libvff 0.1.0, .vff format 1.0)", for --version.
+std::string versionString(std::string_view prog);
+
+// ---- Diagnostics (all to stderr) ----------------------------------------------------------------
+// "PROG: SEVERITY: FILE@0xOFFSET [TAG]: code-name (1234): message". The place is left out piece by
+// piece when unknown: no "@0x.." without an offset, no "[TAG]" without a section, no "FILE" when
+// `file` is empty (then the colon after the place goes too).
+std::string formatDiagnostic(std::string_view prog, std::string_view severity, std::string_view file,
+                             const Error& error);
+
+// Prints formatDiagnostic(prog, "error", file, error) to stderr and returns exitCodeFor(error.code).
+int reportError(std::string_view prog, std::string_view file, const Error& error);
+
+// Prints "PROG: warning: ..." for an Error that does not stop the command.
+void reportWarning(std::string_view prog, std::string_view file, const Error& error);
+
+// Prints "PROG: error: message" and a hint to run --help. The caller returns kExitUsage.
+void usageError(std::string_view prog, std::string_view message);
+
+// Prints "PROG: error: message" for a failure that is neither a usage error nor a libvff Error.
+void printError(std::string_view prog, std::string_view message);
+
+// ---- Options shared by every tool ---------------------------------------------------------------
+enum class OutputFormat { kText, kJson };
+
+struct CommonOptions {
+  OutputFormat format = OutputFormat::kText;  // --format text|json
+};
+
+// Adds --version (printing versionString(prog)) to `app`.
+void addVersionFlag(CLI::App& app, std::string_view prog);
+// Adds --format text|json, stored into `format`.
+void addFormatOption(CLI::App& app, OutputFormat& format);
+// Both of the above.
+void addCommonOptions(CLI::App& app, std::string_view prog, CommonOptions& options);
+
+// Parses the command line. Returns nothing when the tool should go on; otherwise the exit code to
+// return at once: kExitSuccess after --help or --version (printed to stdout), kExitUsage after a
+// parse error (printed to stderr as a diagnostic, with a hint to run --help).
+std::optional<int> parse(CLI::App& app, std::string_view prog, int argc, char** argv);
+
+// ---- Formatting ---------------------------------------------------------------------------------
+// "17309696 bytes (16.508 MiB)": the exact count and MiB (2^20 bytes) with three decimals.
+std::string formatBytes(uint64_t bytes);
+// "0x1f40"
+std::string hex(uint64_t value);
+// "0x0123456789abcdef" (always 16 digits, for checksums)
+std::string hex64(uint64_t value);
+
+// ---- Files --------------------------------------------------------------------------------------
+// The whole of standard input (for a FILE argument of "-"). Fails with kIoRead.
+Result<std::vector<uint8_t>> readStdin();
+
+// Writes `bytes` to `path` through a temporary file in the same folder and a rename, so that a
+// failure never leaves a partial file (nor removes an existing one). "-" writes to stdout.
+// Fails with kIoWrite (the message names the file).
+Status writeFileAtomic(const std::string& path, std::span<const uint8_t> bytes);
+
+}  // namespace vff::cli
