@@ -829,9 +829,13 @@ TEST(PositionLookupLarge, FibonacciLargestNSpotCheck) {
     const uint32_t got = fib.nearest(q);
     const auto g = exact(got);
     const L gd = g[0] * q.x + g[1] * q.y + g[2] * q.z;
-    const double chord = std::sqrt(double(2 - 2 * gd)) + 1e-9;
-    const int64_t lo = std::max<int64_t>(0, int64_t(std::floor((n * (1 - q.z - chord) - 1) / 2)) - 1);
-    const int64_t hi = std::min<int64_t>(n - 1, int64_t(std::ceil((n * (1 - q.z + chord) - 1) / 2)) + 1);
+    // q is a unit vector only to binary32 precision: the band is computed from the normalised query.
+    const L len = std::sqrt(L(q.x) * q.x + L(q.y) * q.y + L(q.z) * q.z);
+    const double qz = double(q.z / len);
+    const double chord = std::sqrt(std::max(0.0, double(2 - 2 * (gd / len)))) + 1e-9;
+    const int64_t lo = std::max<int64_t>(0, int64_t(std::floor((n * (1 - qz - chord) - 1) / 2)) - 1);
+    const int64_t hi = std::min<int64_t>(n - 1, int64_t(std::ceil((n * (1 - qz + chord) - 1) / 2)) + 1);
+    ASSERT_LE(lo, hi) << "query " << k;
     for (int64_t i = lo; i <= hi; ++i) {
       const auto p = exact(i);
       ASSERT_LE(double(p[0] * q.x + p[1] * q.y + p[2] * q.z - gd), 1e-12) << "query " << k << " i=" << i;
