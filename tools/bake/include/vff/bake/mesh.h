@@ -1,0 +1,47 @@
+// vff/bake/mesh.h - triangle meshes for baking, and their importers.
+//
+// Supported inputs: OBJ, PLY, OFF, STL (through OpenMesh; polygons are triangulated) and glTF 2.0
+// .gltf/.glb (through tinygltf: every triangle primitive of the default scene, node transforms
+// applied). Content that cannot be baked is an error, never a silently empty mesh:
+//   kIoOpen          the file is missing or unreadable
+//   kMeshFormat      unknown extension
+//   kMeshParse       the importer cannot parse the file
+//   kMeshUnsupported points/lines primitives, required glTF extensions (Draco, meshopt, ...),
+//                    non-float positions, sparse accessors
+//   kMeshIndex       an index or an accessor outside its buffer
+//   kMeshEmpty       no triangles; kMeshNonFinite a NaN/Inf coordinate (message names the vertex);
+//   kMeshDegenerate  every triangle has zero area
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "vff/error.h"
+
+namespace vff::bake {
+
+struct Mesh {
+  std::vector<float> positions;   // x, y, z per vertex (object space)
+  std::vector<float> normals;     // x, y, z per vertex, or empty when the input has none
+  std::vector<uint32_t> indices;  // three per triangle
+  uint64_t droppedDegenerate = 0;  // zero-area triangles removed by checkMesh()
+  size_t vertexCount() const { return positions.size() / 3; }
+  size_t triangleCount() const { return indices.size() / 3; }
+};
+
+struct MeshInfo {
+  std::string format;  // "obj", "ply", "off", "stl", "gltf", "glb"
+};
+
+// Loads and checks a mesh (see the error list above). Messages name the file.
+Result<Mesh> loadMesh(const std::string& path, MeshInfo* info = nullptr);
+
+// Checks a mesh held in memory: finite coordinates, indices in range, drops zero-area triangles,
+// and fails when none remain. `what` names the source in messages.
+Status checkMesh(Mesh* mesh, const std::string& what);
+
+// Content hash (XXH3-64 of the positions and indices) for provenance metadata.
+uint64_t meshHash(const Mesh& mesh);
+
+}  // namespace vff::bake

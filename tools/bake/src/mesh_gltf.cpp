@@ -1,0 +1,272 @@
+// glTF 2.0 (.gltf and .glb) through tinygltf: the triangle primitives of the default scene.
+#include <tiny_gltf.h>
+
+#include <array>
+#include <cmath>
+#include <cstring>
+
+#include "mesh_importers.h"
+
+namespace vff::bake::detail {
+namespace {
+
+using Mat4 = std::array<double, 16>;  // column-major, as glTF stores it
+
+Mat4 identity() { return {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}; }
+
+Mat4 mul(const Mat4& a, const Mat4& b) {
+  Mat4 r{};
+  for (int c = 0; c < 4; ++c)
+    for (int rr = 0; rr < 4; ++rr) {
+      double s = 0;
+      for (int k = 0; k < 4; ++k) s += a[size_t(k * 4 + rr)] * b[size_t(c * 4 + k)];
+      r[size_t(c * 4 + rr)] = s;
+    }
+  return r;
+}
+
+Mat4 nodeMatrix(const tinygltf::Node& n) {
+  if (n.matrix.size() == 16) {
+    Mat4 m;
+    std::copy(n.matrix.begin(), n.matrix.end(), m.begin());
+    return m;
+  }
+  Mat4 t = identity(), r = identity(), s = identity();
+  if (n.translation.size() == 3) {
+    t[12] = n.translation[0];
+    t[13] = n.translation[1];
+    t[14] = n.translation[2];
+  }
+  if (n.rotation.size() == 4) {
+    const double x = n.rotation[0], y = n.rotation[1], z = n.rotation[2], w = n.rotation[3];
+    r = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w),     2 * (x * z - y * w),     0,
+         2 * (x * y - z * w),     1 - 2 * (x * x + z * z), 2 * (y * z + x * w),     0,
+         2 * (x * z + y * w),     2 * (y * z - x * w),     1 - 2 * (x * x + y * y), 0,
+         0,                       0,                       0,                       1};
+  }
+  if (n.scale.size() == 3) {
+    s[0] = n.scale[0];
+    s[5] = n.scale[1];
+    s[10] = n.scale[2];
+  }
+  return mul(t, mul(r, s));
+}
+
+// Inverse transpose of the upper 3x3 (for normals), row-major 3x3.
+std::array<double, 9> normalMatrix(const Mat4& m) {
+  const double a = m[0], b = m[4], c = m[8], d = m[1], e = m[5], f = m[9], g = m[2], h = m[6], i = m[10];
+  const double A = e * i - f * h, B = -(d * i - f * g), C = d * h - e * g;
+  const double D = -(b * i - c * h), E = a * i - c * g, F = -(a * h - b * g);
+  const double G = b * f - c * e, H = -(a * f - c * d), I = a * e - b * d;
+  // inverse = adj / det; transpose of inverse = cofactor matrix / det.
+  const double det = a * A + b * B + c * C;
+  const double s = det != 0 ? 1.0 / det : 0.0;
+  return {A * s, B * s, C * s, D * s, E * s, F * s, G * s, H * s, I * s};
+}
+
+class Importer {
+ public:
+  Importer(const tinygltf::Model& model, const std::string& path) : model_(model), path_(path) {}
+
+  Status node(int index, const Mat4& parent, int depth) {
+    if (index < 0 || size_t(index) >= model_.nodes.size())
+      return makeError(Code::kMeshIndex, path_ + ": node index " + std::to_string(index) + " out of range");
+    if (depth > 64) return makeError(Code::kMeshParse, path_ + ": node hierarchy deeper than 64 (a cycle?)");
+    const tinygltf::Node& n = model_.nodes[size_t(index)];
+    const Mat4 world = mul(parent, nodeMatrix(n));
+    if (n.mesh >= 0) {
+      if (size_t(n.mesh) >= model_.meshes.size())
+        return makeError(Code::kMeshIndex, path_ + ": node " + std::to_string(index) + " references a missing mesh");
+      Status s = mesh(model_.meshes[size_t(n.mesh)], world);
+      if (!s) return s;
+    }
+    for (int c : n.children) {
+      Status s = node(c, world, depth + 1);
+      if (!s) return s;
+    }
+    return {};
+  }
+
+  Status mesh(const tinygltf::Mesh& mesh, const Mat4& world) {
+    for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
+      const tinygltf::Primitive& p = mesh.primitives[pi];
+      const std::string where = path_ + ": mesh '" + mesh.name + "' primitive " + std::to_string(pi);
+      const int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
+      if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN)
+        return makeError(Code::kMeshUnsupported, where + " has mode " + std::to_string(mode) +
+                                                     " (points or lines), not triangles");
+      auto pos = p.attributes.find("POSITION");
+      if (pos == p.attributes.end()) return makeError(Code::kMeshUnsupported, where + " has no POSITION");
+      std::vector<float> xyz;
+      Status s = readVec3(pos->second, where + " POSITION", &xyz);
+      if (!s) return s;
+      std::vector<float> nrm;
+      auto nit = p.attributes.find("NORMAL");
+      if (nit != p.attributes.end()) {
+        s = readVec3(nit->second, where + " NORMAL", &nrm);
+        if (!s) return s;
+        if (nrm.size() != xyz.size()) nrm.clear();
+      }
+      const size_t count = xyz.size() / 3;
+      std::vector<uint32_t> idx;
+      if (p.indices >= 0) {
+        s = readIndices(p.indices, where + " indices", count, &idx);
+        if (!s) return s;
+      } else {
+        idx.resize(count);
+        for (size_t i = 0; i < count; ++i) idx[i] = uint32_t(i);
+      }
+      const uint32_t base = uint32_t(out.positions.size() / 3);
+      for (size_t v = 0; v < count; ++v) {
+        const double x = xyz[3 * v], y = xyz[3 * v + 1], z = xyz[3 * v + 2];
+        out.positions.push_back(float(world[0] * x + world[4] * y + world[8] * z + world[12]));
+        out.positions.push_back(float(world[1] * x + world[5] * y + world[9] * z + world[13]));
+        out.positions.push_back(float(world[2] * x + world[6] * y + world[10] * z + world[14]));
+      }
+      if (nrm.empty()) {
+        allNormals_ = false;
+      } else {
+        const auto nm = normalMatrix(world);
+        for (size_t v = 0; v < count; ++v) {
+          const double x = nrm[3 * v], y = nrm[3 * v + 1], z = nrm[3 * v + 2];
+          normals_.push_back(float(nm[0] * x + nm[1] * y + nm[2] * z));
+          normals_.push_back(float(nm[3] * x + nm[4] * y + nm[5] * z));
+          normals_.push_back(float(nm[6] * x + nm[7] * y + nm[8] * z));
+        }
+      }
+      // Flip winding under a mirroring transform so geometric normals stay outward.
+      const bool mirror = (world[0] * (world[5] * world[10] - world[9] * world[6]) -
+                           world[4] * (world[1] * world[10] - world[9] * world[2]) +
+                           world[8] * (world[1] * world[6] - world[5] * world[2])) < 0;
+      auto tri = [&](uint32_t a, uint32_t b, uint32_t c) {
+        if (mirror) std::swap(b, c);
+        out.indices.insert(out.indices.end(), {base + a, base + b, base + c});
+      };
+      if (mode == TINYGLTF_MODE_TRIANGLES) {
+        for (size_t t = 0; t + 2 < idx.size(); t += 3) tri(idx[t], idx[t + 1], idx[t + 2]);
+      } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+        for (size_t t = 0; t + 2 < idx.size(); ++t)
+          (t % 2 == 0) ? tri(idx[t], idx[t + 1], idx[t + 2]) : tri(idx[t + 1], idx[t], idx[t + 2]);
+      } else {
+        for (size_t t = 1; t + 1 < idx.size(); ++t) tri(idx[0], idx[t], idx[t + 1]);
+      }
+    }
+    return {};
+  }
+
+  // The bytes an accessor covers, checked against its buffer.
+  Status view(int accessor, const std::string& what, size_t elemSize, const uint8_t** data, size_t* stride,
+              size_t* count, int* componentType, int* type) {
+    if (accessor < 0 || size_t(accessor) >= model_.accessors.size())
+      return makeError(Code::kMeshIndex, what + ": accessor " + std::to_string(accessor) + " out of range");
+    const tinygltf::Accessor& a = model_.accessors[size_t(accessor)];
+    if (a.sparse.isSparse) return makeError(Code::kMeshUnsupported, what + ": sparse accessors are not supported");
+    *componentType = a.componentType;
+    *type = a.type;
+    *count = a.count;
+    if (a.bufferView < 0 || size_t(a.bufferView) >= model_.bufferViews.size())
+      return makeError(Code::kMeshIndex, what + ": accessor has no valid bufferView");
+    const tinygltf::BufferView& bv = model_.bufferViews[size_t(a.bufferView)];
+    if (bv.buffer < 0 || size_t(bv.buffer) >= model_.buffers.size())
+      return makeError(Code::kMeshIndex, what + ": bufferView references a missing buffer");
+    const tinygltf::Buffer& buf = model_.buffers[size_t(bv.buffer)];
+    *stride = bv.byteStride ? bv.byteStride : elemSize;
+    const uint64_t begin = uint64_t(bv.byteOffset) + a.byteOffset;
+    const uint64_t need = a.count == 0 ? 0 : uint64_t(*stride) * (a.count - 1) + elemSize;
+    if (uint64_t(bv.byteOffset) + bv.byteLength > buf.data.size() || a.byteOffset + need > bv.byteLength ||
+        begin + need > buf.data.size())
+      return makeError(Code::kMeshIndex, what + ": accessor reaches outside its buffer");
+    *data = buf.data.data() + begin;
+    return {};
+  }
+
+  Status readVec3(int accessor, const std::string& what, std::vector<float>* out3) {
+    const uint8_t* d;
+    size_t stride, count;
+    int ct, type;
+    Status s = view(accessor, what, 12, &d, &stride, &count, &ct, &type);
+    if (!s) return s;
+    if (type != TINYGLTF_TYPE_VEC3 || ct != TINYGLTF_COMPONENT_TYPE_FLOAT)
+      return makeError(Code::kMeshUnsupported, what + ": only float VEC3 data is supported (quantised meshes are not)");
+    out3->resize(count * 3);
+    for (size_t i = 0; i < count; ++i) std::memcpy(&(*out3)[3 * i], d + i * stride, 12);
+    return {};
+  }
+
+  Status readIndices(int accessor, const std::string& what, size_t vertexCount, std::vector<uint32_t>* idx) {
+    const uint8_t* d;
+    size_t stride, count;
+    int ct, type;
+    const int ctPeek = accessor >= 0 && size_t(accessor) < model_.accessors.size() ? model_.accessors[size_t(accessor)].componentType : 0;
+    const size_t es = ctPeek == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ? 1 : ctPeek == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? 2 : 4;
+    Status s = view(accessor, what, es, &d, &stride, &count, &ct, &type);
+    if (!s) return s;
+    if (type != TINYGLTF_TYPE_SCALAR ||
+        (ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+         ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
+      return makeError(Code::kMeshUnsupported, what + ": indices must be unsigned scalar integers");
+    idx->resize(count);
+    for (size_t i = 0; i < count; ++i) {
+      uint32_t v = 0;
+      if (es == 1) v = d[i * stride];
+      else if (es == 2) { uint16_t t; std::memcpy(&t, d + i * stride, 2); v = t; }
+      else std::memcpy(&v, d + i * stride, 4);
+      if (v >= vertexCount)
+        return makeError(Code::kMeshIndex, what + ": index " + std::to_string(v) + " >= vertex count " + std::to_string(vertexCount));
+      (*idx)[i] = v;
+    }
+    return {};
+  }
+
+  Mesh out;
+  std::vector<float> normals_;
+  bool allNormals_ = true;
+
+ private:
+  const tinygltf::Model& model_;
+  std::string path_;
+};
+
+bool skipImages(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+  return true;  // images are not needed for baking
+}
+
+}  // namespace
+
+Result<Mesh> loadWithTinyGltf(const std::string& path, bool binary) {
+  tinygltf::TinyGLTF loader;
+  loader.SetImageLoader(skipImages, nullptr);
+  tinygltf::Model model;
+  std::string err, warn;
+  bool ok = false;
+  try {
+    ok = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, path) : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+  } catch (const std::exception& e) {
+    return makeError(Code::kMeshParse, path + ": " + e.what());
+  }
+  if (!ok) {
+    while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
+    return makeError(Code::kMeshParse, path + ": " + (err.empty() ? std::string("cannot parse glTF") : err));
+  }
+  for (const std::string& ext : model.extensionsRequired)
+    return makeError(Code::kMeshUnsupported, path + ": required extension " + ext + " is not supported");
+  Importer imp(model, path);
+  const Mat4 id = identity();
+  if (!model.scenes.empty()) {
+    const int sceneIndex = model.defaultScene >= 0 ? model.defaultScene : 0;
+    if (size_t(sceneIndex) >= model.scenes.size()) return makeError(Code::kMeshIndex, path + ": default scene out of range");
+    for (int n : model.scenes[size_t(sceneIndex)].nodes) {
+      Status s = imp.node(n, id, 0);
+      if (!s) return std::move(s).error();
+    }
+  } else {
+    for (const auto& m : model.meshes) {
+      Status s = imp.mesh(m, id);
+      if (!s) return std::move(s).error();
+    }
+  }
+  if (imp.allNormals_ && imp.normals_.size() == imp.out.positions.size()) imp.out.normals = std::move(imp.normals_);
+  return std::move(imp.out);
+}
+
+}  // namespace vff::bake::detail
