@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Command 1: set up, build, bake the Stanford bunny (Debian's glmark2-data copy) with the paper's
+# configuration (4226 maps of 64x64, 8 bits per ray, normalised by 2R), inspect the field and write
+# a contact sheet of its maps. Output goes to out/.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$root"
+bash scripts/setup.sh
+cmake --preset release >/dev/null
+cmake --build --preset release -j "$(nproc)"
+
+bin="$root/build/tools"
+mesh="${1:-/usr/share/glmark2/models/bunny.obj}"
+mkdir -p out
+echo "== vff-bake $mesh"
+"$bin/vff-bake/vff-bake" "$mesh" -o out/bunny.vff
+echo "== vff-inspect out/bunny.vff"
+"$bin/vff-inspect/vff-inspect" out/bunny.vff --preview out/bunny-maps.png
+"$bin/vff-inspect/vff-inspect" out/bunny.vff --validate
+echo "wrote out/bunny.vff and out/bunny-maps.png"

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Installs what vff needs to build, test and run, from Debian 12's archive. Idempotent: when every
+# package is already installed it changes nothing and needs no network.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config git
+  libembree-dev libopenexr-dev openexr libopenvdb-dev libopenvdb-tools libboost-iostreams-dev
+  libopenmesh-dev libtinygltf-dev libcli11-dev libzstd-dev libxxhash-dev nlohmann-json3-dev
+  libstb-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev glslang-tools
+  libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri
+  glmark2-data zstd xz-utils python3
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+echo "setup: installing ${missing[*]}"
+sudo=""
+if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+$sudo apt-get update -qq
+$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
