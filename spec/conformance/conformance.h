@@ -6,6 +6,9 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <span>
 #include <string>
@@ -20,6 +23,12 @@ namespace vff::conformance {
 inline bool isFileProblem(Code code) noexcept {
   const auto v = uint32_t(code);
   return v >= 2000 && v < 9000;
+}
+
+// The whole file at `path` (empty when it cannot be read; the callers compare against known bytes).
+inline std::vector<uint8_t> readBytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 inline constexpr ChecksumPolicy kPolicies[] = {ChecksumPolicy::kVerifyAll, ChecksumPolicy::kLazy,

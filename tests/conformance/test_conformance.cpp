@@ -35,10 +35,7 @@ namespace {
 
 const fs::path kDir = VFF_CONFORMANCE_DIR;
 
-std::vector<uint8_t> readBytes(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using conformance::readBytes;
 
 json readJson(const fs::path& p) {
   std::ifstream in(p);
