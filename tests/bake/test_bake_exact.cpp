@@ -1,7 +1,6 @@
 // Decoded distances of baked fields against exact Embree ray casts on the same sample directions:
 // hits within one quantisation step, misses exact. The reference uses rtcIntersect1 on its own
 // scene, not the baker's packet path.
-#include <embree3/rtcore.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,56 +8,13 @@
 
 #include "vff/bake/baker.h"
 #include "vff/bake/procedural.h"
+#include "embree_reference.h"
 #include "vff/vff.h"
 
 namespace vff::bake {
 namespace {
 
-class Reference {
- public:
-  explicit Reference(const Mesh& m) {
-    dev_ = rtcNewDevice("threads=1");
-    scene_ = rtcNewScene(dev_);
-    rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
-    RTCGeometry g = rtcNewGeometry(dev_, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 12, m.vertexCount()));
-    auto* ix = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 12, m.triangleCount()));
-    std::copy(m.positions.begin(), m.positions.end(), v);
-    std::copy(m.indices.begin(), m.indices.end(), ix);
-    rtcCommitGeometry(g);
-    rtcAttachGeometry(scene_, g);
-    rtcReleaseGeometry(g);
-    rtcCommitScene(scene_);
-  }
-  ~Reference() {
-    rtcReleaseScene(scene_);
-    rtcReleaseDevice(dev_);
-  }
-  // Distance to the first hit, or a negative value for a miss.
-  float cast(Vec3 o, Vec3 d, Vec3* ng = nullptr) const {
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    RTCRayHit rh{};
-    rh.ray.org_x = o.x;
-    rh.ray.org_y = o.y;
-    rh.ray.org_z = o.z;
-    rh.ray.dir_x = d.x;
-    rh.ray.dir_y = d.y;
-    rh.ray.dir_z = d.z;
-    rh.ray.tnear = 0;
-    rh.ray.tfar = INFINITY;
-    rh.ray.mask = ~0u;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(scene_, &ctx, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return -1;
-    if (ng) *ng = {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
-    return rh.ray.tfar;
-  }
-
- private:
-  RTCDevice dev_;
-  RTCScene scene_;
-};
+using test::Reference;
 
 struct Stats {
   uint64_t hits = 0, misses = 0;

@@ -6,6 +6,7 @@
 #include "vff/error.h"
 #include "vff/format.h"
 #include "vff/positions.h"
+#include "vff/query.h"
 #include "vff/reader.h"
 #include "vff/validate.h"
 #include "vff/version.h"

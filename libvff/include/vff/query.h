@@ -1,0 +1,164 @@
+// vff/query.h - answering rays with a visibility field: the CPU query.
+//
+// A FieldQuery is a query-ready view of one object's field. It answers rays in the object's space
+// (spec/geometry.md section 7); an Instance places it in a world with a rigid transform (rotation,
+// translation, uniform scale) and answers world-space rays.
+//
+//   vff::Result<vff::File> file = vff::File::open("bunny.vff");
+//   vff::Result<vff::FieldQuery> q = vff::FieldQuery::fromFile(*file);   // borrows *file
+//   vff::Ray ray{origin, direction, 0.0f, tmax};
+//   vff::QueryHit h = q->intersect(ray);                                  // h.hit, h.t, h.point
+//   bool blocked = q->occluded(ray);                                      // the shadow/AO shortcut
+//
+// What a query answers.
+// * A ray whose origin is outside the bounding sphere (inter-object) enters the sphere at distance
+//   tEntry; the map of the positional sample nearest to the entry point, looked up in the ray's
+//   direction, gives the distance d to the surface: the hit is at t = tEntry + d (section 7.2).
+// * A ray whose origin is inside the sphere (intra-object: a point on the object looking out) is
+//   answered by the paper's test (section 7.3): the ray leaves the sphere at d1; the reversed ray,
+//   entering there, reports the surface at d2 from the exit point. The ray is occluded when
+//   d2 < d1 - bias. The field only sees the surface from outside, so intersect() then reports the
+//   LAST surface crossing before the exit, at t = d1 - d2, not necessarily the first.
+// * Reconstruction::kNearest is the paper's: one sample, one texel. kInterpolated blends the few
+//   samples within one mean spacing of the entry point (each looked up in the ray's direction, its hit point projected
+//   back onto the ray) and, within each map, the 2 x 2 texels around the direction, with weights
+//   that fall off with distance. Hits and misses are never averaged as numbers: the weights of the
+//   hits and of the misses are summed separately, the ray hits when the hits outweigh the misses,
+//   and the distance is the weighted mean of the hits' distances only. visibility() returns the
+//   misses' share of the weight (1: certainly unoccluded): a smooth value for ambient occlusion.
+// * Limits. From inside, the field knows only the last surface before the exit point: with a
+//   finite tmax, a ray whose first surface lies before tmax and whose last lies beyond it is
+//   reported unoccluded. A bit1 field has no distances: an outside ray's hit is reported at the
+//   entry point, and rays from inside are never occluded.
+//
+// Units. A Ray's direction need not be unit length; t is measured in multiples of it, as in Embree
+// (point = origin + t * direction). Results are approximate: see spec/geometry.md section 7.2.
+//
+// Threads. A FieldQuery is immutable after creation: every member function is const and may be
+// called from many threads at once. The batch functions run on the calling thread.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <span>
+
+#include "vff/direction.h"
+#include "vff/error.h"
+#include "vff/format.h"
+#include "vff/positions.h"
+
+namespace vff {
+
+class File;
+
+struct Ray {
+  Vec3 origin;
+  Vec3 direction;  // non-zero; need not be unit length
+  float tmin = 0.0f;
+  float tmax = std::numeric_limits<float>::infinity();
+};
+
+enum class Reconstruction : uint8_t {
+  kNearest = 0,       // the paper: nearest positional sample, texel containing the direction
+  kInterpolated = 1,  // miss-aware blend of the neighbouring samples and texels (see above)
+};
+
+struct QueryOptions {
+  Reconstruction reconstruction = Reconstruction::kNearest;
+  // Intra-object bias, as a fraction of the radius R: a ray from inside is occluded when
+  // d2 < d1 - bias * R. Negative: the default, defaultIntraBias(field), plus for kInterpolated one
+  // mean sample spacing, sqrt(4 pi / mapCount) (its neighbouring samples' rays pass that far
+  // beside the origin). A ray that starts inside the sphere but not on the object (a point of the
+  // ground under it) has no surface of its own to skip: use 0.
+  float intraBias = -1.0f;
+};
+
+// The default intra-object bias (fraction of R): two quantisation steps at normal incidence plus
+// half the mean angular spacing of the positional samples, sqrt(4 pi / mapCount) / 2 (the largest
+// lateral error of snapping the exit point to its nearest sample, relative to R).
+float defaultIntraBias(const FieldDesc& field) noexcept;
+
+struct QueryHit {
+  bool hit = false;
+  float t = std::numeric_limits<float>::infinity();  // along the ray, in multiples of its direction
+  Vec3 point;              // origin + t * direction (object space for FieldQuery, world for Instance)
+  Vec3 normal;             // unit surface normal, when hasNormal
+  bool hasNormal = false;  // the field has a normal plane and the ray hit
+  bool inside = false;     // the origin was inside the bounding sphere (answered by section 7.3)
+};
+
+// A query-ready view of one field. Borrows its maps: from a File (which must outlive the
+// FieldQuery) or from caller memory. Holds a small table per positional sample (its position,
+// tangent frame and neighbour list: 80 bytes per map), nothing per texel.
+class FieldQuery {
+ public:
+  FieldQuery() noexcept;  // empty: every ray misses
+  FieldQuery(FieldQuery&&) noexcept;
+  FieldQuery& operator=(FieldQuery&&) noexcept;
+  ~FieldQuery();
+
+  // Decodes every block of the file's distance (and normal) plane into the file's cache once, so
+  // that queries never fail or allocate. Errors: those of File::mapData (kBlockChecksum,
+  // kBlockDecode...), kPositionScheme for a scheme this library cannot evaluate.
+  static Result<FieldQuery> fromFile(const File& file);
+  // Borrows map-major planes laid out as in a file (mapCount * mapBytes each; normals may be empty).
+  // Errors: kInvalidArgument when a size does not match the description; the checks of
+  // FieldDesc validation (kMapCount, kPositionScheme...).
+  static Result<FieldQuery> fromMaps(const FieldDesc& field, std::span<const uint8_t> distance,
+                                     std::span<const uint8_t> normals = {});
+
+  const FieldDesc& field() const noexcept;
+  const PositionSet& positions() const noexcept;
+  bool hasNormals() const noexcept;
+  // Bytes of the maps this view reads (the field's payload: what a GPU would hold).
+  uint64_t payloadBytes() const noexcept;
+
+  // Object-space queries.
+  QueryHit intersect(const Ray& ray, const QueryOptions& options = {}) const noexcept;
+  // True when the ray hits the object with t in [tmin, tmax].
+  bool occluded(const Ray& ray, const QueryOptions& options = {}) const noexcept;
+  // The probability that the ray reaches tmax unoccluded: 0 or 1 for kNearest; for kInterpolated
+  // the misses' (and far hits') share of the blend weight.
+  float visibility(const Ray& ray, const QueryOptions& options = {}) const noexcept;
+
+  // Batches (the calling thread; out.size() must equal rays.size(), extra entries are ignored).
+  void intersect(std::span<const Ray> rays, std::span<QueryHit> out, const QueryOptions& options = {}) const noexcept;
+  void occluded(std::span<const Ray> rays, std::span<uint8_t> out, const QueryOptions& options = {}) const noexcept;
+  void visibility(std::span<const Ray> rays, std::span<float> out, const QueryOptions& options = {}) const noexcept;
+
+  struct Impl;  // opaque
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+// world = translation + scale * (rotation * object). rotation is row-major and orthonormal
+// (det +1); scale > 0.
+struct RigidTransform {
+  float rotation[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  Vec3 translation;
+  float scale = 1.0f;
+
+  Vec3 toWorldPoint(Vec3 p) const noexcept;
+  Vec3 toWorldVector(Vec3 v) const noexcept;  // rotation * scale * v
+  Vec3 toObjectPoint(Vec3 p) const noexcept;
+  Vec3 toObjectVector(Vec3 v) const noexcept;
+  // A rotation of `radians` about `axis` (need not be unit), then the scale, then the translation.
+  static RigidTransform fromAxisAngle(Vec3 axis, float radians, Vec3 translation = {}, float scale = 1.0f) noexcept;
+};
+
+// A field placed in a world. Borrows the FieldQuery. Rays and results are in world space; t is
+// the same parameter as in object space, because the direction is transformed with the ray.
+struct Instance {
+  const FieldQuery* field = nullptr;
+  RigidTransform transform;
+
+  QueryHit intersect(const Ray& worldRay, const QueryOptions& options = {}) const noexcept;
+  bool occluded(const Ray& worldRay, const QueryOptions& options = {}) const noexcept;
+  float visibility(const Ray& worldRay, const QueryOptions& options = {}) const noexcept;
+  // The bounding sphere in world space.
+  Sphere worldSphere() const noexcept;
+};
+
+}  // namespace vff

@@ -1,0 +1,475 @@
+// The CPU query (vff/query.h; spec/geometry.md section 7).
+#include "vff/query.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "vff/encoding.h"
+#include "vff/reader.h"
+
+namespace vff {
+namespace {
+
+constexpr float kPi = 3.14159265358979323846f;
+
+inline Vec3 operator+(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline Vec3 operator*(Vec3 a, float s) { return {a.x * s, a.y * s, a.z * s}; }
+inline Vec3 operator-(Vec3 a) { return {-a.x, -a.y, -a.z}; }
+inline float dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+
+inline Vec3 normalize(Vec3 v) {
+  const float l = std::sqrt(dot(v, v));
+  return l > 0 ? v * (1.0f / l) : Vec3{};
+}
+
+// One decoded texel: a hit at `distance` from the map's sample point, or a miss.
+struct Sample {
+  bool hit = false;
+  float distance = 0;
+};
+
+// What one map lookup contributes to the answer: a hit point's parameter t along the ray (in
+// distance units) with a weight, or a miss with a weight.
+struct Blend {
+  float hitWeight = 0, missWeight = 0;
+  float tSum = 0;         // sum of weight * t over hits
+  Vec3 normalSum;         // sum of weight * normal over hits
+  float farWeight = 0;    // hits beyond the visibility range (count as unoccluded)
+  float nearWeight = 0;   // hits before the start of the range (ignored for visibility)
+};
+
+}  // namespace
+
+struct FieldQuery::Impl {
+  FieldDesc field;
+  PositionSet positions;
+  Vec3 center;
+  float radius = 0;
+  uint32_t m = 0;
+  uint64_t distMapBytes = 0, normMapBytes = 0;
+  std::vector<const uint8_t*> dist;  // per map
+  std::vector<const uint8_t*> norm;  // per map, empty without normals
+  std::vector<Vec3> unit;            // û_k, float
+  std::vector<Frame> frames;         // frame of map k (inward normal)
+  static constexpr uint32_t kNeighbours = 8;
+  std::vector<uint32_t> neighbours;  // kNeighbours per map; UINT32_MAX pads
+  float spacing = 0;                 // mean angular spacing sqrt(4 pi / mapCount)
+  float kernelRadius2 = 0;           // squared chord radius of the interpolation kernel
+  float defaultBias = 0;             // fraction of R
+  uint64_t payload = 0;
+
+  Sample texel(uint32_t k, uint32_t i, uint32_t j) const noexcept {
+    const uint8_t* map = dist[k];
+    const size_t t = size_t(j) * m + i;
+    switch (field.distanceEncoding) {
+      case DistanceEncoding::kUnorm8Diameter: {
+        const uint32_t c = map[t];
+        return {c != 255u, float(c) * (2.0f * radius / 254.0f)};
+      }
+      case DistanceEncoding::kUnorm16Diameter: {
+        const uint32_t c = uint32_t(map[2 * t]) | (uint32_t(map[2 * t + 1]) << 8);
+        return {c != 65535u, float(c) * (2.0f * radius / 65534.0f)};
+      }
+      case DistanceEncoding::kUnorm8Chord: {
+        const uint32_t c = map[t];
+        const float cosAlpha = texelDirection(field.directionScheme, m, i, j).z;
+        return {c != 255u, float(c) * (2.0f * radius * cosAlpha / 254.0f)};
+      }
+      case DistanceEncoding::kBit1:
+        return {((map[t / 8] >> (t % 8)) & 1u) != 0, 0.0f};
+      case DistanceEncoding::kInvalid: break;
+    }
+    return {};
+  }
+
+  Vec3 normalAt(uint32_t k, uint32_t i, uint32_t j) const noexcept {
+    return decodeNormal(norm[k] + 4 * (size_t(j) * m + i));
+  }
+
+  Vec3 samplePoint(uint32_t k) const noexcept { return center + unit[k] * radius; }
+
+  void build();
+  QueryHit query(const Ray& ray, const QueryOptions& o, float* visibility) const noexcept;
+};
+
+namespace {
+
+Vec3 toVec(const float c[3]) { return {c[0], c[1], c[2]}; }
+
+}  // namespace
+
+void FieldQuery::Impl::build() {
+  const uint32_t n = field.mapCount;
+  center = toVec(field.sphere.center);
+  radius = field.sphere.radius;
+  m = field.mapResolution;
+  unit.resize(n);
+  frames.resize(n);
+  for (uint32_t k = 0; k < n; ++k) {
+    unit[k] = positions.position(k);
+    frames[k] = positions.frame(k);
+  }
+  spacing = std::sqrt(4.0f * kPi / float(n));
+  // The kernel reaches one mean spacing (wider kernels blur more than they smooth: measured by
+  // tests/query, ground ambient occlusion).
+  const float r = spacing;
+  kernelRadius2 = r * r;
+  defaultBias = defaultIntraBias(field);
+  // Neighbours: the samples nearest to probe directions on two rings around each sample. This
+  // finds the samples whose Voronoi cells border the kernel around û_k in every scheme.
+  neighbours.assign(size_t(n) * kNeighbours, UINT32_MAX);
+  constexpr int kProbes = 12;
+  for (uint32_t k = 0; k < n; ++k) {
+    uint32_t found[kNeighbours];
+    uint32_t count = 0;
+    const Frame& f = frames[k];
+    for (float ring : {1.0f, 1.6f}) {
+      const float a = ring * spacing;
+      for (int p = 0; p < kProbes && count < kNeighbours; ++p) {
+        const float phi = 2.0f * kPi * (float(p) + (ring > 1.2f ? 0.5f : 0.0f)) / kProbes;
+        const Vec3 d = unit[k] * std::cos(a) + (f.t * std::cos(phi) + f.b * std::sin(phi)) * std::sin(a);
+        const uint32_t q = positions.nearest(d);
+        if (q == k) continue;
+        // An octa-hemi2 equator copy has the same position as its twin: keep one of them.
+        bool dup = false;
+        for (uint32_t c = 0; c < count; ++c) dup = dup || found[c] == q;
+        if (!dup) found[count++] = q;
+      }
+    }
+    std::copy(found, found + count, neighbours.begin() + ptrdiff_t(size_t(k) * kNeighbours));
+  }
+}
+
+float defaultIntraBias(const FieldDesc& field) noexcept {
+  if (field.mapCount == 0 || !(field.sphere.radius > 0)) return 0.0f;
+  const float step = quantizationStep(field.distanceEncoding, 1.0f, 1.0f);
+  return 2.0f * step + 0.5f * std::sqrt(4.0f * kPi / float(field.mapCount));
+}
+
+FieldQuery::FieldQuery() noexcept = default;
+FieldQuery::FieldQuery(FieldQuery&&) noexcept = default;
+FieldQuery& FieldQuery::operator=(FieldQuery&&) noexcept = default;
+FieldQuery::~FieldQuery() = default;
+
+Result<FieldQuery> FieldQuery::fromMaps(const FieldDesc& field, std::span<const uint8_t> distance,
+                                        std::span<const uint8_t> normals) {
+  if (Status s = checkFieldDesc(field); !s) return s.error();
+  auto ps = PositionSet::fromField(field);
+  if (!ps) return ps.error();
+  const uint64_t db = distanceMapBytes(field.distanceEncoding, field.mapResolution);
+  const uint64_t nb = normalMapBytes(field.normalEncoding, field.mapResolution);
+  if (distance.size() != db * field.mapCount)
+    return makeError(Code::kInvalidArgument, "distance plane holds " + std::to_string(distance.size()) +
+                                                 " bytes, the field needs " + std::to_string(db * field.mapCount));
+  if (!normals.empty() && (field.normalEncoding == NormalEncoding::kNone || normals.size() != nb * field.mapCount))
+    return makeError(Code::kInvalidArgument, "normal plane holds " + std::to_string(normals.size()) +
+                                                 " bytes, the field needs " + std::to_string(nb * field.mapCount));
+  auto impl = std::make_unique<Impl>();
+  impl->field = field;
+  impl->positions = *ps;
+  impl->distMapBytes = db;
+  impl->normMapBytes = nb;
+  impl->dist.resize(field.mapCount);
+  for (uint32_t k = 0; k < field.mapCount; ++k) impl->dist[k] = distance.data() + k * db;
+  impl->payload = distance.size();
+  if (!normals.empty()) {
+    impl->norm.resize(field.mapCount);
+    for (uint32_t k = 0; k < field.mapCount; ++k) impl->norm[k] = normals.data() + k * nb;
+    impl->payload += normals.size();
+  }
+  impl->build();
+  FieldQuery q;
+  q.impl_ = std::move(impl);
+  return q;
+}
+
+Result<FieldQuery> FieldQuery::fromFile(const File& file) {
+  const FieldDesc& field = file.field();
+  auto ps = PositionSet::fromField(field);
+  if (!ps) return ps.error();
+  auto impl = std::make_unique<Impl>();
+  impl->field = field;
+  impl->positions = *ps;
+  impl->distMapBytes = distanceMapBytes(field.distanceEncoding, field.mapResolution);
+  impl->normMapBytes = normalMapBytes(field.normalEncoding, field.mapResolution);
+  impl->dist.resize(field.mapCount);
+  for (uint32_t k = 0; k < field.mapCount; ++k) {
+    auto map = file.mapData(Plane::kDistance, k);
+    if (!map) return map.error();
+    impl->dist[k] = map->data();
+  }
+  impl->payload = file.plane(Plane::kDistance).rawBytes;
+  if (file.hasNormals()) {
+    impl->norm.resize(field.mapCount);
+    for (uint32_t k = 0; k < field.mapCount; ++k) {
+      auto map = file.mapData(Plane::kNormal, k);
+      if (!map) return map.error();
+      impl->norm[k] = map->data();
+    }
+    impl->payload += file.plane(Plane::kNormal).rawBytes;
+  }
+  impl->build();
+  FieldQuery q;
+  q.impl_ = std::move(impl);
+  return q;
+}
+
+const FieldDesc& FieldQuery::field() const noexcept {
+  static const FieldDesc kEmpty{};
+  return impl_ ? impl_->field : kEmpty;
+}
+const PositionSet& FieldQuery::positions() const noexcept {
+  static const PositionSet kEmpty{};
+  return impl_ ? impl_->positions : kEmpty;
+}
+bool FieldQuery::hasNormals() const noexcept { return impl_ && !impl_->norm.empty(); }
+uint64_t FieldQuery::payloadBytes() const noexcept { return impl_ ? impl_->payload : 0; }
+
+// The core of every query. Distances below are object-space lengths along the unit direction w;
+// the caller's t is that length divided by |direction|.
+QueryHit FieldQuery::Impl::query(const Ray& ray, const QueryOptions& o, float* visibility) const noexcept {
+  QueryHit out;
+  if (visibility) *visibility = 1.0f;
+  const float len = std::sqrt(dot(ray.direction, ray.direction));
+  if (!(len > 0) || !std::isfinite(len)) return out;
+  const Vec3 w = ray.direction * (1.0f / len);
+  const float tmin = ray.tmin * len, tmax = ray.tmax * len;
+  // 1. The sphere (section 7.2).
+  const Vec3 delta = ray.origin - center;
+  const float beta = dot(delta, w);
+  const float gamma = dot(delta, delta) - radius * radius;
+  const float disc = beta * beta - gamma;
+  if (!(disc >= 0)) return out;
+  const float sq = std::sqrt(disc);
+  const float t1 = -beta + sq;
+  if (t1 < 0) return out;
+  const bool inside = gamma <= 0;
+  // The lookup: the ray enters at `e` looking along `v`. From inside (section 7.3) the reversed
+  // ray enters at the exit point, looking back at the origin.
+  float t0 = inside ? t1 : -beta - sq;  // parameter of the lookup's entry point along the ray
+  if (!inside) t0 = std::max(t0, 0.0f);
+  const Vec3 e = ray.origin + w * t0;
+  const Vec3 v = inside ? -w : w;
+  const float sign = inside ? -1.0f : 1.0f;  // t of a point at distance d from e along v: t0 + sign d
+  // A hit counts when its t lies in [lo, hi]. From inside, the surface must also be more than the
+  // bias in front of the origin (the origin's own surface is not an occluder).
+  float lo = tmin;
+  if (inside) {
+    if (field.distanceEncoding == DistanceEncoding::kBit1) return out;  // no distances: cannot tell
+    // The blended samples' parallel rays pass up to one spacing beside the origin, where its own
+    // surface may lie further along: the interpolated default is wider by that much.
+    float bias = o.intraBias >= 0 ? o.intraBias
+                 : defaultBias + (o.reconstruction == Reconstruction::kInterpolated ? spacing : 0.0f);
+    bias *= radius;
+    lo = std::max(lo, bias);
+  }
+  const float hi = tmax;
+  const Vec3 eu = (e - center) * (1.0f / radius);
+  const uint32_t k0 = positions.nearest(eu);
+
+  if (o.reconstruction == Reconstruction::kNearest) {
+    const Vec3 l = toLocal(frames[k0], v);
+    const Vec2 uv = hemisphereToSquare(field.directionScheme, l);
+    uint32_t i, j;
+    squareToTexel(uv, m, &i, &j);
+    const Sample s = texel(k0, i, j);
+    if (!s.hit) return out;
+    const float t = t0 + sign * s.distance;
+    if (t < lo || t > hi) return out;
+    if (visibility) *visibility = 0.0f;
+    out.hit = true;
+    out.inside = inside;
+    out.t = t / len;
+    out.point = ray.origin + w * t;
+    if (!norm.empty()) {
+      out.normal = normalAt(k0, i, j);
+      out.hasNormal = true;
+    }
+    return out;
+  }
+
+  // Interpolated: the kernel's samples, each looked up along v from its own sample point
+  // (parallel rays) with miss-aware bilinear weights; each hit point is projected onto the ray.
+  auto kernel = [&](uint32_t k) {
+    const Vec3 d = eu - unit[k];
+    const float x = 1.0f - dot(d, d) / kernelRadius2;
+    return x > 0 ? x * x : 0.0f;
+  };
+  uint32_t ks[1 + kNeighbours];
+  float kw[1 + kNeighbours];
+  uint32_t kc = 0;
+  ks[kc] = k0;
+  kw[kc++] = std::max(kernel(k0), 1e-6f);  // the nearest sample always contributes
+  const uint32_t* nb = &neighbours[size_t(k0) * kNeighbours];
+  for (uint32_t c = 0; c < kNeighbours && nb[c] != UINT32_MAX; ++c) {
+    const float wk = kernel(nb[c]);
+    if (wk > 0) {
+      ks[kc] = nb[c];
+      kw[kc++] = wk;
+    }
+  }
+  auto blend = [&]() {
+    Blend bl;
+    for (uint32_t c = 0; c < kc; ++c) {
+      const uint32_t k = ks[c];
+      const Vec3 p = samplePoint(k);
+      const Vec3 l = toLocal(frames[k], v);
+      if (l.z <= 0) continue;  // the sample does not see this direction
+      const Vec2 uv = hemisphereToSquare(field.directionScheme, l);
+      const float x = (uv.x + 1.0f) * 0.5f * float(m) - 0.5f;
+      const float y = (uv.y + 1.0f) * 0.5f * float(m) - 0.5f;
+      const float fx0 = std::floor(x), fy0 = std::floor(y);
+      const float fx = x - fx0, fy = y - fy0;
+      const int ix = int(fx0), iy = int(fy0);
+      const float base = dot(p - ray.origin, w);  // t of the sample point, projected on the ray
+      const float along = sign;                   // t per unit distance along v
+      for (int dj = 0; dj < 2; ++dj) {
+        for (int di = 0; di < 2; ++di) {
+          const float bw = kw[c] * (di ? fx : 1.0f - fx) * (dj ? fy : 1.0f - fy);
+          if (bw <= 0) continue;
+          const uint32_t ti = uint32_t(std::clamp(ix + di, 0, int(m) - 1));
+          const uint32_t tj = uint32_t(std::clamp(iy + dj, 0, int(m) - 1));
+          const Sample s = texel(k, ti, tj);
+          if (!s.hit) {
+            bl.missWeight += bw;
+            continue;
+          }
+          const float t = base + along * s.distance;
+          if (t > hi) {
+            bl.farWeight += bw;
+          } else if (t < lo) {
+            bl.nearWeight += bw;
+          } else {
+            bl.hitWeight += bw;
+            bl.tSum += bw * t;
+            if (!norm.empty()) bl.normalSum = bl.normalSum + normalAt(k, ti, tj) * bw;
+          }
+        }
+      }
+    }
+    return bl;
+  };
+  const Blend b = blend();
+  // Hits before the range (the origin's own surface from inside, or surfaces behind tmin) are
+  // neither occluders nor misses: leave them out of the vote.
+  const float total = b.hitWeight + b.missWeight + b.farWeight;
+  if (!(total > 0)) return out;
+  if (visibility) *visibility = (b.missWeight + b.farWeight) / total;
+  if (b.hitWeight <= b.missWeight + b.farWeight) return out;
+  const float t = b.tSum / b.hitWeight;
+  out.hit = true;
+  out.inside = inside;
+  out.t = t / len;
+  out.point = ray.origin + w * t;
+  if (!norm.empty()) {
+    out.normal = normalize(b.normalSum);
+    out.hasNormal = dot(out.normal, out.normal) > 0;
+  }
+  return out;
+}
+
+QueryHit FieldQuery::intersect(const Ray& ray, const QueryOptions& options) const noexcept {
+  return impl_ ? impl_->query(ray, options, nullptr) : QueryHit{};
+}
+
+bool FieldQuery::occluded(const Ray& ray, const QueryOptions& options) const noexcept {
+  return impl_ && impl_->query(ray, options, nullptr).hit;
+}
+
+float FieldQuery::visibility(const Ray& ray, const QueryOptions& options) const noexcept {
+  if (!impl_) return 1.0f;
+  float v = 1.0f;
+  impl_->query(ray, options, &v);
+  return v;
+}
+
+void FieldQuery::intersect(std::span<const Ray> rays, std::span<QueryHit> out, const QueryOptions& options) const noexcept {
+  const size_t n = std::min(rays.size(), out.size());
+  for (size_t r = 0; r < n; ++r) out[r] = intersect(rays[r], options);
+}
+
+void FieldQuery::occluded(std::span<const Ray> rays, std::span<uint8_t> out, const QueryOptions& options) const noexcept {
+  const size_t n = std::min(rays.size(), out.size());
+  for (size_t r = 0; r < n; ++r) out[r] = occluded(rays[r], options) ? 1 : 0;
+}
+
+void FieldQuery::visibility(std::span<const Ray> rays, std::span<float> out, const QueryOptions& options) const noexcept {
+  const size_t n = std::min(rays.size(), out.size());
+  for (size_t r = 0; r < n; ++r) out[r] = visibility(rays[r], options);
+}
+
+// ---- RigidTransform and Instance ----------------------------------------------------------------
+
+Vec3 RigidTransform::toWorldVector(Vec3 v) const noexcept {
+  const auto& r = rotation;
+  return Vec3{r[0][0] * v.x + r[0][1] * v.y + r[0][2] * v.z, r[1][0] * v.x + r[1][1] * v.y + r[1][2] * v.z,
+              r[2][0] * v.x + r[2][1] * v.y + r[2][2] * v.z} *
+         scale;
+}
+
+Vec3 RigidTransform::toWorldPoint(Vec3 p) const noexcept { return toWorldVector(p) + translation; }
+
+Vec3 RigidTransform::toObjectVector(Vec3 v) const noexcept {
+  const auto& r = rotation;  // the inverse rotation is the transpose
+  return Vec3{r[0][0] * v.x + r[1][0] * v.y + r[2][0] * v.z, r[0][1] * v.x + r[1][1] * v.y + r[2][1] * v.z,
+              r[0][2] * v.x + r[1][2] * v.y + r[2][2] * v.z} *
+         (1.0f / scale);
+}
+
+Vec3 RigidTransform::toObjectPoint(Vec3 p) const noexcept { return toObjectVector(p - translation); }
+
+RigidTransform RigidTransform::fromAxisAngle(Vec3 axis, float radians, Vec3 translation, float scale) noexcept {
+  RigidTransform x;
+  const Vec3 a = normalize(axis);
+  const float c = std::cos(radians), s = std::sin(radians), t = 1.0f - c;
+  x.rotation[0][0] = c + a.x * a.x * t;
+  x.rotation[0][1] = a.x * a.y * t - a.z * s;
+  x.rotation[0][2] = a.x * a.z * t + a.y * s;
+  x.rotation[1][0] = a.y * a.x * t + a.z * s;
+  x.rotation[1][1] = c + a.y * a.y * t;
+  x.rotation[1][2] = a.y * a.z * t - a.x * s;
+  x.rotation[2][0] = a.z * a.x * t - a.y * s;
+  x.rotation[2][1] = a.z * a.y * t + a.x * s;
+  x.rotation[2][2] = c + a.z * a.z * t;
+  x.translation = translation;
+  x.scale = scale;
+  return x;
+}
+
+namespace {
+
+Ray toObject(const RigidTransform& x, const Ray& r) {
+  return Ray{x.toObjectPoint(r.origin), x.toObjectVector(r.direction), r.tmin, r.tmax};
+}
+
+}  // namespace
+
+QueryHit Instance::intersect(const Ray& worldRay, const QueryOptions& options) const noexcept {
+  if (!field) return {};
+  QueryHit h = field->intersect(toObject(transform, worldRay), options);
+  if (h.hit) {
+    h.point = worldRay.origin + worldRay.direction * h.t;
+    if (h.hasNormal) h.normal = normalize(transform.toWorldVector(h.normal));
+  }
+  return h;
+}
+
+bool Instance::occluded(const Ray& worldRay, const QueryOptions& options) const noexcept {
+  return field && field->occluded(toObject(transform, worldRay), options);
+}
+
+float Instance::visibility(const Ray& worldRay, const QueryOptions& options) const noexcept {
+  return field ? field->visibility(toObject(transform, worldRay), options) : 1.0f;
+}
+
+Sphere Instance::worldSphere() const noexcept {
+  if (!field) return {};
+  const Sphere& s = field->field().sphere;
+  const Vec3 c = transform.toWorldPoint(toVec(s.center));
+  return Sphere{{c.x, c.y, c.z}, s.radius * transform.scale};
+}
+
+}  // namespace vff
