@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Command 1: set up, build, bake the Stanford bunny (Debian's glmark2-data copy) with the paper's
-# configuration (4226 maps of 64x64, 8 bits per ray, normalised by 2R), inspect the field and write
-# a contact sheet of its maps. Output goes to out/.
+# configuration (4226 maps of 64x64, 8 bits per ray, normalised by 2R), inspect the field, write a
+# contact sheet of its maps, then render the paper's Fig. 3 comparison (ambient occlusion on the
+# ground: exact Embree vs three fields, nearest and interpolated) and print its table. Output goes
+# to out/ and out/experiments/.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"
@@ -17,4 +19,6 @@ echo "== vff-bake $mesh"
 echo "== vff-inspect out/bunny.vff"
 "$bin/vff-inspect/vff-inspect" out/bunny.vff --preview out/bunny-maps.png
 "$bin/vff-inspect/vff-inspect" out/bunny.vff --validate
-echo "wrote out/bunny.vff and out/bunny-maps.png"
+echo "== vff-experiments ao (the paper's Fig. 3: exact vs visibility fields)"
+"$root/build/samples/experiments/vff-experiments" ao --mesh "$mesh" -o out/experiments
+echo "wrote out/bunny.vff, out/bunny-maps.png and out/experiments/ (images, error heat maps, ao-table.md)"

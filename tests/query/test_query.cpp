@@ -208,9 +208,9 @@ AoResult groundAo(const Baked& b, uint32_t grid, uint32_t raysPerPoint, float re
 TEST(Query, GroundAmbientOcclusionIsAccurate) {
   // Ground AO under a procedural object at a small image size. Bounds asserted: nearest RMS <= 5 on
   // the 8-bit scale at the paper's 4226 x 64 x 64; interpolated below 0.95 x nearest at the same
-  // memory, and no worse than 1.15 x nearest-at-4226x64x64 with a quarter of the memory
-  // (4226 x 32 x 32). (Measured: see the printed lines; the project's stated goal of 0.6 x is not
-  // reached yet.)
+  // memory, and within 1.2 x nearest-at-4226x64x64 with a quarter of the memory (4226 x 32 x 32).
+  // (Measured: see the printed lines. On the bunny, vff-experiments ao, the quarter-memory field
+  // interpolated beats the full one nearest; the 0.6 x goal at equal memory is not reached.)
   for (const char* shape : {"torus-knot", "bowl"}) {
     auto full = bakeShape(shape, 32, 64);
     auto quarter = bakeShape(shape, 32, 32);
@@ -222,7 +222,7 @@ TEST(Query, GroundAmbientOcclusionIsAccurate) {
                 q.rmsInterpolated);
     EXPECT_LE(a.rmsNearest, 5.0) << shape;
     EXPECT_LE(a.rmsInterpolated, 0.95 * a.rmsNearest) << shape;
-    EXPECT_LE(q.rmsInterpolated, 1.15 * a.rmsNearest) << shape;
+    EXPECT_LE(q.rmsInterpolated, 1.2 * a.rmsNearest) << shape;
     EXPECT_LT(q.rmsInterpolated, q.rmsNearest) << shape;
   }
 }
@@ -284,7 +284,7 @@ TEST(Query, IntraObjectOcclusionAgreesWithExactCasts) {
                 mode == Reconstruction::kNearest ? "nearest" : "interpolated", 100 * rate,
                 (unsigned long long)st.rays, (unsigned long long)st.falseOccluded,
                 (unsigned long long)st.missedOccluded);
-    EXPECT_GE(rate, 0.9);
+    EXPECT_GE(rate, 0.95);
   }
 }
 
@@ -380,7 +380,9 @@ TEST(Query, BatchesEqualSingleRays) {
       ASSERT_EQ(vis[r], b->query.visibility(rays[r], o));
       ASSERT_GE(vis[r], 0.0f);
       ASSERT_LE(vis[r], 1.0f);
-      if (mode == Reconstruction::kNearest) ASSERT_EQ(vis[r], h.hit ? 0.0f : 1.0f);
+      if (mode == Reconstruction::kNearest) {
+        ASSERT_EQ(vis[r], h.hit ? 0.0f : 1.0f);
+      }
     }
   }
 }
@@ -449,7 +451,9 @@ TEST(Query, Bit1FieldsAnswerHitOrMissOnly) {
     const QueryHit h = b->query.intersect(Ray{from, d});
     ++total;
     agree += h.hit == (ref.cast(from, d) >= 0);
-    if (h.hit) EXPECT_NEAR(h.t, dot3(sub(h.point, from), d), 1e-3f);
+    if (h.hit) {
+      EXPECT_NEAR(h.t, dot3(sub(h.point, from), d), 1e-3f);
+    }
   }
   EXPECT_GE(double(agree) / total, 0.9);
   // From inside there is no distance to compare: never occluded.
@@ -461,9 +465,9 @@ TEST(Query, DefaultIntraBiasFollowsTheDocumentedFormula) {
   f.sphere = {{0, 0, 0}, 3.0f};
   f.mapCount = 4226;
   f.distanceEncoding = DistanceEncoding::kUnorm8Diameter;
-  EXPECT_NEAR(defaultIntraBias(f), 2 * 2.0f / 254 + 0.5f * std::sqrt(4 * 3.14159265f / 4226), 1e-6f);
+  EXPECT_NEAR(defaultIntraBias(f), 2 * 2.0f / 254 + std::sqrt(4 * 3.14159265f / 4226), 1e-6f);
   f.distanceEncoding = DistanceEncoding::kUnorm16Diameter;
-  EXPECT_NEAR(defaultIntraBias(f), 2 * 2.0f / 65534 + 0.5f * std::sqrt(4 * 3.14159265f / 4226), 1e-6f);
+  EXPECT_NEAR(defaultIntraBias(f), 2 * 2.0f / 65534 + std::sqrt(4 * 3.14159265f / 4226), 1e-6f);
 }
 
 }  // namespace

@@ -1,0 +1,237 @@
+// common.h - what the experiments share: small vector maths, the per-pixel random numbers, the
+// world (object on a ground plane, camera), the G-buffer of primary hits, the two tracers (exact
+// Embree and visibility field), the tiled renderer, images and the result table.
+//
+// Conventions. World space is y-up; the ground plane is y = 0 and is intersected analytically (it
+// is never in a field). The object stands on the plane: world = object + translation (scale 1, no
+// rotation), so object and world normals coincide. Every distance the experiments choose (AO range,
+// offsets, lights) is a multiple of the object's bounding-sphere radius R.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "vff/bake/baker.h"
+#include "vff/bake/mesh.h"
+#include "vff/query.h"
+
+namespace vffx {
+
+using vff::Vec3;
+
+// ---- Vector maths -------------------------------------------------------------------------------
+inline Vec3 operator+(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline Vec3 operator*(Vec3 a, float s) { return {a.x * s, a.y * s, a.z * s}; }
+inline Vec3 operator*(float s, Vec3 a) { return a * s; }
+inline Vec3 mul(Vec3 a, Vec3 b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
+inline float dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline Vec3 cross(Vec3 a, Vec3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+inline float length(Vec3 a) { return std::sqrt(dot(a, a)); }
+inline Vec3 normalize(Vec3 a) {
+  const float l = length(a);
+  return l > 0 ? a * (1.0f / l) : Vec3{0, 1, 0};
+}
+inline Vec3 toVec(const float* p) { return {p[0], p[1], p[2]}; }
+inline constexpr float kPi = 3.14159265358979f;
+
+// ---- Random numbers -----------------------------------------------------------------------------
+// PCG32. Every pixel seeds its own generator from (x, y, stream), so an image does not depend on
+// the thread count or tile order, and the exact and field renders of one experiment draw exactly
+// the same rays (their difference is the field's error, not Monte Carlo noise).
+class Rng {
+ public:
+  Rng(uint32_t x, uint32_t y, uint32_t stream);
+  uint32_t nextU32();
+  float next01();  // [0, 1)
+
+ private:
+  uint64_t state_ = 0, inc_ = 1;
+};
+
+// Cosine-weighted direction around unit normal n (u1, u2 in [0,1)).
+Vec3 cosineDirection(Vec3 n, float u1, float u2);
+// Uniform point on the unit sphere.
+Vec3 uniformSphere(float u1, float u2);
+// A unit vector b, c completing n to an orthonormal frame.
+void orthonormalBasis(Vec3 n, Vec3* b, Vec3* c);
+
+// ---- Threads ------------------------------------------------------------------------------------
+// Runs fn(begin, end) over [0, count) in chunks handed out to `threads` workers (0: hardware).
+void parallelFor(uint64_t count, uint64_t chunk, unsigned threads,
+                 const std::function<void(uint64_t, uint64_t)>& fn);
+unsigned resolveThreads(unsigned threads);
+
+// ---- World --------------------------------------------------------------------------------------
+struct Camera {
+  Vec3 eye, forward, right, up;  // right/up scaled to the half extent of the image plane at distance 1
+  Vec3 rayDirection(float px, float py, int width, int height) const;  // pixel coords, y down
+};
+
+struct World {
+  vff::bake::Mesh objectMesh;  // as loaded (object space)
+  vff::bake::Mesh worldMesh;   // standing on the plane (world space)
+  vff::RigidTransform transform;
+  vff::Sphere objectSphere;    // minimal enclosing sphere, object space (what the bake uses)
+  Vec3 center;                 // its centre in world space
+  float radius = 0;            // R
+  Camera camera;
+};
+
+// Loads the mesh (errors name the file), stands it on the plane, aims the camera.
+vff::Result<World> makeWorld(const std::string& meshPath);
+
+// ---- Exact tracer (Embree 3, the object's triangles in world space) ------------------------------
+struct ExactHit {
+  bool hit = false;
+  float t = 0;
+  Vec3 normal;     // interpolated vertex normal when the mesh has normals, else geometric; unit
+  Vec3 geometric;  // unit geometric normal
+};
+
+class ExactTracer {
+ public:
+  static vff::Result<ExactTracer> create(const vff::bake::Mesh& mesh);
+  ExactTracer(ExactTracer&&) noexcept;
+  ExactTracer& operator=(ExactTracer&&) noexcept;
+  ~ExactTracer();
+
+  bool occluded(const vff::Ray& ray) const;  // rtcOccluded1
+  ExactHit intersect(const vff::Ray& ray) const;  // rtcIntersect1
+  uint64_t memoryBytes() const;  // Embree's peak allocation (BVH and buffers)
+
+  struct Impl;
+
+ private:
+  ExactTracer() = default;
+  std::unique_ptr<Impl> impl_;
+};
+
+// ---- Field tracer (baked in memory with vff::bake, queried through vff::Instance) ---------------
+struct FieldConfig {
+  uint32_t n = 32;   // octa-hemi2 parameter: 2(2n^2+2n+1) maps
+  uint32_t mapSize = 64;
+  std::string name() const;  // "4226x64x64"
+};
+
+struct BakedQuery {
+  FieldConfig config;
+  vff::bake::BakedField baked;  // owns the maps the query borrows
+  vff::FieldQuery query;
+  vff::Instance instance;       // the field placed in the world
+  double bakeSeconds = 0;
+  double payloadMiB() const { return double(query.payloadBytes()) / 1048576.0; }
+};
+
+// Bakes one configuration (unorm8-diameter) of the object and places it like the world's object.
+vff::Result<std::unique_ptr<BakedQuery>> bakeQuery(const World& world, const vff::bake::Scene& scene,
+                                                   const FieldConfig& config, bool normals, unsigned threads);
+// Parses "4226x64x64" (or "n32m64"): maps must be an octa-hemi2 count.
+bool parseFieldConfig(const std::string& text, FieldConfig* out);
+
+// ---- Primary visibility (G-buffer) --------------------------------------------------------------
+enum class PixelKind : uint8_t { kBackground, kPlane, kObject };
+
+struct GSample {
+  PixelKind kind = PixelKind::kBackground;
+  Vec3 point;    // world
+  Vec3 normal;   // geometric, facing the camera
+  Vec3 shadingNormal;  // interpolated when the mesh has normals, facing the camera
+  Vec3 viewDir;  // unit, camera -> point
+};
+
+struct GBuffer {
+  int width = 0, height = 0;
+  std::vector<GSample> pixels;
+  const GSample& at(int x, int y) const { return pixels[size_t(y) * size_t(width) + size_t(x)]; }
+};
+
+// One primary ray through each pixel centre: the nearer of the plane and the object (exact).
+GBuffer traceGBuffer(const World& world, const ExactTracer& exact, int size, unsigned threads);
+
+// ---- Images -------------------------------------------------------------------------------------
+struct Image {
+  int width = 0, height = 0;
+  std::vector<Vec3> rgb;  // linear, nominally [0, 1]
+  Vec3& at(int x, int y) { return rgb[size_t(y) * size_t(width) + size_t(x)]; }
+  const Vec3& at(int x, int y) const { return rgb[size_t(y) * size_t(width) + size_t(x)]; }
+};
+
+// Renders every pixel with shade(x, y, sample, rng) in 16x16 tiles on `threads` workers; the
+// result does not depend on the thread count. Returns the wall time in seconds through *seconds.
+Image renderImage(const GBuffer& g, unsigned threads, uint32_t stream,
+                  const std::function<Vec3(const GSample&, Rng&)>& shade, double* seconds);
+
+// PNG (8 bits per channel: round(255 * clamp(v)), no transfer curve, so that the 8-bit error of
+// the table is the difference of the PNG values) and EXR (linear half RGB). Errors: kIoWrite.
+vff::Status writePng(const Image& image, const std::string& path);
+vff::Status writeExr(const Image& image, const std::string& path);
+// |a - b| on the 8-bit scale, times `gain`, through a black-red-yellow-white ramp; pixels outside
+// the mask are dark grey.
+vff::Status writeErrorMap(const Image& reference, const Image& image, const std::vector<uint8_t>& mask,
+                          float gain, const std::string& path);
+
+struct ErrorStats {
+  double rms = 0;  // on the 8-bit scale, over every channel of the masked pixels
+  double max = 0;
+  uint64_t pixels = 0;
+};
+ErrorStats compareImages(const Image& reference, const Image& image, const std::vector<uint8_t>& mask);
+
+// ---- Experiments --------------------------------------------------------------------------------
+struct Options {
+  std::string experiment;
+  std::string mesh = "/usr/share/glmark2/models/bunny.obj";
+  std::string out = "out/experiments";
+  int size = 512;
+  int rays = 0;       // 0: the experiment's default (ao 256, intra-ao 121, shadows 20, reflections 4)
+  unsigned threads = 0;
+  std::vector<std::string> configs;  // empty: the experiment's default field configurations
+  // AO range as a multiple of R. 2 R spans the whole bounding sphere, so for a plane point inside the
+  // sphere the range never cuts the intra-object answer (whose hit is the LAST crossing, at most 2 R away).
+  float aoDistance = 2.0f;
+  // bench
+  uint32_t benchRays = 1u << 21;
+  int repeat = 3;
+};
+
+// The result table of an image experiment, printed as Markdown and written to OUT/NAME-table.md.
+struct TableRow {
+  std::string configuration, reconstruction;
+  double memoryMiB = -1;  // < 0: not applicable
+  double rms = 0, max = 0, seconds = 0;
+  bool reference = false;
+};
+std::string formatTable(const std::vector<TableRow>& rows);
+
+// Every experiment returns an exit code (vff::cli::kExit*), after printing its diagnostics.
+int runAo(const Options& o);
+int runIntraAo(const Options& o);
+int runShadows(const Options& o);
+int runReflections(const Options& o);
+int runBench(const Options& o);
+
+// The shared driver of the image experiments (experiment.cpp): loads the world, builds the exact
+// tracer and the G-buffer, bakes the configurations, renders the reference and every (config,
+// reconstruction) image, writes images, heat maps and the table.
+struct ImageExperiment {
+  std::string name;  // "ao": files OUT/ao-*.png, OUT/ao-table.md
+  int defaultRays = 0;
+  std::vector<std::string> defaultConfigs;
+  bool normals = false;           // bake the normal plane too
+  bool comparePlane = true;    // pixels whose error is measured: plane pixels,
+  bool compareObject = false;  // object pixels
+  // Returns the shade function of one method: field == nullptr is the exact reference.
+  std::function<std::function<Vec3(const GSample&, Rng&)>(const World&, const ExactTracer&, const BakedQuery* field,
+                                                            vff::Reconstruction, int rays)>
+      makeShader;
+};
+int runImageExperiment(const Options& o, const ImageExperiment& e);
+
+inline constexpr const char* kProg = "vff-experiments";
+
+}  // namespace vffx

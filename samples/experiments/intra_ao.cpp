@@ -1,0 +1,47 @@
+// intra_ao.cpp - intra-object ambient occlusion on the object's own surface (the paper's Fig. 5).
+//
+// Every object pixel casts `rays` cosine-weighted rays (default 121) around its geometric normal
+// from a point lifted 1e-3 R off the surface, with no range limit (self-occlusion only: the plane
+// is not an occluder here). The origins are inside the bounding sphere, so the field answers with
+// the intra-object test (the reversed ray from the sphere exit, spec/geometry.md 7.3). Plane pixels
+// get a constant colour.
+#include "common.h"
+
+namespace vffx {
+
+const Vec3 kPlaneFlat{0.30f, 0.30f, 0.34f};
+
+int runIntraAo(const Options& o) {
+  ImageExperiment e;
+  e.name = "intra-ao";
+  e.defaultRays = 121;
+  e.defaultConfigs = {"16642x64x64", "4226x64x64", "4226x32x32"};
+  e.comparePlane = false;
+  e.compareObject = true;
+  e.makeShader = [](const World& w, const ExactTracer& exact, const BakedQuery* field, vff::Reconstruction r,
+                    int rays) -> std::function<Vec3(const GSample&, Rng&)> {
+    const float eps = 1e-3f * w.radius;
+    const vff::QueryOptions qo{.reconstruction = r};
+    return [=, &exact](const GSample& s, Rng& rng) -> Vec3 {
+      if (s.kind == PixelKind::kPlane) return kPlaneFlat;
+      if (s.kind != PixelKind::kObject) return {};
+      const Vec3 origin = s.point + s.normal * eps;
+      float open = 0;
+      for (int i = 0; i < rays; ++i) {
+        const float u1 = rng.next01(), u2 = rng.next01();
+        const vff::Ray ray{origin, cosineDirection(s.normal, u1, u2)};
+        if (!field)
+          open += exact.occluded(ray) ? 0.0f : 1.0f;
+        else if (r == vff::Reconstruction::kNearest)
+          open += field->instance.occluded(ray, qo) ? 0.0f : 1.0f;
+        else
+          open += field->instance.visibility(ray, qo);
+      }
+      const float v = open / float(rays);
+      return {v, v, v};
+    };
+  };
+  return runImageExperiment(o, e);
+}
+
+}  // namespace vffx

@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# vff-experiments end to end at a tiny size: images and tables written, exit codes, determinism.
+# Usage: run.sh EXPERIMENTS MESHGEN CASE
+set -uo pipefail
+exp="$1"; meshgen="$2"; case="$3"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+cd "$work"
+fail() { echo "FAIL: $*"; exit 1; }
+"$meshgen" torus-knot knot.obj || fail "mesh generator"
+small=(--mesh knot.obj --size 40 --config 1090x16x16)
+
+case "$case" in
+  ao_writes_images_and_table)
+    "$exp" ao "${small[@]}" --rays 16 -o out >stdout.txt 2>stderr.txt || { cat stderr.txt; fail "ao failed"; }
+    for f in ao-exact.png ao-exact.exr ao-table.md; do [ -s "out/$f" ] || { ls out; fail "missing out/$f"; }; done
+    ls out | grep -q 'error.*\.png\|heat.*\.png' || { ls out; fail "no error heat map"; }
+    grep -q '1090x16x16 | nearest' stdout.txt || { cat stdout.txt; fail "table lacks the nearest row"; }
+    grep -q '1090x16x16 | interpolated' stdout.txt || fail "table lacks the interpolated row"
+    if command -v exrheader >/dev/null; then exrheader out/ao-exact.exr >/dev/null || fail "exrheader rejects the EXR"; fi
+    ;;
+  every_experiment_runs)
+    for e in intra-ao shadows reflections; do
+      "$exp" "$e" "${small[@]}" --rays 4 -o out >stdout.txt 2>stderr.txt || { cat stderr.txt; fail "$e failed"; }
+      [ -s "out/$e-table.md" ] || { ls out; fail "missing out/$e-table.md"; }
+    done
+    "$exp" bench --mesh knot.obj --config 1090x16x16 --bench-rays 20000 --repeat 1 >stdout.txt 2>stderr.txt \
+      || { cat stderr.txt; fail "bench failed"; }
+    grep -q "Embree rtcOccluded1" stdout.txt || { cat stdout.txt; fail "bench prints no baseline"; }
+    ;;
+  images_do_not_depend_on_threads)
+    "$exp" ao "${small[@]}" --rays 8 -j 1 -o one >/dev/null 2>&1 || fail "ao -j 1 failed"
+    "$exp" ao "${small[@]}" --rays 8 -j 2 -o two >/dev/null 2>&1 || fail "ao -j 2 failed"
+    for f in one/*.png one/*.exr; do cmp "$f" "two/${f#one/}" || fail "$f differs between 1 and 2 threads"; done
+    ;;
+  bad_input_exit_codes)
+    "$exp" ao --mesh nothere.obj -o out >stdout.txt 2>stderr.txt; rc=$?
+    [ "$rc" -eq 2 ] || fail "missing mesh exited $rc, expected 2"
+    grep -q nothere.obj stderr.txt || fail "message does not name the mesh"
+    "$exp" ao --mesh knot.obj --config 1000x16x16 -o out >/dev/null 2>&1; rc=$?
+    [ "$rc" -eq 1 ] || fail "bad --config exited $rc, expected 1"
+    "$exp" nosuch >/dev/null 2>&1; rc=$?
+    [ "$rc" -eq 1 ] || fail "unknown experiment exited $rc, expected 1"
+    ;;
+  *) fail "unknown case $case" ;;
+esac
+echo "PASS: $case"
