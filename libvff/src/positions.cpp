@@ -99,7 +99,10 @@ D3 octaPosition(uint32_t n, uint32_t index) {
   return octaPoint(n, h == 0 ? 1 : -1, i, j);
 }
 
-uint32_t octaNearest(uint32_t un, const D3& q) {
+// Offers every candidate of the O(1) lookup: offer(index, position) where position() computes the
+// binary64 position on demand (callers with a table of positions need not call it).
+template <class Offer>
+void octaCandidates(uint32_t un, const D3& q, Offer&& offer) {
   const int64_t n = un;
   // Restricting to the query's hemisphere is exact: the other hemisphere is its mirror image.
   const int64_t h = q.z >= 0 ? 0 : 1;
@@ -111,17 +114,14 @@ uint32_t octaNearest(uint32_t un, const D3& q) {
   const int64_t si = q.x < 0 ? -1 : 1, sj = q.y < 0 ? -1 : 1;
   // The unit cell's corners, and the far vertices of the four triangles adjacent to its two.
   static constexpr int kCand[8][2] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}, {-1, 1}, {1, -1}, {2, 0}, {0, 2}};
-  Best best;
   for (const auto& c : kCand) {
     const int64_t a = a0 + c[0], b = b0 + c[1];
     const int64_t aa = a < 0 ? -a : a, ab = b < 0 ? -b : b;
     if (aa + ab > n) continue;
     const int64_t i = si * a, j = sj * b;
-    const double d = dot(octaPoint(n, s, i, j), q);
     // An equator point (|i| + |j| = n) is canonically its hemisphere-0 copy.
-    best.offer(d, octaIndex(n, aa + ab == n ? 0 : h, i, j));
+    offer(octaIndex(n, aa + ab == n ? 0 : h, i, j), [=] { return octaPoint(n, s, i, j); });
   }
-  return best.index;
 }
 
 // ---- ea-octa-grid -----------------------------------------------------------------------------
@@ -169,7 +169,8 @@ void eaWrap(int64_t n, int64_t* i, int64_t* j) {
   }
 }
 
-uint32_t eaNearest(uint32_t un, const D3& q) {
+template <class Offer>
+void eaCandidates(uint32_t un, const D3& q, Offer&& offer) {
   const int64_t n = un;
   // Inverse map (sphere -> square), exact form of pbrt-v4's EqualAreaSphereToSquare.
   const double x = std::fabs(q.x), y = std::fabs(q.y), z = std::fabs(q.z);
@@ -185,14 +186,12 @@ uint32_t eaNearest(uint32_t un, const D3& q) {
   const double fn = double(n);
   const int64_t i0 = std::clamp(int64_t(std::floor((u + 1.0) * 0.5 * fn)), int64_t(0), n - 1);
   const int64_t j0 = std::clamp(int64_t(std::floor((v + 1.0) * 0.5 * fn)), int64_t(0), n - 1);
-  Best best;
   for (int64_t dj = -1; dj <= 1; ++dj)
     for (int64_t di = -1; di <= 1; ++di) {
       int64_t i = i0 + di, j = j0 + dj;
       eaWrap(n, &i, &j);
-      best.offer(dot(eaCell(n, i, j), q), uint32_t(j * n + i));
+      offer(uint32_t(j * n + i), [=] { return eaCell(n, i, j); });
     }
-  return best.index;
 }
 
 // ---- fibonacci --------------------------------------------------------------------------------
@@ -222,7 +221,8 @@ D3 fibPosition(uint32_t n, uint32_t index) {
 constexpr uint64_t kFib[22] = {0,  1,   1,   2,   3,   5,   8,    13,   21,   34,   55,
                                89, 144, 233, 377, 610, 987, 1597, 2584, 4181, 6765, 10946};
 
-uint32_t fibNearest(uint32_t un, const D3& q) {
+template <class Offer>
+void fibCandidates(uint32_t un, const D3& q, Offer&& offer) {
   const int64_t n = un;
   // Zone: the pair of Fibonacci index offsets (F_k, F_k+1) that form a good lattice basis at the
   // query's latitude (Keinert et al. 2015): k = max(2, floor(log(n pi sqrt5 rho^2) / log(Phi^2))).
@@ -239,14 +239,12 @@ uint32_t fibNearest(uint32_t un, const D3& q) {
   const double det = p0 * z1 - p1 * z0;
   const double c0 = std::floor((phi * z1 - p1 * dz) / det);
   const double c1 = std::floor((p0 * dz - z0 * phi) / det);
-  Best best;
   for (int s = 0; s < 4; ++s) {
     const double idx = (c0 + double(s & 1)) * double(f0) + (c1 + double(s >> 1)) * double(f1);
     if (!(idx >= 0.0 && idx < double(n))) continue;
     const uint32_t i = uint32_t(idx);
-    best.offer(dot(fibPosition(un, i), q), i);
+    offer(i, [=] { return fibPosition(un, i); });
   }
-  return best.index;
 }
 
 }  // namespace
@@ -286,24 +284,56 @@ Vec3 PositionSet::position(uint32_t index) const noexcept {
   return {};
 }
 
-uint32_t PositionSet::nearest(Vec3 direction) const noexcept {
-  if (count_ == 0) return 0;
-  D3 q{direction.x, direction.y, direction.z};
-  if (!std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z)) return 0;
-  const double len = std::sqrt(dot(q, q));
-  if (!(len > 0.0)) return 0;
-  q = {q.x / len, q.y / len, q.z / len};
-  switch (scheme_) {
+namespace {
+
+// Normalises a finite, non-zero direction in binary64; false otherwise.
+bool unitQuery(Vec3 d, D3* q) {
+  *q = {d.x, d.y, d.z};
+  if (!std::isfinite(q->x) || !std::isfinite(q->y) || !std::isfinite(q->z)) return false;
+  const double len = std::sqrt(dot(*q, *q));
+  if (!(len > 0.0)) return false;
+  *q = {q->x / len, q->y / len, q->z / len};
+  return true;
+}
+
+template <class Offer>
+void forEachCandidate(PositionScheme scheme, uint32_t param, const D3& q, Offer&& offer) {
+  switch (scheme) {
     case PositionScheme::kOctaHemi2:
-      return octaNearest(param_, q);
+      octaCandidates(param, q, offer);
+      break;
     case PositionScheme::kEqualAreaOctaGrid:
-      return eaNearest(param_, q);
+      eaCandidates(param, q, offer);
+      break;
     case PositionScheme::kSphericalFibonacci:
-      return fibNearest(param_, q);
+      fibCandidates(param, q, offer);
+      break;
     case PositionScheme::kInvalid:
       break;
   }
-  return 0;
+}
+
+}  // namespace
+
+uint32_t PositionSet::nearest(Vec3 direction) const noexcept {
+  D3 q;
+  if (count_ == 0 || !unitQuery(direction, &q)) return 0;
+  Best best;
+  forEachCandidate(scheme_, param_, q, [&](uint32_t index, auto&& position) { best.offer(dot(position(), q), index); });
+  return best.index;
+}
+
+uint32_t PositionSet::candidates(Vec3 direction, uint32_t out[kMaxCandidates]) const noexcept {
+  D3 q;
+  if (count_ == 0 || !unitQuery(direction, &q)) {
+    out[0] = 0;
+    return count_ == 0 ? 0 : 1;
+  }
+  uint32_t count = 0;
+  forEachCandidate(scheme_, param_, q, [&](uint32_t index, auto&&) {
+    if (count < kMaxCandidates) out[count++] = index;
+  });
+  return count;
 }
 
 }  // namespace vff

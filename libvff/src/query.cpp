@@ -91,6 +91,24 @@ struct FieldQuery::Impl {
 
   Vec3 samplePoint(uint32_t k) const noexcept { return center + unit[k] * radius; }
 
+  // The nearest sample among the O(1) candidates, by binary32 dot products with the table of
+  // positions (spec/positions.md section 2 allows a decoder this; it differs from the binary64
+  // choice only between samples equally near to within rounding).
+  uint32_t nearestSample(Vec3 d) const noexcept {
+    uint32_t c[PositionSet::kMaxCandidates];
+    const uint32_t n = positions.candidates(d, c);
+    uint32_t best = c[0];
+    float bestDot = dot(unit[best], d);
+    for (uint32_t i = 1; i < n; ++i) {
+      const float v = dot(unit[c[i]], d);
+      if (v > bestDot || (v == bestDot && c[i] < best)) {
+        bestDot = v;
+        best = c[i];
+      }
+    }
+    return best;
+  }
+
   void build();
   QueryHit query(const Ray& ray, const QueryOptions& o, float* visibility) const noexcept;
 };
@@ -265,7 +283,7 @@ QueryHit FieldQuery::Impl::query(const Ray& ray, const QueryOptions& o, float* v
   }
   const float hi = tmax;
   const Vec3 eu = (e - center) * (1.0f / radius);
-  const uint32_t k0 = positions.nearest(eu);
+  const uint32_t k0 = nearestSample(eu);
 
   // From inside, kInterpolated answers like kNearest: the blended samples' rays pass beside the
   // origin and take its own surface for an occluder (tests/query, intra-object occlusion).

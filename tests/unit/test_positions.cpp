@@ -469,6 +469,34 @@ TEST(PositionSet, FromFieldChecksMapCount) {
   EXPECT_EQ(badParam.error().code, Code::kPositionScheme);
 }
 
+TEST(PositionSet, CandidatesHoldTheNearestSample) {
+  // candidates() is what a table-driven lookup (the CPU query, a GPU port) chooses from.
+  for (auto [sc, n] : {std::pair{PositionScheme::kOctaHemi2, 32u}, std::pair{PositionScheme::kEqualAreaOctaGrid, 65u},
+                       std::pair{PositionScheme::kSphericalFibonacci, 4226u}}) {
+    const PositionSet s = make(sc, n);
+    Rng rng{42};
+    for (int k = 0; k < 20000; ++k) {
+      const Vec3 d = toF(rng.direction());
+      uint32_t c[PositionSet::kMaxCandidates];
+      const uint32_t count = s.candidates(d, c);
+      ASSERT_GE(count, 1u);
+      ASSERT_LE(count, PositionSet::kMaxCandidates);
+      const uint32_t want = s.nearest(d);
+      bool found = false;
+      for (uint32_t i = 0; i < count; ++i) {
+        ASSERT_LT(c[i], s.count());
+        found = found || c[i] == want;
+      }
+      ASSERT_TRUE(found) << positionSchemeName(sc) << " query " << k;
+    }
+    uint32_t c[PositionSet::kMaxCandidates];
+    EXPECT_EQ(s.candidates({0, 0, 0}, c), 1u);
+    EXPECT_EQ(c[0], 0u);
+  }
+  uint32_t c[PositionSet::kMaxCandidates];
+  EXPECT_EQ(PositionSet{}.candidates({1, 0, 0}, c), 0u);
+}
+
 TEST(PositionSet, EmptyAndInvalidInputsAreSafe) {
   static_assert(std::is_trivially_copyable_v<PositionSet>);
   const PositionSet empty;

@@ -63,6 +63,13 @@ class PositionSet {
   // every i, except the lower copy of an octa-hemi2 equator sample, which returns its upper copy.
   uint32_t nearest(Vec3 direction) const noexcept;
 
+  // The candidates nearest() chooses from, in O(1) (at most kMaxCandidates; the nearest sample is
+  // always among them): for callers that keep their own table of positions, such as a binary32
+  // query, which then take the candidate with the largest dot product, ties to the smallest index.
+  // Returns their number (>= 1 when count() > 0; a zero or non-finite direction gives {0}).
+  static constexpr uint32_t kMaxCandidates = 9;
+  uint32_t candidates(Vec3 direction, uint32_t out[kMaxCandidates]) const noexcept;
+
   // The map frame of sample `index`: frameFromNormal(-position(index)). Same precondition.
   Frame frame(uint32_t index) const noexcept { return frameFromNormal(negate(position(index))); }
 
