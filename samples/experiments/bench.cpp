@@ -78,12 +78,11 @@ int runBench(const Options& o) {
     return vff::cli::kExitUsage;
   }
   const unsigned threads = resolveThreads(o.threads);
-  auto world = makeWorld(o.mesh);
-  if (!world) return vff::cli::reportError(kProg, o.mesh, world.error());
-  auto exact = ExactTracer::create(world->worldMesh);
-  if (!exact) return vff::cli::reportError(kProg, o.mesh, exact.error());
-  auto scene = vff::bake::Scene::create(world->objectMesh, threads);
-  if (!scene) return vff::cli::reportError(kProg, o.mesh, scene.error());
+  auto setup = makeSetup(o, threads);
+  if (!setup) return vff::cli::reportError(kProg, o.mesh, setup.error());
+  World* world = &(*setup)->world;
+  ExactTracer* exact = &*(*setup)->exact;
+  vff::bake::Scene* scene = &*(*setup)->scene;
   auto field = bakeQuery(*world, *scene, config, false, threads);
   if (!field) return vff::cli::reportError(kProg, o.mesh, field.error());
   const vff::FieldQuery& q = (*field)->query;

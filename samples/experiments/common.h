@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -127,6 +128,15 @@ struct BakedQuery {
   double payloadMiB() const { return double(query.payloadBytes()) / 1048576.0; }
 };
 
+// The unoccluded share of one ray: the exact answer (0 or 1) when field is null, the field's
+// occluded() (0 or 1) for kNearest, its visibility() (a fraction) for kInterpolated.
+inline float openShare(const ExactTracer& exact, const BakedQuery* field, const vff::QueryOptions& qo,
+                       const vff::Ray& ray) {
+  if (!field) return exact.occluded(ray) ? 0.0f : 1.0f;
+  if (qo.reconstruction == vff::Reconstruction::kNearest) return field->instance.occluded(ray, qo) ? 0.0f : 1.0f;
+  return field->instance.visibility(ray, qo);
+}
+
 // Bakes one configuration (unorm8-diameter) of the object and places it like the world's object.
 vff::Result<std::unique_ptr<BakedQuery>> bakeQuery(const World& world, const vff::bake::Scene& scene,
                                                    const FieldConfig& config, bool normals, unsigned threads);
@@ -198,6 +208,15 @@ struct Options {
   uint32_t benchRays = 1u << 21;
   int repeat = 3;
 };
+
+// What every experiment needs first: the world, its exact tracer and the object's Embree scene.
+// The tracers refer to the world's meshes, so a Setup stays where it was made (held by pointer).
+struct Setup {
+  World world;
+  std::optional<ExactTracer> exact;
+  std::optional<vff::bake::Scene> scene;
+};
+vff::Result<std::unique_ptr<Setup>> makeSetup(const Options& o, unsigned threads);
 
 // The result table of an image experiment, printed as Markdown and written to OUT/NAME-table.md.
 struct TableRow {

@@ -61,12 +61,11 @@ int runImageExperiment(const Options& o, const ImageExperiment& e) {
   const int rays = o.rays > 0 ? o.rays : e.defaultRays;
   const unsigned threads = resolveThreads(o.threads);
 
-  auto world = makeWorld(o.mesh);
-  if (!world) return vff::cli::reportError(kProg, o.mesh, world.error());
-  auto exact = ExactTracer::create(world->worldMesh);
-  if (!exact) return vff::cli::reportError(kProg, o.mesh, exact.error());
-  auto scene = vff::bake::Scene::create(world->objectMesh, threads);
-  if (!scene) return vff::cli::reportError(kProg, o.mesh, scene.error());
+  auto setup = makeSetup(o, threads);
+  if (!setup) return vff::cli::reportError(kProg, o.mesh, setup.error());
+  World* world = &(*setup)->world;
+  ExactTracer* exact = &*(*setup)->exact;
+  vff::bake::Scene* scene = &*(*setup)->scene;
   std::error_code ec;
   std::filesystem::create_directories(o.out, ec);
   if (ec) {

@@ -30,12 +30,7 @@ int runIntraAo(const Options& o) {
       for (int i = 0; i < rays; ++i) {
         const float u1 = rng.next01(), u2 = rng.next01();
         const vff::Ray ray{origin, cosineDirection(s.normal, u1, u2)};
-        if (!field)
-          open += exact.occluded(ray) ? 0.0f : 1.0f;
-        else if (r == vff::Reconstruction::kNearest)
-          open += field->instance.occluded(ray, qo) ? 0.0f : 1.0f;
-        else
-          open += field->instance.visibility(ray, qo);
+        open += openShare(exact, field, qo, ray);
       }
       const float v = open / float(rays);
       return {v, v, v};

@@ -51,12 +51,7 @@ int runShadows(const Options& o) {
         const Vec3 target = c + uniformSphere(u1, u2) * (kLightRadius * w.radius);
         const vff::Ray ray{origin, target - origin, 0.0f, 1.0f};
         ++count[l];
-        if (!field)
-          open[l] += exact.occluded(ray) ? 0.0f : 1.0f;
-        else if (r == vff::Reconstruction::kNearest)
-          open[l] += field->instance.occluded(ray, qo) ? 0.0f : 1.0f;
-        else
-          open[l] += field->instance.visibility(ray, qo);
+        open[l] += openShare(exact, field, qo, ray);
       }
       Vec3 sum = kAmbient;
       for (int l = 0; l < 3; ++l) {

@@ -106,4 +106,18 @@ Image renderImage(const GBuffer& g, unsigned threads, uint32_t stream,
   return img;
 }
 
+vff::Result<std::unique_ptr<Setup>> makeSetup(const Options& o, unsigned threads) {
+  auto world = makeWorld(o.mesh);
+  if (!world) return std::move(world).error();
+  auto setup = std::make_unique<Setup>();
+  setup->world = std::move(*world);
+  auto exact = ExactTracer::create(setup->world.worldMesh);
+  if (!exact) return std::move(exact).error();
+  setup->exact.emplace(std::move(*exact));
+  auto scene = vff::bake::Scene::create(setup->world.objectMesh, threads);
+  if (!scene) return std::move(scene).error();
+  setup->scene.emplace(std::move(*scene));
+  return setup;
+}
+
 }  // namespace vffx
