@@ -8,7 +8,7 @@ packages=(
   libembree-dev libopenexr-dev openexr libopenvdb-dev libopenvdb-tools libboost-iostreams-dev
   libopenmesh-dev libtinygltf-dev libcli11-dev libzstd-dev libxxhash-dev nlohmann-json3-dev
   libstb-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev glslang-tools
-  libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri
+  libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
   glmark2-data zstd xz-utils python3
 )
 

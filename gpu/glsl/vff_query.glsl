@@ -1,0 +1,439 @@
+// vff_query.glsl - the visibility-field lookup in GLSL 4.30 core (spec/geometry.md section 7,
+// spec/positions.md, spec/format.md "Packed slice layout" and "Value encodings").
+//
+// Include it after `#version 430` (or later). It answers the same rays as the CPU query
+// vff::FieldQuery::intersect with Reconstruction::kNearest (libvff/src/query.cpp): the same
+// sphere test, the same nearest positional sample, the same texel and the same decoded distance,
+// up to rounding of atan/sqrt/division near a texel or sample boundary (spec/geometry.md section 8).
+//
+// Resources (filled by the C++ loader vff::gl::loadField, gpu/loader/include/vff/gl/loader.h):
+//   binding VFF_FIELD_BINDING      (default 0): uniform block VffFieldBlock (std140, vff::gl::FieldBlock)
+//   binding VFF_MAPS_BINDING       (default 1): the packed distance slices, usampler2DArray
+//                                               (usampler3D when VFF_MAPS_3D is defined);
+//                                               R8UI for unorm8-* and bit1, R16UI for unorm16-diameter
+//   binding VFF_POSITIONS_BINDING  (default 2): buffer VffPositionsBlock, the binary32 unit vectors
+//                                               of the samples (vff::PositionSet::position), one vec4
+//                                               each, then (unorm8-chord) the per-texel decode scales
+// The three bindings are distinct numbers, so the same declarations are valid for OpenGL (where
+// uniform blocks, texture units and storage blocks are separate namespaces) and for Vulkan (one
+// namespace per descriptor set, set 0).
+//
+// Entry points:
+//   VffHit vffIntersect(vec3 origin, vec3 direction, float tmin, float tmax, float intraBias)
+//     direction need not be unit length; t is in multiples of it (as vff::Ray). intraBias < 0
+//     selects the field's default (vff::defaultIntraBias), as vff::QueryOptions::intraBias.
+//   bool vffOccluded(...)  the same arguments; hit within [tmin, tmax].
+// Building blocks (names as in spec/geometry.md 5.4 and spec/positions.md 6): vffFrame, vffToLocal,
+// vffHemisphereToSquare, vffSquareToHemisphere, vffSquareToTexel, vffTexelCenter, vffNearestSample,
+// vffFetchCode, vffDecode.
+//
+// Exactness. Variables on the path whose bits matter are `precise` (no fused multiply-add, no
+// reassociation), and divisions and square roots go through vffDivide and vffSqrt, which refine the
+// driver's result to the correctly rounded one (a driver may implement '/' as a reciprocal and a
+// multiply, and sqrt from an approximate inverse square root; llvmpipe's sqrt is not correctly
+// rounded). The decoded distance of a texel is then bit-identical to the CPU's.
+#ifndef VFF_QUERY_GLSL
+#define VFF_QUERY_GLSL
+
+#ifndef VFF_FIELD_BINDING
+#define VFF_FIELD_BINDING 0
+#endif
+#ifndef VFF_MAPS_BINDING
+#define VFF_MAPS_BINDING 1
+#endif
+#ifndef VFF_POSITIONS_BINDING
+#define VFF_POSITIONS_BINDING 2
+#endif
+
+// ---- Resources -----------------------------------------------------------------------------------
+// Field and layout: the FDSC and LAYT fields (spec/format.md sections 5 and 6) plus three values the
+// loader derives exactly as the CPU does. Must match vff::gl::FieldBlock (96 bytes).
+layout(std140, binding = VFF_FIELD_BINDING) uniform VffFieldBlock {
+  vec3 sphereCenter;        // sphere.center
+  float sphereRadius;       // sphere.radius
+  uint positionScheme;      // 1 octa-hemi2, 2 ea-octa-grid, 3 fibonacci
+  uint positionParam;       // n
+  uint mapCount;
+  uint directionScheme;     // 1 concentric-equal-area, 2 hemi-octahedral
+  uint mapResolution;       // M
+  uint distanceEncoding;    // 1 unorm8-diameter, 2 unorm8-chord, 3 unorm16-diameter, 4 bit1
+  uint missCode;            // 255, 255, 65535, 0
+  uint normalEncoding;      // not read by this include
+  uint target;              // 1 2d-array, 2 3d
+  uint gutter;
+  uint tileSize;
+  uint tilesPerRow;
+  uint tilesPerColumn;
+  uint sliceWidth;
+  uint sliceHeight;
+  uint sliceCount;
+  float intraBias;          // vff::defaultIntraBias(field), a fraction of R
+  float distanceScale;      // unorm8/16-diameter: 2R / 254 or 2R / 65534 (float, as the CPU)
+  float invRadius;          // 1 / R (float, as the CPU)
+  float twoRadius;          // 2 R
+} vffField;
+
+#ifdef VFF_MAPS_3D
+layout(binding = VFF_MAPS_BINDING) uniform highp usampler3D vffMaps;
+#else
+layout(binding = VFF_MAPS_BINDING) uniform highp usampler2DArray vffMaps;
+#endif
+
+// vffPositions[k], k < mapCount: xyz = the outward unit vector of sample k (binary32), w = 0.
+// For unorm8-chord it continues with the decode scale of every texel of a map, 2R cos(alpha) / 254
+// with cos(alpha) of the texel centre, computed by the CPU exactly as the CPU query does: texel
+// t = j M + i is component t % 4 of vffPositions[mapCount + t / 4].
+layout(std430, binding = VFF_POSITIONS_BINDING) readonly buffer VffPositionsBlock {
+  vec4 vffPositions[];
+};
+
+const uint VFF_POSITION_OCTA_HEMI2 = 1u;
+const uint VFF_POSITION_EA_OCTA_GRID = 2u;
+const uint VFF_POSITION_FIBONACCI = 3u;
+const uint VFF_DIRECTION_CONCENTRIC_EQUAL_AREA = 1u;
+const uint VFF_DIRECTION_HEMI_OCTAHEDRAL = 2u;
+const uint VFF_ENCODING_UNORM8_DIAMETER = 1u;
+const uint VFF_ENCODING_UNORM8_CHORD = 2u;
+const uint VFF_ENCODING_UNORM16_DIAMETER = 3u;
+const uint VFF_ENCODING_BIT1 = 4u;
+
+// ---- Arithmetic ----------------------------------------------------------------------------------
+// a / b, correctly rounded (one Newton correction of the driver's quotient, with a fused residual).
+float vffDivide(float a, float b) {
+  precise float q = a / b;
+  precise float r = fma(-q, b, a);
+  precise float c = fma(r, 1.0 / b, q);
+  // Keep the driver's quotient where the correction is meaningless (inf, nan, zero divisor).
+  return (isinf(q) || isnan(c) || b == 0.0) ? q : c;
+}
+
+// sqrt(a), correctly rounded (one Newton correction with a fused residual), for drivers whose sqrt
+// is an approximation.
+float vffSqrt(float a) {
+  precise float s = sqrt(a);
+  precise float r = fma(-s, s, a);
+  precise float c = fma(r, vffDivide(0.5, s), s);
+  return (s == 0.0 || isinf(s) || isnan(c)) ? s : c;
+}
+
+// a.x b.x + a.y b.y + a.z b.z, in this order, each operation rounded (as the C++ reference).
+float vffDot(vec3 a, vec3 b) {
+  precise float x = a.x * b.x;
+  precise float y = a.y * b.y;
+  precise float z = a.z * b.z;
+  precise float s = x + y;
+  precise float d = s + z;
+  return d;
+}
+
+// ---- Frames and direction schemes (spec/geometry.md sections 3 to 5) ------------------------------
+const float kVffPi = 3.14159265358979323846;
+const float kVffQuarterPi = kVffPi / 4.0;
+
+// duff2017 frame around the unit inward normal n: columns t, b, n.
+mat3 vffFrame(vec3 n) {
+  precise float s = n.z >= 0.0 ? 1.0 : -1.0;  // not sign(): sign(0.0) is 0
+  precise float a = vffDivide(-1.0, s + n.z);
+  precise float k = n.x * n.y * a;
+  precise vec3 t = vec3(1.0 + s * n.x * n.x * a, s * k, -s * n.x);
+  precise vec3 b = vec3(k, s + n.y * n.y * a, -n.y);
+  return mat3(t, b, n);
+}
+// (w.t, w.b, w.n)
+vec3 vffToLocal(mat3 F, vec3 w) { return vec3(vffDot(w, F[0]), vffDot(w, F[1]), vffDot(w, F[2])); }
+
+// scheme 1 = concentric-equal-area, 2 = hemi-octahedral. d.z < 0 is treated as the horizon.
+vec2 vffHemisphereToSquare(uint scheme, vec3 d) {
+  precise float z = max(0.0, d.z);
+  if (scheme == VFF_DIRECTION_HEMI_OCTAHEDRAL) {
+    precise float l1 = abs(d.x) + abs(d.y) + z;
+    precise float inv = vffDivide(1.0, l1);
+    precise float x = d.x * inv;
+    precise float y = d.y * inv;
+    precise vec2 uv = vec2(x + y, x - y);
+    return clamp(uv, -1.0, 1.0);
+  }
+  precise float r = vffSqrt(max(0.0, 1.0 - z));
+  if (r == 0.0) return vec2(0.0);            // the pole; atan(0, 0) is undefined in GLSL
+  precise float phi = atan(d.y, d.x);        // (-pi, pi]
+  if (phi < -kVffQuarterPi) phi += 2.0 * kVffPi;  // [-pi/4, 7pi/4)
+  precise vec2 ab;
+  if (phi < kVffQuarterPi) {
+    ab = vec2(r, vffDivide(phi * r, kVffQuarterPi));
+  } else if (phi < 3.0 * kVffQuarterPi) {
+    ab = vec2(vffDivide(-(phi - 2.0 * kVffQuarterPi) * r, kVffQuarterPi), r);
+  } else if (phi < 5.0 * kVffQuarterPi) {
+    ab = vec2(-r, vffDivide((phi - kVffPi) * -r, kVffQuarterPi));
+  } else {
+    ab = vec2(vffDivide((phi - 6.0 * kVffQuarterPi) * r, kVffQuarterPi), -r);
+  }
+  return clamp(ab, -1.0, 1.0);
+}
+
+vec3 vffSquareToHemisphere(uint scheme, vec2 uv) {
+  precise float a = clamp(uv.x, -1.0, 1.0);
+  precise float b = clamp(uv.y, -1.0, 1.0);
+  if (scheme == VFF_DIRECTION_HEMI_OCTAHEDRAL) {
+    precise float x = (a + b) * 0.5;
+    precise float y = (a - b) * 0.5;
+    precise float z = 1.0 - abs(x) - abs(y);
+    precise float ss = x * x + y * y + z * z;
+    precise float len = vffSqrt(ss);
+    return vec3(vffDivide(x, len), vffDivide(y, len), vffDivide(z, len));
+  }
+  precise float r, phi;
+  if (a == 0.0 && b == 0.0) { r = 0.0; phi = 0.0; }
+  else if (abs(a) > abs(b)) { r = a; phi = kVffQuarterPi * vffDivide(b, a); }
+  else                      { r = b; phi = 2.0 * kVffQuarterPi - kVffQuarterPi * vffDivide(a, b); }
+  precise float r2 = r * r;
+  precise float s = r * vffSqrt(max(0.0, 2.0 - r2));
+  return vec3(s * cos(phi), s * sin(phi), 1.0 - r2);
+}
+
+// cos(alpha) of the direction through square point uv: the z of vffSquareToHemisphere, computed
+// without sin and cos (bit-identical to the CPU's texelDirection(...).z).
+float vffSquareToCosAlpha(uint scheme, vec2 uv) {
+  precise float a = clamp(uv.x, -1.0, 1.0);
+  precise float b = clamp(uv.y, -1.0, 1.0);
+  if (scheme == VFF_DIRECTION_HEMI_OCTAHEDRAL) {
+    precise float x = (a + b) * 0.5;
+    precise float y = (a - b) * 0.5;
+    precise float z = 1.0 - abs(x) - abs(y);
+    precise float ss = x * x + y * y + z * z;
+    precise float len = vffSqrt(ss);
+    return vffDivide(z, len);
+  }
+  precise float r = (a == 0.0 && b == 0.0) ? 0.0 : (abs(a) > abs(b) ? a : b);
+  precise float c = 1.0 - r * r;
+  return c;
+}
+
+ivec2 vffSquareToTexel(vec2 uv, int M) {
+  precise vec2 f = floor((uv + 1.0) * 0.5 * float(M));
+  return clamp(ivec2(clamp(f, vec2(0.0), vec2(float(M - 1)))), ivec2(0), ivec2(M - 1));
+}
+vec2 vffTexelCenter(ivec2 ij, int M) {
+  precise vec2 n = 2.0 * vec2(ij) + 1.0;
+  return vec2(vffDivide(n.x, float(M)), vffDivide(n.y, float(M))) - 1.0;
+}
+
+// ---- Nearest positional sample (spec/positions.md section 6, positions read from the buffer) -------
+vec3 vffPosition(int k) { return vffPositions[k].xyz; }
+
+int vffOctaHemi2Index(int n, int h, int p, int q) {
+  int t = n + q;
+  int start = q <= 0 ? t * t : t * t - 2 * q * (q - 1);
+  return h * (2 * n * n + 2 * n + 1) + start + p + n - abs(q);
+}
+
+int vffNearestOctaHemi2(vec3 d, int n) {
+  int h = d.z >= 0.0 ? 0 : 1;
+  vec3 a = abs(d);
+  float s = float(n) / (a.x + a.y + a.z);
+  ivec2 c0 = min(ivec2(a.xy * s), ivec2(n - 1));
+  ivec2 sg = ivec2(d.x < 0.0 ? -1 : 1, d.y < 0.0 ? -1 : 1);
+  const ivec2 offs[8] = ivec2[8](ivec2(0, 0), ivec2(1, 0), ivec2(0, 1), ivec2(1, 1),
+                                 ivec2(-1, 1), ivec2(1, -1), ivec2(2, 0), ivec2(0, 2));
+  float best = -2.0;
+  int bestK = 0;
+  for (int c = 0; c < 8; ++c) {
+    ivec2 ab = c0 + offs[c];
+    int l1 = abs(ab.x) + abs(ab.y);
+    if (l1 > n) continue;
+    ivec2 pq = sg * ab;
+    int k = vffOctaHemi2Index(n, l1 == n ? 0 : h, pq.x, pq.y);
+    float dd = vffDot(vffPosition(k), d);
+    if (dd > best || (dd == best && k < bestK)) { best = dd; bestK = k; }
+  }
+  return bestK;
+}
+
+int vffNearestEaOctaGrid(vec3 d, int n) {
+  vec3 a = abs(d);
+  float r = sqrt((a.x * a.x + a.y * a.y) / (1.0 + a.z));
+  float b = a.x + a.y > 0.0 ? r * (atan(a.y, a.x) * 0.636619772) : 0.0;  // atan(0, 0) is undefined
+  vec2 uv = vec2(r - b, b);
+  if (d.z < 0.0) uv = 1.0 - uv.yx;
+  uv = vec2(d.x < 0.0 ? -uv.x : uv.x, d.y < 0.0 ? -uv.y : uv.y);
+  ivec2 c0 = clamp(ivec2(floor((uv + 1.0) * (0.5 * float(n)))), ivec2(0), ivec2(n - 1));
+  float best = -2.0;
+  int bestK = 0;
+  for (int dj = -1; dj <= 1; ++dj)
+    for (int di = -1; di <= 1; ++di) {
+      ivec2 c = c0 + ivec2(di, dj);
+      if (c.x < 0 || c.x >= n) c = ivec2(c.x < 0 ? 0 : n - 1, n - 1 - c.y);
+      if (c.y < 0 || c.y >= n) c = ivec2(n - 1 - c.x, c.y < 0 ? 0 : n - 1);
+      int k = c.y * n + c.x;
+      float dd = vffDot(vffPosition(k), d);
+      if (dd > best || (dd == best && k < bestK)) { best = dd; bestK = k; }
+    }
+  return bestK;
+}
+
+const uint VFF_FIB[22] = uint[22](0u, 1u, 1u, 2u, 3u, 5u, 8u, 13u, 21u, 34u, 55u, 89u, 144u, 233u,
+                                  377u, 610u, 987u, 1597u, 2584u, 4181u, 6765u, 10946u);
+
+// The top 32 bits of (k * 0x9E3779B97F4A7C15) mod 2^64, that is frac(k (Phi - 1)) * 2^32.
+uint vffFibTop32(uint k) {
+  uint hi, lo;
+  umulExtended(k, 0x7F4A7C15u, hi, lo);
+  return k * 0x9E3779B9u + hi;
+}
+
+int vffNearestFibonacci(vec3 d, int n) {
+  float rho2 = d.x * d.x + d.y * d.y;
+  float v = float(n) * 7.02481473 * rho2;                                  // n pi sqrt(5) rho^2
+  int k = v > 1.0 ? clamp(int(floor(log(v) * 1.03904346)), 2, 20) : 2;    // 1 / ln(Phi^2)
+  uint f0 = VFF_FIB[k], f1 = VFF_FIB[k + 1];
+  float p0 = float(int(vffFibTop32(f0))) * (6.28318531 / 4294967296.0);
+  float p1 = float(int(vffFibTop32(f1))) * (6.28318531 / 4294967296.0);
+  float z0 = -2.0 * float(f0) / float(n), z1 = -2.0 * float(f1) / float(n);
+  float phi = rho2 > 0.0 ? atan(d.y, d.x) : 0.0;
+  float dz = d.z - (1.0 - 1.0 / float(n));
+  float det = p0 * z1 - p1 * z0;
+  int c0 = int(floor((phi * z1 - p1 * dz) / det));
+  int c1 = int(floor((p0 * dz - z0 * phi) / det));
+  float best = -2.0;
+  int bestK = 0;
+  for (int s = 0; s < 4; ++s) {
+    int i = (c0 + (s & 1)) * int(f0) + (c1 + (s >> 1)) * int(f1);
+    if (i < 0 || i >= n) continue;
+    float dd = vffDot(vffPosition(i), d);
+    if (dd > best || (dd == best && i < bestK)) { best = dd; bestK = i; }
+  }
+  return bestK;
+}
+
+// The sample nearest to direction d (need not be unit length).
+int vffNearestSample(vec3 d) {
+  vec3 u = normalize(d);
+  int n = int(vffField.positionParam);
+  if (vffField.positionScheme == VFF_POSITION_OCTA_HEMI2) return vffNearestOctaHemi2(u, n);
+  if (vffField.positionScheme == VFF_POSITION_EA_OCTA_GRID) return vffNearestEaOctaGrid(u, n);
+  return vffNearestFibonacci(u, n);
+}
+
+// ---- Fetch and decode (spec/format.md "Packed slice layout", "Value encodings") ----------------------
+// The stored code of texel (i, j) of map k: placeMap, then texelFetch in the packed slices.
+uint vffFetchCode(uint k, uvec2 ij) {
+  uint perSlice = vffField.tilesPerRow * vffField.tilesPerColumn;
+  uint slice = k / perSlice;
+  uint r = k - slice * perSlice;
+  uint x = (r % vffField.tilesPerRow) * vffField.tileSize + vffField.gutter + ij.x;
+  uint y = (r / vffField.tilesPerRow) * vffField.tileSize + vffField.gutter + ij.y;
+  if (vffField.distanceEncoding == VFF_ENCODING_BIT1)
+    return (texelFetch(vffMaps, ivec3(int(x >> 3u), int(y), int(slice)), 0).r >> (x & 7u)) & 1u;
+  return texelFetch(vffMaps, ivec3(int(x), int(y), int(slice)), 0).r;
+}
+
+// A decoded texel: hit, and the distance from the sample point (0 for bit1).
+struct VffTexel {
+  bool hit;
+  float distance;
+};
+
+VffTexel vffDecode(uint code, uvec2 ij) {
+  VffTexel o;
+  uint e = vffField.distanceEncoding;
+  if (e == VFF_ENCODING_BIT1) {
+    o.hit = code != 0u;
+    o.distance = 0.0;
+    return o;
+  }
+  o.hit = code != vffField.missCode;
+  if (e == VFF_ENCODING_UNORM8_CHORD) {
+    // The texel's scale 2R cos(alpha) / 254 from the table after the positions (see the buffer).
+    // Computing it here with vffSquareToCosAlpha is within an ulp, but not bit-exact on drivers
+    // that fuse a * b + c despite `precise` (llvmpipe does).
+    uint t = ij.y * vffField.mapResolution + ij.x;
+    float scale = vffPositions[vffField.mapCount + t / 4u][t % 4u];
+    precise float d = float(code) * scale;
+    o.distance = d;
+  } else {
+    precise float d = float(code) * vffField.distanceScale;
+    o.distance = d;
+  }
+  return o;
+}
+
+// ---- The ray query (spec/geometry.md 7.2, 7.3; vff::FieldQuery::intersect, kNearest) --------------
+struct VffHit {
+  bool hit;       // the ray hits the object with t in [tmin, tmax]
+  bool inside;    // the origin was inside the bounding sphere (the reversed-ray test of 7.3)
+  float t;        // along the ray, in multiples of its direction; +inf without a hit
+  // The lookup that answered the ray (valid when looked): sample, texel, stored code and its
+  // decoded distance from the sample's entry point. Useful for debugging and for the tests.
+  bool looked;
+  uint sampleIndex;
+  uvec2 texel;
+  uint code;
+  float distance;
+};
+
+VffHit vffIntersect(vec3 origin, vec3 direction, float tmin, float tmax, float intraBias) {
+  VffHit o;
+  o.hit = false;
+  o.inside = false;
+  o.t = uintBitsToFloat(0x7f800000u);
+  o.looked = false;
+  o.sampleIndex = 0u;
+  o.texel = uvec2(0u);
+  o.code = 0u;
+  o.distance = 0.0;
+  precise float len = vffSqrt(vffDot(direction, direction));
+  if (!(len > 0.0) || isinf(len) || isnan(len)) return o;
+  precise float invLen = vffDivide(1.0, len);
+  precise vec3 w = direction * invLen;
+  precise float lo = tmin * len;
+  precise float hi = tmax * len;
+  // 1. The sphere.
+  vec3 c = vffField.sphereCenter;
+  float R = vffField.sphereRadius;
+  precise vec3 delta = origin - c;
+  precise float beta = vffDot(delta, w);
+  precise float gamma = vffDot(delta, delta) - R * R;
+  precise float disc = beta * beta - gamma;
+  if (!(disc >= 0.0)) return o;
+  precise float sq = vffSqrt(disc);
+  precise float t1 = -beta + sq;
+  if (t1 < 0.0) return o;
+  bool inside = gamma <= 0.0;
+  // From inside, the reversed ray enters at the exit point and looks back at the origin.
+  precise float t0 = inside ? t1 : max(-beta - sq, 0.0);
+  precise vec3 e = origin + w * t0;
+  vec3 v = inside ? -w : w;
+  if (inside) {
+    if (vffField.distanceEncoding == VFF_ENCODING_BIT1) return o;  // no distances: cannot tell
+    precise float bias = (intraBias >= 0.0 ? intraBias : vffField.intraBias) * R;
+    lo = max(lo, bias);
+  }
+  // 2. The nearest sample, 3. the texel, 4. the decode.
+  precise vec3 eu = (e - c) * vffField.invRadius;
+  int k = vffNearestSample(eu);
+  vec3 ek = vffPosition(k);
+  mat3 F = vffFrame(-ek);
+  vec3 l = vffToLocal(F, v);
+  vec2 uv = vffHemisphereToSquare(vffField.directionScheme, l);
+  uvec2 ij = uvec2(vffSquareToTexel(uv, int(vffField.mapResolution)));
+  uint code = vffFetchCode(uint(k), ij);
+  VffTexel s = vffDecode(code, ij);
+  o.looked = true;
+  o.sampleIndex = uint(k);
+  o.texel = ij;
+  o.code = code;
+  o.distance = s.distance;
+  if (!s.hit) return o;
+  // 5. The result.
+  precise float t = inside ? t0 - s.distance : t0 + s.distance;
+  if (t < lo || t > hi) return o;
+  o.hit = true;
+  o.inside = inside;
+  o.t = vffDivide(t, len);
+  return o;
+}
+
+bool vffOccluded(vec3 origin, vec3 direction, float tmin, float tmax, float intraBias) {
+  return vffIntersect(origin, direction, tmin, tmax, intraBias).hit;
+}
+
+#endif  // VFF_QUERY_GLSL

@@ -1,0 +1,18 @@
+// A headless OpenGL 4.3 core context through EGL (surfaceless Mesa platform, else an EGL device,
+// else the default display), for the GPU tests. On llvmpipe this runs without any GPU.
+#pragma once
+
+#include <string>
+
+namespace vff::test {
+
+struct HeadlessGl {
+  bool ok = false;
+  std::string error;     // why no context could be made (when !ok)
+  std::string renderer;  // GL_RENDERER and GL_VERSION (when ok)
+};
+
+// Makes (once per process) a GL 4.3 core context current on the calling thread.
+const HeadlessGl& headlessGl();
+
+}  // namespace vff::test

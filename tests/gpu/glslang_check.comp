@@ -1,0 +1,24 @@
+// Compile check of gpu/glsl/vff_query.glsl with glslangValidator (tests/gpu/CMakeLists.txt): the
+// same source is compiled for OpenGL (GLSL 4.30 core), OpenGL SPIR-V (-G) and Vulkan SPIR-V (-V),
+// with the include's default bindings (0, 1, 2, all in set 0) and this shader's buffers at 3 and 4.
+#version 430
+#extension GL_GOOGLE_include_directive : require
+#include "vff_query.glsl"
+
+layout(local_size_x = 64) in;
+
+struct VffCheckRay {
+  vec4 origin;     // xyz
+  vec4 direction;  // xyz
+  vec4 range;      // tmin, tmax, intraBias
+};
+layout(std430, binding = 3) readonly buffer VffCheckRays { VffCheckRay rays[]; };
+layout(std430, binding = 4) writeonly buffer VffCheckOut { vec4 results[]; };
+
+void main() {
+  uint id = gl_GlobalInvocationID.x;
+  if (id >= uint(rays.length())) return;
+  VffCheckRay r = rays[id];
+  VffHit h = vffIntersect(r.origin.xyz, r.direction.xyz, r.range.x, r.range.y, r.range.z);
+  results[id] = vec4(h.hit ? 1.0 : 0.0, h.t, float(h.sampleIndex), h.distance);
+}
