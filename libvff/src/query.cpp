@@ -110,7 +110,29 @@ struct FieldQuery::Impl {
   }
 
   void build();
+  // A query in two halves, so that a batch can fetch the texels of many rays at once: prepare()
+  // does everything up to the texel address (false: the ray misses, *out is final); nearestHit()
+  // decodes that texel.
+  struct Lookup {
+    Vec3 w, v, eu;
+    float len = 0, t0 = 0, sign = 1, lo = 0, hi = 0;
+    bool inside = false;
+    uint32_t k0 = 0, i = 0, j = 0;  // i, j: the nearest lookup's texel
+  };
+  bool prepare(const Ray& ray, const QueryOptions& o, Lookup* l) const noexcept;
+  QueryHit nearestHit(const Ray& ray, const Lookup& l, float* visibility) const noexcept;
+  QueryHit interpolated(const Ray& ray, const Lookup& l, float* visibility) const noexcept;
   QueryHit query(const Ray& ray, const QueryOptions& o, float* visibility) const noexcept;
+  template <class Emit>
+  void batchNearest(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept;
+  const uint8_t* texelAddress(const Lookup& l) const noexcept {
+    const size_t t = size_t(l.j) * m + l.i;
+    switch (field.distanceEncoding) {
+      case DistanceEncoding::kUnorm16Diameter: return dist[l.k0] + 2 * t;
+      case DistanceEncoding::kBit1: return dist[l.k0] + t / 8;
+      default: return dist[l.k0] + t;
+    }
+  }
 };
 
 namespace {
@@ -248,11 +270,9 @@ uint64_t FieldQuery::payloadBytes() const noexcept { return impl_ ? impl_->paylo
 
 // The core of every query. Distances below are object-space lengths along the unit direction w;
 // the caller's t is that length divided by |direction|.
-QueryHit FieldQuery::Impl::query(const Ray& ray, const QueryOptions& o, float* visibility) const noexcept {
-  QueryHit out;
-  if (visibility) *visibility = 1.0f;
+bool FieldQuery::Impl::prepare(const Ray& ray, const QueryOptions& o, Lookup* l) const noexcept {
   const float len = std::sqrt(dot(ray.direction, ray.direction));
-  if (!(len > 0) || !std::isfinite(len)) return out;
+  if (!(len > 0) || !std::isfinite(len)) return false;
   const Vec3 w = ray.direction * (1.0f / len);
   const float tmin = ray.tmin * len, tmax = ray.tmax * len;
   // 1. The sphere (section 7.2).
@@ -260,54 +280,71 @@ QueryHit FieldQuery::Impl::query(const Ray& ray, const QueryOptions& o, float* v
   const float beta = dot(delta, w);
   const float gamma = dot(delta, delta) - radius * radius;
   const float disc = beta * beta - gamma;
-  if (!(disc >= 0)) return out;
+  if (!(disc >= 0)) return false;
   const float sq = std::sqrt(disc);
   const float t1 = -beta + sq;
-  if (t1 < 0) return out;
+  if (t1 < 0) return false;
   const bool inside = gamma <= 0;
   // The lookup: the ray enters at `e` looking along `v`. From inside (section 7.3) the reversed
   // ray enters at the exit point, looking back at the origin.
-  float t0 = inside ? t1 : -beta - sq;  // parameter of the lookup's entry point along the ray
-  if (!inside) t0 = std::max(t0, 0.0f);
-  const Vec3 e = ray.origin + w * t0;
-  const Vec3 v = inside ? -w : w;
-  const float sign = inside ? -1.0f : 1.0f;  // t of a point at distance d from e along v: t0 + sign d
+  const float t0 = inside ? t1 : std::max(-beta - sq, 0.0f);  // the lookup's entry point along the ray
   // A hit counts when its t lies in [lo, hi]. From inside, the surface must also be more than the
   // bias in front of the origin (the origin's own surface is not an occluder).
   float lo = tmin;
   if (inside) {
-    if (field.distanceEncoding == DistanceEncoding::kBit1) return out;  // no distances: cannot tell
-    float bias = o.intraBias >= 0 ? o.intraBias : defaultBias;
-    bias *= radius;
-    lo = std::max(lo, bias);
+    if (field.distanceEncoding == DistanceEncoding::kBit1) return false;  // no distances: cannot tell
+    const float bias = o.intraBias >= 0 ? o.intraBias : defaultBias;
+    lo = std::max(lo, bias * radius);
   }
-  const float hi = tmax;
-  const Vec3 eu = (e - center) * (1.0f / radius);
-  const uint32_t k0 = nearestSample(eu);
+  if (!inside && t0 > tmax) return false;  // the sphere begins beyond the range
+  l->w = w;
+  l->len = len;
+  l->t0 = t0;
+  l->inside = inside;
+  l->v = inside ? -w : w;
+  l->sign = inside ? -1.0f : 1.0f;  // t of a point at distance d from the entry along v: t0 + sign d
+  l->lo = lo;
+  l->hi = tmax;
+  l->eu = (ray.origin + w * t0 - center) * (1.0f / radius);
+  l->k0 = nearestSample(l->eu);
+  const Vec3 local = toLocal(frames[l->k0], l->v);
+  squareToTexel(hemisphereToSquare(field.directionScheme, local), m, &l->i, &l->j);
+  return true;
+}
 
+QueryHit FieldQuery::Impl::nearestHit(const Ray& ray, const Lookup& l, float* visibility) const noexcept {
+  QueryHit out;
+  const Sample s = texel(l.k0, l.i, l.j);
+  if (!s.hit) return out;
+  const float t = l.t0 + l.sign * s.distance;
+  if (t < l.lo || t > l.hi) return out;
+  if (visibility) *visibility = 0.0f;
+  out.hit = true;
+  out.inside = l.inside;
+  out.t = t / l.len;
+  out.point = ray.origin + l.w * t;
+  if (!norm.empty()) {
+    out.normal = normalAt(l.k0, l.i, l.j);
+    out.hasNormal = true;
+  }
+  return out;
+}
+
+QueryHit FieldQuery::Impl::query(const Ray& ray, const QueryOptions& o, float* visibility) const noexcept {
+  if (visibility) *visibility = 1.0f;
+  Lookup l;
+  if (!prepare(ray, o, &l)) return {};
   // From inside, kInterpolated answers like kNearest: the blended samples' rays pass beside the
   // origin and take its own surface for an occluder (tests/query, intra-object occlusion).
-  if (o.reconstruction == Reconstruction::kNearest || inside) {
-    const Vec3 l = toLocal(frames[k0], v);
-    const Vec2 uv = hemisphereToSquare(field.directionScheme, l);
-    uint32_t i, j;
-    squareToTexel(uv, m, &i, &j);
-    const Sample s = texel(k0, i, j);
-    if (!s.hit) return out;
-    const float t = t0 + sign * s.distance;
-    if (t < lo || t > hi) return out;
-    if (visibility) *visibility = 0.0f;
-    out.hit = true;
-    out.inside = inside;
-    out.t = t / len;
-    out.point = ray.origin + w * t;
-    if (!norm.empty()) {
-      out.normal = normalAt(k0, i, j);
-      out.hasNormal = true;
-    }
-    return out;
-  }
+  if (o.reconstruction == Reconstruction::kNearest || l.inside) return nearestHit(ray, l, visibility);
+  return interpolated(ray, l, visibility);
+}
 
+QueryHit FieldQuery::Impl::interpolated(const Ray& ray, const Lookup& l, float* visibility) const noexcept {
+  QueryHit out;
+  const Vec3 w = l.w, v = l.v, eu = l.eu;
+  const float sign = l.sign, lo = l.lo, hi = l.hi, len = l.len;
+  const uint32_t k0 = l.k0;
   // Interpolated: the kernel's samples, each looked up along v from its own sample point
   // (parallel rays) with miss-aware bilinear weights; each hit point is projected onto the ray.
   auto kernel = [&](uint32_t k) {
@@ -333,9 +370,9 @@ QueryHit FieldQuery::Impl::query(const Ray& ray, const QueryOptions& o, float* v
     for (uint32_t c = 0; c < kc; ++c) {
       const uint32_t k = ks[c];
       const Vec3 p = samplePoint(k);
-      const Vec3 l = toLocal(frames[k], v);
-      if (l.z <= 0) continue;  // the sample does not see this direction
-      const Vec2 uv = hemisphereToSquare(field.directionScheme, l);
+      const Vec3 local = toLocal(frames[k], v);
+      if (local.z <= 0) continue;  // the sample does not see this direction
+      const Vec2 uv = hemisphereToSquare(field.directionScheme, local);
       const float x = (uv.x + 1.0f) * 0.5f * float(m) - 0.5f;
       const float y = (uv.y + 1.0f) * 0.5f * float(m) - 0.5f;
       const float fx0 = std::floor(x), fy0 = std::floor(y);
@@ -378,7 +415,7 @@ QueryHit FieldQuery::Impl::query(const Ray& ray, const QueryOptions& o, float* v
   if (b.hitWeight <= b.missWeight + b.farWeight) return out;
   const float t = b.tSum / b.hitWeight;
   out.hit = true;
-  out.inside = inside;
+  out.inside = l.inside;
   out.t = t / len;
   out.point = ray.origin + w * t;
   if (!norm.empty()) {
@@ -403,18 +440,52 @@ float FieldQuery::visibility(const Ray& ray, const QueryOptions& options) const 
   return v;
 }
 
+// Batches of nearest lookups run in groups: the first pass computes every ray's texel address and
+// asks the memory system for it, the second decodes. The scattered texel reads of a group then
+// overlap instead of waiting one after the other.
+template <class Emit>
+void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept {
+  constexpr size_t kGroup = 32;
+  Lookup l[kGroup];
+  bool live[kGroup];
+  for (size_t base = 0; base < rays.size(); base += kGroup) {
+    const size_t n = std::min(kGroup, rays.size() - base);
+    for (size_t r = 0; r < n; ++r) {
+      live[r] = prepare(rays[base + r], o, &l[r]);
+      if (live[r]) __builtin_prefetch(texelAddress(l[r]));
+    }
+    for (size_t r = 0; r < n; ++r) {
+      float vis = 1.0f;
+      const QueryHit h = live[r] ? nearestHit(rays[base + r], l[r], &vis) : QueryHit{};
+      emit(base + r, h, vis);
+    }
+  }
+}
+
 void FieldQuery::intersect(std::span<const Ray> rays, std::span<QueryHit> out, const QueryOptions& options) const noexcept {
   const size_t n = std::min(rays.size(), out.size());
+  if (impl_ && options.reconstruction == Reconstruction::kNearest) {
+    impl_->batchNearest(rays.first(n), options, [&](size_t r, const QueryHit& h, float) { out[r] = h; });
+    return;
+  }
   for (size_t r = 0; r < n; ++r) out[r] = intersect(rays[r], options);
 }
 
 void FieldQuery::occluded(std::span<const Ray> rays, std::span<uint8_t> out, const QueryOptions& options) const noexcept {
   const size_t n = std::min(rays.size(), out.size());
+  if (impl_ && options.reconstruction == Reconstruction::kNearest) {
+    impl_->batchNearest(rays.first(n), options, [&](size_t r, const QueryHit& h, float) { out[r] = h.hit ? 1 : 0; });
+    return;
+  }
   for (size_t r = 0; r < n; ++r) out[r] = occluded(rays[r], options) ? 1 : 0;
 }
 
 void FieldQuery::visibility(std::span<const Ray> rays, std::span<float> out, const QueryOptions& options) const noexcept {
   const size_t n = std::min(rays.size(), out.size());
+  if (impl_ && options.reconstruction == Reconstruction::kNearest) {
+    impl_->batchNearest(rays.first(n), options, [&](size_t r, const QueryHit&, float v) { out[r] = v; });
+    return;
+  }
   for (size_t r = 0; r < n; ++r) out[r] = visibility(rays[r], options);
 }
 
