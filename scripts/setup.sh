@@ -9,6 +9,7 @@ packages=(
   libopenmesh-dev libtinygltf-dev libcli11-dev libzstd-dev libxxhash-dev nlohmann-json3-dev
   libstb-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev glslang-tools
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
+  clang libclang-rt-14-dev
   glmark2-data zstd xz-utils python3
 )
 

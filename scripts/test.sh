@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Command 2: set up a fresh Debian 12 machine, build, and run the whole test suite:
 #   1. every ctest case of the Release build (unit, conformance, robustness, cli, bake, install ...);
-#   2. the library suites (unit, conformance, robustness, query) again under AddressSanitizer + UBSan.
+#   2. the library suites (unit, conformance, robustness, query) again under AddressSanitizer + UBSan;
+#   3. a short, reproducible burst of every libFuzzer target (scripts/fuzz.sh: fixed seed and runs).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"
@@ -18,3 +19,6 @@ echo "== AddressSanitizer + UndefinedBehaviorSanitizer"
 cmake --preset asan >/dev/null
 cmake --build --preset asan -j "$jobs" --target vff_unit_tests vff_conformance_tests vff_robustness_tests vff_query_tests
 ctest --preset asan -j "$jobs" -L 'unit|conformance|robustness|query'
+
+echo "== libFuzzer burst (Clang, ASan + UBSan)"
+bash scripts/fuzz.sh 5000

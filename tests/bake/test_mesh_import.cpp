@@ -137,6 +137,35 @@ TEST_F(MeshImport, BadInputsGetClearErrors) {
   EXPECT_FALSE(loadMesh(write("garbage.glb", std::string("\x01\x02\x03garbage", 10))).ok());
 }
 
+TEST_F(MeshImport, HostileObjAndPlyGetClearErrors) {
+  // Inputs that crash or hang OpenMesh 9 itself (found by tests/fuzz) are refused before it sees them.
+  struct Case {
+    const char* name;
+    const char* text;
+    const char* says;
+  };
+  const Case cases[] = {
+      {"oob.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "line 4: face index 9 refers to a vertex"},
+      {"neg.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", "face index -4"},
+      {"badnormal.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//2 3//1\n", "refers to a normal"},
+      {"token.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 elemen3//1 3\n", "is not v, v/vt"},
+      {"short.obj", "v 0 0 0\nv 1 0 0\nf 1 2\n", "at least three corners"},
+      {"noend.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n", "no end_header"},
+      {"keyword.ply", "ply\nformat ascii 1.0\nproper3 0 2 3\nend_header\n", "line 3: unknown PLY header keyword"},
+  };
+  for (const Case& c : cases) {
+    auto m = loadMesh(write(c.name, c.text));
+    ASSERT_FALSE(m.ok()) << c.name;
+    EXPECT_EQ(m.error().code, Code::kMeshParse) << c.name;
+    EXPECT_NE(m.error().message.find(c.name), std::string::npos) << m.error().message;
+    EXPECT_NE(m.error().message.find(c.says), std::string::npos) << m.error().message;
+  }
+  // Valid corner forms still load, negative (relative) indices included.
+  auto ok = loadMesh(write("forms.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf 1/1/1 2//1 -1/1\n"));
+  ASSERT_TRUE(ok.ok()) << ok.error().toString();
+  EXPECT_EQ(ok->triangleCount(), 1u);
+}
+
 TEST_F(MeshImport, NonFiniteVertexIsNamed) {
   std::string g = triangleGltf();
   auto m = loadMesh(write("ok.gltf", g));

@@ -3,9 +3,124 @@
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <OpenMesh/Core/System/omstream.hh>
 
+#include <fstream>
+#include <set>
+#include <vector>
+#include <sstream>
+#include <string>
+
 #include "mesh_importers.h"
 
 namespace vff::bake::detail {
+namespace {
+
+// OpenMesh's PLY reader loops forever on a header that never reaches `end_header` or holds an
+// unknown keyword (found by tests/fuzz, fuzz_mesh). The header is checked here first: the magic
+// line, then only the keywords of the PLY format, up to `end_header`, within 64 KiB.
+Status checkPlyHeader(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return makeError(Code::kIoOpen, path + ": cannot open");
+  std::string line;
+  uint64_t read = 0;
+  for (int n = 1; std::getline(in, line); ++n) {
+    read += line.size() + 1;
+    if (read > 65536) return makeError(Code::kMeshParse, path + ": PLY header longer than 64 KiB");
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream words(line);
+    std::string keyword;
+    words >> keyword;
+    if (n == 1) {
+      if (keyword != "ply") return makeError(Code::kMeshParse, path + ": line 1: not a PLY file (no 'ply' magic)");
+      continue;
+    }
+    if (keyword == "end_header") return {};
+    auto bad = [&](const std::string& why) {
+      return makeError(Code::kMeshParse, path + ": line " + std::to_string(n) + ": " + why);
+    };
+    std::vector<std::string> rest;
+    for (std::string w; words >> w;) rest.push_back(w);
+    static const std::set<std::string> kTypes = {"char",  "uchar", "short", "ushort", "int",     "uint",    "float",
+                                                 "double", "int8", "uint8", "int16",  "uint16",  "int32",   "uint32",
+                                                 "float32", "float64"};
+    auto isCount = [](const std::string& w) {
+      return !w.empty() && w.size() <= 10 && w.find_first_not_of("0123456789") == std::string::npos;
+    };
+    if (keyword == "comment" || keyword == "obj_info") continue;
+    if (keyword == "format") {
+      if (rest.size() != 2 || (rest[0] != "ascii" && rest[0] != "binary_little_endian" && rest[0] != "binary_big_endian"))
+        return bad("PLY format line is not 'format ascii|binary_little_endian|binary_big_endian VERSION'");
+    } else if (keyword == "element") {
+      if (rest.size() != 2 || !isCount(rest[1])) return bad("PLY element line is not 'element NAME COUNT'");
+    } else if (keyword == "property") {
+      const bool list = !rest.empty() && rest[0] == "list";
+      if (list ? (rest.size() != 4 || !kTypes.count(rest[1]) || !kTypes.count(rest[2]))
+               : (rest.size() != 2 || !kTypes.count(rest[0])))
+        return bad("PLY property line is not 'property TYPE NAME' or 'property list TYPE TYPE NAME'");
+    } else {
+      return bad("unknown PLY header keyword '" + keyword.substr(0, 32) + "'");
+    }
+  }
+  return makeError(Code::kMeshParse, path + ": PLY header has no end_header line");
+}
+
+// OpenMesh's OBJ reader writes through invalid handles when a face refers to a vertex or normal
+// that does not exist, or a face token is malformed (found by tests/fuzz, fuzz_mesh: a heap
+// overflow in set_normal). Every face token is checked first: v, v/vt, v//vn or v/vt/vn, integers,
+// each index within the elements declared before it (negative indices count back from there),
+// counting only the v/vt/vn lines whose numbers parse, as OpenMesh does.
+Status checkObjFaces(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return makeError(Code::kIoOpen, path + ": cannot open");
+  int64_t count[3] = {0, 0, 0};  // v, vt, vn so far
+  std::string line;
+  auto fail = [&](int64_t n, const std::string& why) {
+    return makeError(Code::kMeshParse, path + ": line " + std::to_string(n) + ": " + why);
+  };
+  for (int64_t n = 1; std::getline(in, line); ++n) {
+    std::istringstream words(line);
+    std::string keyword;
+    words >> keyword;
+    // Count the elements as OpenMesh does: a line whose numbers do not parse adds nothing.
+    float x = 0, y = 0, z = 0;
+    if (keyword == "v" && (words >> x >> y >> z)) ++count[0];
+    else if (keyword == "vt" && (words >> x >> y)) ++count[1];
+    else if (keyword == "vn" && (words >> x >> y >> z)) ++count[2];
+    if (keyword != "f") continue;
+    std::string token;
+    int corners = 0;
+    while (words >> token) {
+      ++corners;
+      size_t pos = 0;
+      for (int part = 0; part < 3 && pos <= token.size(); ++part) {
+        const size_t slash = token.find('/', pos);
+        const std::string field = token.substr(pos, slash == std::string::npos ? std::string::npos : slash - pos);
+        if (!field.empty() || part == 0) {
+          size_t used = 0;
+          long long index = 0;
+          try {
+            index = std::stoll(field, &used);
+          } catch (const std::exception&) {
+            return fail(n, "face corner '" + token.substr(0, 32) + "' is not v, v/vt, v//vn or v/vt/vn");
+          }
+          if (used != field.size())
+            return fail(n, "face corner '" + token.substr(0, 32) + "' is not v, v/vt, v//vn or v/vt/vn");
+          const int64_t resolved = index < 0 ? count[part] + index + 1 : index;
+          if (resolved < 1 || resolved > count[part])
+            return fail(n, "face index " + std::to_string(index) + " refers to a " +
+                               (part == 0 ? "vertex" : part == 1 ? "texture coordinate" : "normal") +
+                               " that does not exist (" + std::to_string(count[part]) + " so far)");
+        }
+        if (slash == std::string::npos) break;
+        pos = slash + 1;
+        if (part == 2) return fail(n, "face corner '" + token.substr(0, 32) + "' has more than three parts");
+      }
+    }
+    if (corners < 3) return fail(n, "a face needs at least three corners");
+  }
+  return {};
+}
+
+}  // namespace
 
 Result<Mesh> loadWithOpenMesh(const std::string& path, const std::string& ext) {
   using TriMesh = OpenMesh::TriMesh_ArrayKernelT<>;
@@ -13,6 +128,11 @@ Result<Mesh> loadWithOpenMesh(const std::string& path, const std::string& ext) {
   omerr().disable();
   omlog().disable();
   omout().disable();
+  if (ext == "ply") {
+    if (Status s = checkPlyHeader(path); !s) return s.error();
+  } else if (ext == "obj") {
+    if (Status s = checkObjFaces(path); !s) return s.error();
+  }
   TriMesh tm;
   tm.request_vertex_normals();
   OpenMesh::IO::Options opt = OpenMesh::IO::Options::VertexNormal;
