@@ -37,18 +37,22 @@ Status checkPlyHeader(const std::string& path) {
     auto bad = [&](const std::string& why) {
       return makeError(Code::kMeshParse, path + ": line " + std::to_string(n) + ": " + why);
     };
+    if (keyword == "comment" || keyword == "obj_info") continue;
     std::vector<std::string> rest;
     for (std::string w; words >> w;) rest.push_back(w);
+    for (const std::string& w : rest)
+      for (char ch : w)
+        if (ch < 0x21 || ch > 0x7e) return bad("PLY header holds a byte that is not printable ASCII");
     static const std::set<std::string> kTypes = {"char",  "uchar", "short", "ushort", "int",     "uint",    "float",
                                                  "double", "int8", "uint8", "int16",  "uint16",  "int32",   "uint32",
                                                  "float32", "float64"};
     auto isCount = [](const std::string& w) {
       return !w.empty() && w.size() <= 10 && w.find_first_not_of("0123456789") == std::string::npos;
     };
-    if (keyword == "comment" || keyword == "obj_info") continue;
     if (keyword == "format") {
-      if (rest.size() != 2 || (rest[0] != "ascii" && rest[0] != "binary_little_endian" && rest[0] != "binary_big_endian"))
-        return bad("PLY format line is not 'format ascii|binary_little_endian|binary_big_endian VERSION'");
+      if (rest.size() != 2 || (rest[0] != "ascii" && rest[0] != "binary_little_endian" && rest[0] != "binary_big_endian") ||
+          rest[1] != "1.0")
+        return bad("PLY format line is not 'format ascii|binary_little_endian|binary_big_endian 1.0'");
     } else if (keyword == "element") {
       if (rest.size() != 2 || !isCount(rest[1])) return bad("PLY element line is not 'element NAME COUNT'");
     } else if (keyword == "property") {
@@ -120,6 +124,77 @@ Status checkObjFaces(const std::string& path) {
   return {};
 }
 
+// OpenMesh's OFF reader trusts the counts it reads: a garbled face line can make it allocate
+// without bound (found by tests/fuzz, fuzz_mesh: out of memory). The file is checked first: the
+// "OFF" keyword (the variants with colours, normals or texture coordinates, and binary OFF, are
+// not supported), the counts, every vertex line (three numbers), every face line (a corner count
+// from 3 to 1024, then that many indices of existing vertices).
+Status checkOff(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return makeError(Code::kIoOpen, path + ": cannot open");
+  std::string line;
+  int64_t n = 0;
+  auto bad = [&](const std::string& why) {
+    return makeError(Code::kMeshParse, path + ": line " + std::to_string(n) + ": " + why);
+  };
+  // The next line that is not empty or a comment, split into words.
+  auto next = [&](std::vector<std::string>* words) {
+    while (std::getline(in, line)) {
+      ++n;
+      const size_t hash = line.find('#');
+      if (hash != std::string::npos) line.resize(hash);
+      std::istringstream ws(line);
+      words->clear();
+      for (std::string w; ws >> w;) words->push_back(w);
+      if (!words->empty()) return true;
+    }
+    return false;
+  };
+  auto integer = [](const std::string& w, int64_t lo, int64_t hi, int64_t* out) {
+    if (w.empty() || w.size() > 12 || w.find_first_not_of("0123456789") != std::string::npos) return false;
+    *out = std::stoll(w);
+    return *out >= lo && *out <= hi;
+  };
+  auto number = [](const std::string& w) {
+    std::istringstream ws(w);
+    float f = 0;
+    return bool(ws >> f) && ws.peek() == EOF;
+  };
+  std::vector<std::string> w;
+  if (!next(&w)) return makeError(Code::kMeshEmpty, path + ": empty OFF file");
+  if (w[0] != "OFF") {
+    if (w[0].size() > 3 && w[0].compare(w[0].size() - 3, 3, "OFF") == 0)
+      return makeError(Code::kMeshUnsupported, path + ": line " + std::to_string(n) + ": OFF variant '" +
+                                                   w[0].substr(0, 16) + "' is not supported (plain OFF only)");
+    return bad("not an OFF file (no 'OFF' keyword)");
+  }
+  if (w.size() > 1 && w[1] == "BINARY")
+    return makeError(Code::kMeshUnsupported, path + ": binary OFF is not supported");
+  std::vector<std::string> counts(w.begin() + 1, w.end());
+  if (counts.empty() && !next(&counts)) return bad("missing the vertex and face counts");
+  int64_t nv = 0, nf = 0, ne = 0;
+  constexpr int64_t kMax = 100000000;
+  if (counts.size() < 2 || !integer(counts[0], 0, kMax, &nv) || !integer(counts[1], 0, kMax, &nf) ||
+      (counts.size() > 2 && !integer(counts[2], 0, INT64_MAX / 2, &ne)))
+    return bad("the counts line is not 'VERTICES FACES EDGES' (non-negative integers up to 10^8)");
+  for (int64_t v = 0; v < nv; ++v) {
+    if (!next(&w)) return bad("the file ends after " + std::to_string(v) + " of " + std::to_string(nv) + " vertices");
+    if (w.size() < 3 || !number(w[0]) || !number(w[1]) || !number(w[2])) return bad("a vertex needs three numbers");
+  }
+  for (int64_t f = 0; f < nf; ++f) {
+    if (!next(&w)) return bad("the file ends after " + std::to_string(f) + " of " + std::to_string(nf) + " faces");
+    int64_t corners = 0;
+    if (!integer(w[0], 3, 1024, &corners)) return bad("a face must start with its corner count (3 to 1024)");
+    if (int64_t(w.size()) < 1 + corners) return bad("the face has fewer indices than its corner count");
+    for (int64_t c = 1; c <= corners; ++c) {
+      int64_t index = 0;
+      if (!integer(w[size_t(c)], 0, nv - 1, &index))
+        return bad("face index '" + w[size_t(c)].substr(0, 16) + "' is not a vertex (0 to " + std::to_string(nv - 1) + ")");
+    }
+  }
+  return {};
+}
+
 }  // namespace
 
 Result<Mesh> loadWithOpenMesh(const std::string& path, const std::string& ext) {
@@ -132,6 +207,8 @@ Result<Mesh> loadWithOpenMesh(const std::string& path, const std::string& ext) {
     if (Status s = checkPlyHeader(path); !s) return s.error();
   } else if (ext == "obj") {
     if (Status s = checkObjFaces(path); !s) return s.error();
+  } else if (ext == "off") {
+    if (Status s = checkOff(path); !s) return s.error();
   }
   TriMesh tm;
   tm.request_vertex_normals();
