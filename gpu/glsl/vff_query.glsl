@@ -13,7 +13,11 @@
 //                                               R8UI for unorm8-* and bit1, R16UI for unorm16-diameter
 //   binding VFF_POSITIONS_BINDING  (default 2): buffer VffPositionsBlock, the binary32 unit vectors
 //                                               of the samples (vff::PositionSet::position), one vec4
-//                                               each, then (unorm8-chord) the per-texel decode scales
+//                                               each, then (unorm8-chord) the per-texel decode scales,
+//                                               then the neighbour lists of kInterpolated
+//   binding VFF_NORMALS_BINDING    (default 3): the packed normal slices (oct-snorm16 as GL_RG16I),
+//                                               isampler2DArray (isampler3D); read only when the
+//                                               field has normals; define VFF_NO_NORMALS to omit it
 // The three bindings are distinct numbers, so the same declarations are valid for OpenGL (where
 // uniform blocks, texture units and storage blocks are separate namespaces) and for Vulkan (one
 // namespace per descriptor set, set 0).
@@ -23,6 +27,10 @@
 //     direction need not be unit length; t is in multiples of it (as vff::Ray). intraBias < 0
 //     selects the field's default (vff::defaultIntraBias), as vff::QueryOptions::intraBias.
 //   bool vffOccluded(...)  the same arguments; hit within [tmin, tmax].
+//   VffHit vffIntersectInterpolated(...)  Reconstruction::kInterpolated (the miss-aware blend).
+//   float vffVisibility(...)  kInterpolated FieldQuery::visibility: the unoccluded share in [0, 1].
+//   VffHit vffQuery(..., bool interpolated, out float visibility)  the core of all four.
+// A hit carries the object-space normal (hasNormal) when the field has a normal plane.
 // Building blocks (names as in spec/geometry.md 5.4 and spec/positions.md 6): vffFrame, vffToLocal,
 // vffHemisphereToSquare, vffSquareToHemisphere, vffSquareToTexel, vffTexelCenter, vffNearestSample,
 // vffFetchCode, vffDecode.
@@ -44,10 +52,13 @@
 #ifndef VFF_POSITIONS_BINDING
 #define VFF_POSITIONS_BINDING 2
 #endif
+#ifndef VFF_NORMALS_BINDING
+#define VFF_NORMALS_BINDING 3
+#endif
 
 // ---- Resources -----------------------------------------------------------------------------------
 // Field and layout: the FDSC and LAYT fields (spec/format.md sections 5 and 6) plus three values the
-// loader derives exactly as the CPU does. Must match vff::gl::FieldBlock (96 bytes).
+// loader derives exactly as the CPU does. Must match vff::gl::FieldBlock (112 bytes).
 layout(std140, binding = VFF_FIELD_BINDING) uniform VffFieldBlock {
   vec3 sphereCenter;        // sphere.center
   float sphereRadius;       // sphere.radius
@@ -71,18 +82,30 @@ layout(std140, binding = VFF_FIELD_BINDING) uniform VffFieldBlock {
   float distanceScale;      // unorm8/16-diameter: 2R / 254 or 2R / 65534 (float, as the CPU)
   float invRadius;          // 1 / R (float, as the CPU)
   float twoRadius;          // 2 R
+  uint neighbourOffset;     // vec4 index of the neighbour lists in vffPositions (kInterpolated)
+  float kernelRadius2;      // squared chord radius of the kInterpolated kernel (as the CPU)
+  uint reserved0;
+  uint reserved1;
 } vffField;
 
 #ifdef VFF_MAPS_3D
 layout(binding = VFF_MAPS_BINDING) uniform highp usampler3D vffMaps;
+#ifndef VFF_NO_NORMALS
+layout(binding = VFF_NORMALS_BINDING) uniform highp isampler3D vffNormals;
+#endif
 #else
 layout(binding = VFF_MAPS_BINDING) uniform highp usampler2DArray vffMaps;
+#ifndef VFF_NO_NORMALS
+layout(binding = VFF_NORMALS_BINDING) uniform highp isampler2DArray vffNormals;
+#endif
 #endif
 
 // vffPositions[k], k < mapCount: xyz = the outward unit vector of sample k (binary32), w = 0.
 // For unorm8-chord it continues with the decode scale of every texel of a map, 2R cos(alpha) / 254
 // with cos(alpha) of the texel centre, computed by the CPU exactly as the CPU query does: texel
-// t = j M + i is component t % 4 of vffPositions[mapCount + t / 4].
+// t = j M + i is component t % 4 of vffPositions[mapCount + t / 4]. From vec4 index
+// vffField.neighbourOffset: the neighbour lists of kInterpolated, 8 sample indices per map (two
+// vec4, as floats; -1 pads), the lists the CPU query builds.
 layout(std430, binding = VFF_POSITIONS_BINDING) readonly buffer VffPositionsBlock {
   vec4 vffPositions[];
 };
@@ -314,16 +337,49 @@ int vffNearestSample(vec3 d) {
 }
 
 // ---- Fetch and decode (spec/format.md "Packed slice layout", "Value encodings") ----------------------
-// The stored code of texel (i, j) of map k: placeMap, then texelFetch in the packed slices.
-uint vffFetchCode(uint k, uvec2 ij) {
+// Where texel (i, j) of map k lies in the packed slices (placeMap): x, y, slice.
+uvec3 vffPlace(uint k, uvec2 ij) {
   uint perSlice = vffField.tilesPerRow * vffField.tilesPerColumn;
   uint slice = k / perSlice;
   uint r = k - slice * perSlice;
   uint x = (r % vffField.tilesPerRow) * vffField.tileSize + vffField.gutter + ij.x;
   uint y = (r / vffField.tilesPerRow) * vffField.tileSize + vffField.gutter + ij.y;
+  return uvec3(x, y, slice);
+}
+
+// The stored code of texel (i, j) of map k: placeMap, then texelFetch in the packed slices.
+uint vffFetchCode(uint k, uvec2 ij) {
+  uvec3 p = vffPlace(k, ij);
   if (vffField.distanceEncoding == VFF_ENCODING_BIT1)
-    return (texelFetch(vffMaps, ivec3(int(x >> 3u), int(y), int(slice)), 0).r >> (x & 7u)) & 1u;
-  return texelFetch(vffMaps, ivec3(int(x), int(y), int(slice)), 0).r;
+    return (texelFetch(vffMaps, ivec3(int(p.x >> 3u), int(p.y), int(p.z)), 0).r >> (p.x & 7u)) & 1u;
+  return texelFetch(vffMaps, ivec3(p), 0).r;
+}
+
+// oct-snorm16 (spec/format.md 7.3) as vff::decodeNormal: X / 32767 clamped to -1, the octahedral
+// unfold, then v / |v|, with correctly rounded division and square root.
+vec3 vffDecodeNormal(ivec2 c) {
+  precise float px = max(vffDivide(float(c.x), 32767.0), -1.0);
+  precise float py = max(vffDivide(float(c.y), 32767.0), -1.0);
+  precise float pz = 1.0 - abs(px) - abs(py);
+  precise vec3 n = vec3(px, py, pz);
+  if (n.z < 0.0) {
+    precise float ox = (1.0 - abs(n.y)) * (n.x >= 0.0 ? 1.0 : -1.0);
+    precise float oy = (1.0 - abs(n.x)) * (n.y >= 0.0 ? 1.0 : -1.0);
+    n.x = ox;
+    n.y = oy;
+  }
+  precise float len = vffSqrt(vffDot(n, n));
+  return vec3(vffDivide(n.x, len), vffDivide(n.y, len), vffDivide(n.z, len));
+}
+
+// The object-space unit normal stored for texel (i, j) of map k (the field must have a normal
+// plane; define VFF_NO_NORMALS to leave the normal texture out of the shader).
+vec3 vffFetchNormal(uint k, uvec2 ij) {
+#ifdef VFF_NO_NORMALS
+  return vec3(0.0);
+#else
+  return vffDecodeNormal(texelFetch(vffNormals, ivec3(vffPlace(k, ij)), 0).rg);
+#endif
 }
 
 // A decoded texel: hit, and the distance from the sample point (0 for bit1).
@@ -356,13 +412,16 @@ VffTexel vffDecode(uint code, uvec2 ij) {
   return o;
 }
 
-// ---- The ray query (spec/geometry.md 7.2, 7.3; vff::FieldQuery::intersect, kNearest) --------------
+// ---- The ray query (spec/geometry.md 7.2, 7.3; vff::FieldQuery, kNearest and kInterpolated) ------
 struct VffHit {
   bool hit;       // the ray hits the object with t in [tmin, tmax]
   bool inside;    // the origin was inside the bounding sphere (the reversed-ray test of 7.3)
   float t;        // along the ray, in multiples of its direction; +inf without a hit
+  vec3 normal;    // object-space unit surface normal at the hit, when hasNormal
+  bool hasNormal; // the field has a normal plane (normalEncoding != 0) and the ray hit
   // The lookup that answered the ray (valid when looked): sample, texel, stored code and its
   // decoded distance from the sample's entry point. Useful for debugging and for the tests.
+  // kInterpolated: the nearest sample only (texel, code and distance are 0).
   bool looked;
   uint sampleIndex;
   uvec2 texel;
@@ -370,16 +429,31 @@ struct VffHit {
   float distance;
 };
 
-VffHit vffIntersect(vec3 origin, vec3 direction, float tmin, float tmax, float intraBias) {
+// The kInterpolated kernel weight of sample k for the unit entry point eu (as the CPU).
+float vffKernel(vec3 eu, uint k) {
+  precise vec3 d = eu - vffPosition(int(k));
+  precise float x = 1.0 - vffDivide(vffDot(d, d), vffField.kernelRadius2);
+  precise float w = x * x;
+  return x > 0.0 ? w : 0.0;
+}
+
+// The core of every query, as vff::FieldQuery::Impl::query. `visibility` receives the unoccluded
+// share: 0 or 1 for kNearest (interpolated == false), the misses' and far hits' share of the blend
+// weight for kInterpolated. Rays from inside the sphere are answered as kNearest in both modes.
+VffHit vffQuery(vec3 origin, vec3 direction, float tmin, float tmax, float intraBias, bool interpolated,
+                out float visibility) {
   VffHit o;
   o.hit = false;
   o.inside = false;
   o.t = uintBitsToFloat(0x7f800000u);
+  o.normal = vec3(0.0);
+  o.hasNormal = false;
   o.looked = false;
   o.sampleIndex = 0u;
   o.texel = uvec2(0u);
   o.code = 0u;
   o.distance = 0.0;
+  visibility = 1.0;
   precise float len = vffSqrt(vffDot(direction, direction));
   if (!(len > 0.0) || isinf(len) || isnan(len)) return o;
   precise float invLen = vffDivide(1.0, len);
@@ -407,33 +481,143 @@ VffHit vffIntersect(vec3 origin, vec3 direction, float tmin, float tmax, float i
     precise float bias = (intraBias >= 0.0 ? intraBias : vffField.intraBias) * R;
     lo = max(lo, bias);
   }
+#ifdef VFF_NO_NORMALS
+  bool normals = false;
+#else
+  bool normals = vffField.normalEncoding != 0u;
+#endif
   // 2. The nearest sample, 3. the texel, 4. the decode.
   precise vec3 eu = (e - c) * vffField.invRadius;
   int k = vffNearestSample(eu);
-  vec3 ek = vffPosition(k);
-  mat3 F = vffFrame(-ek);
-  vec3 l = vffToLocal(F, v);
-  vec2 uv = vffHemisphereToSquare(vffField.directionScheme, l);
-  uvec2 ij = uvec2(vffSquareToTexel(uv, int(vffField.mapResolution)));
-  uint code = vffFetchCode(uint(k), ij);
-  VffTexel s = vffDecode(code, ij);
+  int M = int(vffField.mapResolution);
   o.looked = true;
   o.sampleIndex = uint(k);
-  o.texel = ij;
-  o.code = code;
-  o.distance = s.distance;
-  if (!s.hit) return o;
-  // 5. The result.
-  precise float t = inside ? t0 - s.distance : t0 + s.distance;
-  if (t < lo || t > hi) return o;
+  if (!interpolated || inside) {
+    vec3 ek = vffPosition(k);
+    mat3 F = vffFrame(-ek);
+    vec3 l = vffToLocal(F, v);
+    vec2 uv = vffHemisphereToSquare(vffField.directionScheme, l);
+    uvec2 ij = uvec2(vffSquareToTexel(uv, M));
+    uint code = vffFetchCode(uint(k), ij);
+    VffTexel s = vffDecode(code, ij);
+    o.texel = ij;
+    o.code = code;
+    o.distance = s.distance;
+    if (!s.hit) return o;
+    // 5. The result.
+    precise float t = inside ? t0 - s.distance : t0 + s.distance;
+    if (t < lo || t > hi) return o;
+    visibility = 0.0;
+    o.hit = true;
+    o.inside = inside;
+    o.t = vffDivide(t, len);
+    if (normals) {
+      o.normal = vffFetchNormal(uint(k), ij);
+      o.hasNormal = true;
+    }
+    return o;
+  }
+  // kInterpolated (from outside). The sphere begins beyond the range: nothing can occlude (the CPU
+  // query returns before any lookup; for kNearest the texel's hit would lie beyond tmax anyway).
+  if (t0 > hi) return o;
+  // kInterpolated: the kernel's samples (the nearest and its neighbours within the kernel), each
+  // looked up along v from its own sample point with miss-aware bilinear weights; every hit point
+  // is projected onto the ray. Hits and misses are summed separately (FieldQuery::Impl::query).
+  uint ks[9];
+  float kw[9];
+  uint kc = 1u;
+  ks[0] = uint(k);
+  kw[0] = max(vffKernel(eu, uint(k)), 1e-6);  // the nearest sample always contributes
+  uint nbase = vffField.neighbourOffset + 2u * uint(k);
+  for (uint q = 0u; q < 8u; ++q) {
+    float f = vffPositions[nbase + q / 4u][q % 4u];
+    if (f < 0.0) break;
+    uint nk = uint(f);
+    float wk = vffKernel(eu, nk);
+    if (wk > 0.0) {
+      ks[kc] = nk;
+      kw[kc] = wk;
+      ++kc;
+    }
+  }
+  precise float hitW = 0.0, missW = 0.0, farW = 0.0, tSum = 0.0;
+  precise vec3 nSum = vec3(0.0);
+  for (uint q = 0u; q < kc; ++q) {
+    uint kk = ks[q];
+    vec3 uk = vffPosition(int(kk));
+    precise vec3 p = c + uk * R;
+    vec3 l = vffToLocal(vffFrame(-uk), v);
+    if (l.z <= 0.0) continue;  // the sample does not see this direction
+    vec2 uv = vffHemisphereToSquare(vffField.directionScheme, l);
+    precise float x = (uv.x + 1.0) * 0.5 * float(M) - 0.5;
+    precise float y = (uv.y + 1.0) * 0.5 * float(M) - 0.5;
+    precise float fx0 = floor(x), fy0 = floor(y);
+    precise float fx = x - fx0, fy = y - fy0;
+    int ix = int(fx0), iy = int(fy0);
+    precise float base = vffDot(p - origin, w);  // t of the sample point, projected on the ray
+    for (int dj = 0; dj < 2; ++dj) {
+      for (int di = 0; di < 2; ++di) {
+        precise float bw = kw[q] * (di != 0 ? fx : 1.0 - fx) * (dj != 0 ? fy : 1.0 - fy);
+        if (bw <= 0.0) continue;
+        uvec2 tij = uvec2(clamp(ivec2(ix + di, iy + dj), ivec2(0), ivec2(M - 1)));
+        VffTexel s = vffDecode(vffFetchCode(kk, tij), tij);
+        if (!s.hit) {
+          missW += bw;
+          continue;
+        }
+        precise float t = base + s.distance;  // along v = w from outside (t per unit distance: 1)
+        if (t > hi) {
+          farW += bw;
+        } else if (t >= lo) {
+          hitW += bw;
+          tSum += bw * t;
+          if (normals) nSum = nSum + vffFetchNormal(kk, tij) * bw;
+        }
+        // t < lo: a hit before the range, neither an occluder nor a miss
+      }
+    }
+  }
+  precise float open = missW + farW;
+  precise float total = hitW + open;
+  if (!(total > 0.0)) return o;
+  visibility = vffDivide(open, total);
+  if (hitW <= open) return o;
+  precise float t = vffDivide(tSum, hitW);
   o.hit = true;
-  o.inside = inside;
   o.t = vffDivide(t, len);
+  if (normals) {
+    precise float nl = vffSqrt(vffDot(nSum, nSum));
+    if (nl > 0.0) {
+      precise vec3 n = nSum * vffDivide(1.0, nl);  // the CPU's normalize: times the reciprocal
+      o.normal = n;
+      o.hasNormal = vffDot(n, n) > 0.0;
+    }
+  }
   return o;
 }
 
+// vff::FieldQuery::intersect with Reconstruction::kNearest (the paper's lookup).
+VffHit vffIntersect(vec3 origin, vec3 direction, float tmin, float tmax, float intraBias) {
+  float v;
+  return vffQuery(origin, direction, tmin, tmax, intraBias, false, v);
+}
+
+// vff::FieldQuery::intersect with Reconstruction::kInterpolated.
+VffHit vffIntersectInterpolated(vec3 origin, vec3 direction, float tmin, float tmax, float intraBias) {
+  float v;
+  return vffQuery(origin, direction, tmin, tmax, intraBias, true, v);
+}
+
+// kNearest occluded(): a hit within [tmin, tmax].
 bool vffOccluded(vec3 origin, vec3 direction, float tmin, float tmax, float intraBias) {
   return vffIntersect(origin, direction, tmin, tmax, intraBias).hit;
+}
+
+// vff::FieldQuery::visibility with Reconstruction::kInterpolated: the unoccluded share in [0, 1].
+float vffVisibility(vec3 origin, vec3 direction, float tmin, float tmax, float intraBias) {
+  float v;
+  vffQuery(origin, direction, tmin, tmax, intraBias, true, v);
+  return v;
 }
 
 #endif  // VFF_QUERY_GLSL

@@ -54,7 +54,7 @@ struct FieldQuery::Impl {
   std::vector<const uint8_t*> norm;  // per map, empty without normals
   std::vector<Vec3> unit;            // û_k, float
   std::vector<Frame> frames;         // frame of map k (inward normal)
-  static constexpr uint32_t kNeighbours = 8;
+  static constexpr uint32_t kNeighbours = kQueryNeighbours;
   std::vector<uint32_t> neighbours;  // kNeighbours per map; UINT32_MAX pads
   float spacing = 0;                 // mean angular spacing sqrt(4 pi / mapCount)
   float kernelRadius2 = 0;           // squared chord radius of the interpolation kernel
@@ -158,19 +158,27 @@ void FieldQuery::Impl::build() {
   const float r = 1.3f * spacing;
   kernelRadius2 = r * r;
   defaultBias = defaultIntraBias(field);
-  // Neighbours: the samples nearest to probe directions on two rings around each sample. This
-  // finds the samples whose Voronoi cells border the kernel around û_k in every scheme.
-  neighbours.assign(size_t(n) * kNeighbours, UINT32_MAX);
+  neighbours = queryNeighbours(positions);
+}
+
+std::vector<uint32_t> queryNeighbours(const PositionSet& positions) {
+  // The samples nearest to probe directions on two rings around each sample: this finds the
+  // samples whose Voronoi cells border the kernel around it, in every scheme.
+  const uint32_t n = positions.count();
+  std::vector<uint32_t> out(size_t(n) * kQueryNeighbours, UINT32_MAX);
+  if (n == 0) return out;
+  const float spacing = std::sqrt(4.0f * kPi / float(n));
   constexpr int kProbes = 12;
   for (uint32_t k = 0; k < n; ++k) {
-    uint32_t found[kNeighbours];
+    uint32_t found[kQueryNeighbours];
     uint32_t count = 0;
-    const Frame& f = frames[k];
+    const Vec3 u = positions.position(k);
+    const Frame f = positions.frame(k);
     for (float ring : {1.0f, 1.6f}) {
       const float a = ring * spacing;
-      for (int p = 0; p < kProbes && count < kNeighbours; ++p) {
+      for (int p = 0; p < kProbes && count < kQueryNeighbours; ++p) {
         const float phi = 2.0f * kPi * (float(p) + (ring > 1.2f ? 0.5f : 0.0f)) / kProbes;
-        const Vec3 d = unit[k] * std::cos(a) + (f.t * std::cos(phi) + f.b * std::sin(phi)) * std::sin(a);
+        const Vec3 d = u * std::cos(a) + (f.t * std::cos(phi) + f.b * std::sin(phi)) * std::sin(a);
         const uint32_t q = positions.nearest(d);
         if (q == k) continue;
         // An octa-hemi2 equator copy has the same position as its twin: keep one of them.
@@ -179,8 +187,9 @@ void FieldQuery::Impl::build() {
         if (!dup) found[count++] = q;
       }
     }
-    std::copy(found, found + count, neighbours.begin() + ptrdiff_t(size_t(k) * kNeighbours));
+    std::copy(found, found + count, out.begin() + ptrdiff_t(size_t(k) * kQueryNeighbours));
   }
+  return out;
 }
 
 float defaultIntraBias(const FieldDesc& field) noexcept {

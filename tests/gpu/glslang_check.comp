@@ -1,6 +1,6 @@
 // Compile check of gpu/glsl/vff_query.glsl with glslangValidator (tests/gpu/CMakeLists.txt): the
 // same source is compiled for OpenGL (GLSL 4.30 core), OpenGL SPIR-V (-G) and Vulkan SPIR-V (-V),
-// with the include's default bindings (0, 1, 2, all in set 0) and this shader's buffers at 3 and 4.
+// with the include's default bindings (0 to 3, all in set 0) and this shader's buffers at 5 and 6.
 #version 430
 #extension GL_GOOGLE_include_directive : require
 #include "vff_query.glsl"
@@ -12,8 +12,8 @@ struct VffCheckRay {
   vec4 direction;  // xyz
   vec4 range;      // tmin, tmax, intraBias
 };
-layout(std430, binding = 3) readonly buffer VffCheckRays { VffCheckRay rays[]; };
-layout(std430, binding = 4) writeonly buffer VffCheckOut { vec4 results[]; };
+layout(std430, binding = 5) readonly buffer VffCheckRays { VffCheckRay rays[]; };
+layout(std430, binding = 6) writeonly buffer VffCheckOut { vec4 results[]; };
 
 void main() {
   uint id = gl_GlobalInvocationID.x;

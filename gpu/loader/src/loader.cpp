@@ -3,6 +3,8 @@
 
 #include <GL/glcorearb.h>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
@@ -12,6 +14,8 @@
 
 namespace vff::gl {
 namespace {
+
+constexpr float kPi = 3.14159265358979323846f;
 
 std::string glErrorName(GLenum e) {
   switch (e) {
@@ -113,7 +117,17 @@ Result<FieldBlock> makeFieldBlock(const FieldDesc& field, const LayoutDesc& layo
   }
   b.invRadius = 1.0f / radius;
   b.twoRadius = 2.0f * radius;
+  // As FieldQuery::Impl::build.
+  const float spacing = std::sqrt(4.0f * kPi / float(field.mapCount));
+  const float r = 1.3f * spacing;
+  b.kernelRadius2 = r * r;
   return b;
+}
+
+Result<std::vector<uint32_t>> neighbourLists(const FieldDesc& field) {
+  auto ps = PositionSet::fromField(field);
+  if (!ps) return ps.error();
+  return queryNeighbours(*ps);
 }
 
 GpuField::GpuField(GpuField&& o) noexcept
@@ -122,6 +136,7 @@ GpuField::GpuField(GpuField&& o) noexcept
       mapsTarget_(std::exchange(o.mapsTarget_, 0)),
       fieldBuffer_(std::exchange(o.fieldBuffer_, 0)),
       positionsBuffer_(std::exchange(o.positionsBuffer_, 0)),
+      normalsTexture_(std::exchange(o.normalsTexture_, 0)),
       textureBytes_(std::exchange(o.textureBytes_, 0)) {}
 
 GpuField& GpuField::operator=(GpuField&& o) noexcept {
@@ -132,6 +147,7 @@ GpuField& GpuField::operator=(GpuField&& o) noexcept {
     mapsTarget_ = std::exchange(o.mapsTarget_, 0);
     fieldBuffer_ = std::exchange(o.fieldBuffer_, 0);
     positionsBuffer_ = std::exchange(o.positionsBuffer_, 0);
+    normalsTexture_ = std::exchange(o.normalsTexture_, 0);
     textureBytes_ = std::exchange(o.textureBytes_, 0);
   }
   return *this;
@@ -143,13 +159,18 @@ void GpuField::release() noexcept {
   if (mapsTexture_) glDeleteTextures(1, &mapsTexture_);
   if (fieldBuffer_) glDeleteBuffers(1, &fieldBuffer_);
   if (positionsBuffer_) glDeleteBuffers(1, &positionsBuffer_);
-  mapsTexture_ = fieldBuffer_ = positionsBuffer_ = mapsTarget_ = 0;
+  if (normalsTexture_) glDeleteTextures(1, &normalsTexture_);
+  mapsTexture_ = fieldBuffer_ = positionsBuffer_ = mapsTarget_ = normalsTexture_ = 0;
   textureBytes_ = 0;
 }
 
 void GpuField::bind(const Bindings& b) const noexcept {
   glBindBufferBase(GL_UNIFORM_BUFFER, b.field, fieldBuffer_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b.positions, positionsBuffer_);
+  if (normalsTexture_) {
+    glActiveTexture(GL_TEXTURE0 + b.normals);
+    glBindTexture(mapsTarget_ ? mapsTarget_ : GL_TEXTURE_2D_ARRAY, normalsTexture_);
+  }
   glActiveTexture(GL_TEXTURE0 + b.maps);
   glBindTexture(mapsTarget_ ? mapsTarget_ : GL_TEXTURE_2D_ARRAY, mapsTexture_);
 }
@@ -229,7 +250,36 @@ Result<GpuField> loadField(const File& file, const LoadOptions& options) {
     out.textureBytes_ += sliceBytes;
   }
 
-  // The field block.
+  // The normal plane: the same layout, two snorm16 per texel as GL_RG16I.
+  if (file.hasNormals()) {
+    if (field.normalEncoding != NormalEncoding::kOctSnorm16)
+      return makeError(Code::kUnsupported, "vff_gl cannot upload this normal encoding");
+    const uint64_t normalBytes = file.sliceBytes(Plane::kNormal);
+    if (normalBytes != uint64_t(layout.sliceWidth) * layout.sliceHeight * 4)
+      return makeError(Code::kUnsupported, "unexpected normal slice size " + std::to_string(normalBytes) + " bytes");
+    glGenTextures(1, &out.normalsTexture_);
+    glBindTexture(out.mapsTarget_, out.normalsTexture_);
+    glTexParameteri(out.mapsTarget_, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(out.mapsTarget_, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(out.mapsTarget_, GL_TEXTURE_BASE_LEVEL, 0);
+    glTexParameteri(out.mapsTarget_, GL_TEXTURE_MAX_LEVEL, 0);
+    glTexStorage3D(out.mapsTarget_, 1, GL_RG16I, GLsizei(layout.sliceWidth), GLsizei(layout.sliceHeight),
+                   GLsizei(layout.sliceCount));
+    if (Status s = checkGl("glTexStorage3D (normals)"); !s) return s.error();
+    std::vector<uint8_t> nslice(normalBytes);
+    for (uint32_t s = 0; s < layout.sliceCount; ++s) {
+      if (Status st = file.readSlice(Plane::kNormal, s, nslice); !st) return st.error();
+      glTexSubImage3D(out.mapsTarget_, 0, 0, 0, GLint(s), GLsizei(layout.sliceWidth), GLsizei(layout.sliceHeight), 1,
+                      GL_RG_INTEGER, GL_SHORT, nslice.data());
+      if (Status st = checkGl("glTexSubImage3D (normals)"); !st) return st.error();
+      out.textureBytes_ += normalBytes;
+    }
+  }
+
+  // The field block (with where the neighbour lists start in the positions buffer).
+  const bool chordTable = field.distanceEncoding == DistanceEncoding::kUnorm8Chord;
+  const size_t mapTexels = size_t(field.mapResolution) * field.mapResolution;
+  out.block_.neighbourOffset = uint32_t(field.mapCount + (chordTable ? (mapTexels + 3) / 4 : 0));
   glGenBuffers(1, &out.fieldBuffer_);
   glBindBuffer(GL_UNIFORM_BUFFER, out.fieldBuffer_);
   glBufferData(GL_UNIFORM_BUFFER, sizeof(FieldBlock), &out.block_, GL_STATIC_DRAW);
@@ -239,8 +289,7 @@ Result<GpuField> loadField(const File& file, const LoadOptions& options) {
   auto ps = PositionSet::fromField(field);
   if (!ps) return ps.error();
   const bool chord = field.distanceEncoding == DistanceEncoding::kUnorm8Chord;
-  const size_t texels = size_t(field.mapResolution) * field.mapResolution;
-  std::vector<float> positions(size_t(field.mapCount) * 4 + (chord ? (texels + 3) / 4 * 4 : 0), 0.0f);
+  std::vector<float> positions(size_t(out.block_.neighbourOffset) * 4 + size_t(field.mapCount) * kNeighbours, 0.0f);
   if (chord) {
     // The decode scale of every texel, as libvff/src/query.cpp computes it.
     float* scale = positions.data() + size_t(field.mapCount) * 4;
@@ -257,6 +306,12 @@ Result<GpuField> loadField(const File& file, const LoadOptions& options) {
     positions[4 * size_t(k) + 1] = u.y;
     positions[4 * size_t(k) + 2] = u.z;
   }
+  if (field.mapCount > (1u << 24))
+    return makeError(Code::kUnsupported, "vff_gl stores sample indices as binary32: at most 2^24 maps");
+  auto nb = neighbourLists(field);
+  if (!nb) return nb.error();
+  float* lists = positions.data() + size_t(out.block_.neighbourOffset) * 4;
+  for (size_t i = 0; i < nb->size(); ++i) lists[i] = (*nb)[i] == UINT32_MAX ? -1.0f : float((*nb)[i]);
   glGenBuffers(1, &out.positionsBuffer_);
   glBindBuffer(GL_SHADER_STORAGE_BUFFER, out.positionsBuffer_);
   glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(positions.size() * sizeof(float)), positions.data(),

@@ -44,6 +44,7 @@
 #include <limits>
 #include <memory>
 #include <span>
+#include <vector>
 
 #include "vff/direction.h"
 #include "vff/error.h"
@@ -82,6 +83,13 @@ struct QueryOptions {
 // the bunny: half a spacing gives RMS 8.9, one spacing 5.3, 1.5 spacings 3.9 but larger misses at
 // contacts.)
 float defaultIntraBias(const FieldDesc& field) noexcept;
+
+// The neighbour lists kInterpolated blends over: for every positional sample, up to
+// kQueryNeighbours other samples around it (the samples nearest to two rings of probe directions
+// at 1 and 1.6 mean spacings), padded with UINT32_MAX: mapCount * kQueryNeighbours entries. A GPU
+// port of kInterpolated uploads them (gpu/loader).
+inline constexpr uint32_t kQueryNeighbours = 8;
+std::vector<uint32_t> queryNeighbours(const PositionSet& positions);
 
 struct QueryHit {
   bool hit = false;

@@ -15,8 +15,12 @@
 // * a uniform buffer holding a FieldBlock (std140, the shader's VffFieldBlock);
 // * a shader storage buffer with the binary32 unit vector of every positional sample
 //   (vff::PositionSet::position), one vec4 each; for unorm8-chord followed by the decode scale
-//   2R cos(alpha) / 254 of every texel of a map (M * M floats, padded to a multiple of 4).
-// The normal plane is not uploaded (not implemented yet).
+//   2R cos(alpha) / 254 of every texel of a map (M * M floats, padded to a multiple of 4); then,
+//   from vec4 FieldBlock::neighbourOffset, the neighbour lists (neighbourLists below) as floats,
+//   two vec4 per map, -1 for padding (indices below 2^24 are exact in binary32);
+// * when the field has a normal plane (oct-snorm16): its packed slices, same layout and target as
+//   the distance slices, internal format GL_RG16I (the raw snorm16 pairs; the shader converts them
+//   exactly as vff::decodeNormal does, not through GL's snorm conversion).
 //
 // Preconditions: an OpenGL 4.3 (or later) context is current on the calling thread, for loadField
 // and for the GpuField's destructor. GL entry points come from GLVND's libOpenGL. loadField saves
@@ -32,9 +36,11 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "vff/error.h"
 #include "vff/format.h"
+#include "vff/query.h"
 #include "vff/reader.h"
 
 namespace vff::gl {
@@ -64,8 +70,22 @@ struct FieldBlock {
   float distanceScale = 0;  // 2R / 254 (unorm8-diameter), 2R / 65534 (unorm16-diameter), else 0
   float invRadius = 0;      // 1 / R
   float twoRadius = 0;      // 2 R
+  // Reconstruction::kInterpolated (libvff/src/query.cpp, FieldQuery::Impl::build): where the
+  // neighbour lists start in the positions buffer (in vec4 units), and the squared chord radius of
+  // the kernel, (1.3 sqrt(4 pi / mapCount))^2, computed with the CPU's float expressions.
+  uint32_t neighbourOffset = 0;
+  float kernelRadius2 = 0;
+  uint32_t reserved0 = 0, reserved1 = 0;
 };
-static_assert(sizeof(FieldBlock) == 96, "FieldBlock must match the std140 block");
+static_assert(sizeof(FieldBlock) == 112, "FieldBlock must match the std140 block");
+
+// The neighbour lists of Reconstruction::kInterpolated: kNeighbours indices per map (the samples
+// nearest to 12 probe directions on each of two rings, 1 and 1.6 mean spacings around the sample,
+// duplicates and the sample itself left out), UINT32_MAX padding; the same lists as the CPU query
+// uses (vff::queryNeighbours).
+// Errors: PositionSet::fromField's.
+inline constexpr uint32_t kNeighbours = kQueryNeighbours;
+Result<std::vector<uint32_t>> neighbourLists(const FieldDesc& field);
 
 // Fills the block from a field and its layout (no GL calls). Errors: checkFieldDesc's and
 // checkLayout's.
@@ -82,6 +102,7 @@ struct Bindings {
   uint32_t field = 0;      // uniform buffer binding (VFF_FIELD_BINDING)
   uint32_t maps = 1;       // texture unit (VFF_MAPS_BINDING)
   uint32_t positions = 2;  // shader storage buffer binding (VFF_POSITIONS_BINDING)
+  uint32_t normals = 3;    // texture unit (VFF_NORMALS_BINDING)
 };
 
 // A field on the GPU. Move-only; the destructor deletes the GL objects (the context must be current).
@@ -94,7 +115,8 @@ class GpuField {
   GpuField& operator=(const GpuField&) = delete;
   ~GpuField();
 
-  // Binds the three resources. Leaves the active texture unit at `maps`.
+  // Binds the resources (the normal texture only when the field has one). Leaves the active
+  // texture unit at `maps`.
   void bind(const Bindings& bindings = {}) const noexcept;
   // Deletes the GL objects now (the context must be current); the object becomes empty.
   void release() noexcept;
@@ -102,6 +124,7 @@ class GpuField {
   const FieldBlock& block() const noexcept { return block_; }
   uint32_t mapsTexture() const noexcept { return mapsTexture_; }  // GL texture name
   uint32_t mapsTarget() const noexcept { return mapsTarget_; }    // GL_TEXTURE_2D_ARRAY or GL_TEXTURE_3D
+  uint32_t normalsTexture() const noexcept { return normalsTexture_; }  // 0 without a normal plane
   uint32_t fieldBuffer() const noexcept { return fieldBuffer_; }
   uint32_t positionsBuffer() const noexcept { return positionsBuffer_; }
   uint64_t textureBytes() const noexcept { return textureBytes_; }  // bytes uploaded to the texture
@@ -109,7 +132,7 @@ class GpuField {
  private:
   friend Result<GpuField> loadField(const File& file, const LoadOptions& options);
   FieldBlock block_;
-  uint32_t mapsTexture_ = 0, mapsTarget_ = 0, fieldBuffer_ = 0, positionsBuffer_ = 0;
+  uint32_t mapsTexture_ = 0, mapsTarget_ = 0, fieldBuffer_ = 0, positionsBuffer_ = 0, normalsTexture_ = 0;
   uint64_t textureBytes_ = 0;
 };
 

@@ -1,0 +1,352 @@
+// vff-gpu-bench - field queries per second and the ground-AO render (the paper's Fig. 3 setting,
+// gpu/bench/ao_scene.h) on the GPU through gpu/glsl/vff_query.glsl, with the CPU FieldQuery on the
+// same rays in the same run as the baseline.
+//
+//   vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size 512] [--spp 256] [--threads N]
+//
+// Without --field it bakes MESH (default /usr/share/glmark2/models/bunny.obj, else the procedural
+// torus knot) as samples/experiments does: octa-hemi2 n = 32 (4226 maps), 64 x 64, unorm8-diameter.
+// Timings are wall clock around glDispatchCompute + glFinish (uploads excluded), the best of 2
+// runs; the CPU runs FieldQuery::occluded / visibility on --threads threads (default: all cores).
+// Exit codes: 0 ok, 1 usage, 2 I/O, 4 runtime (no GL context, shader or bake failure).
+#include <GL/glcorearb.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "../../tests/gpu/egl_context.h"
+#include "ao_scene.h"
+#include "vff/bake/baker.h"
+#include "vff/bake/mesh.h"
+#include "vff/bake/procedural.h"
+#include "vff/gl/loader.h"
+#include "vff/vff.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+
+std::string readText(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+GLuint buildProgram(const std::string& body, std::string* log) {
+  const std::string src = "#version 430\n#define VFF_NO_NORMALS\n" + readText(std::string(VFF_GLSL_DIR) + "/vff_query.glsl") + body;
+  const char* p = src.c_str();
+  GLuint sh = glCreateShader(GL_COMPUTE_SHADER);
+  glShaderSource(sh, 1, &p, nullptr);
+  glCompileShader(sh);
+  GLint ok = 0;
+  char buf[8192] = {};
+  glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    glGetShaderInfoLog(sh, sizeof(buf), nullptr, buf);
+    *log = buf;
+    return 0;
+  }
+  GLuint prog = glCreateProgram();
+  glAttachShader(prog, sh);
+  glLinkProgram(prog);
+  glDeleteShader(sh);
+  glGetProgramiv(prog, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    glGetProgramInfoLog(prog, sizeof(buf), nullptr, buf);
+    *log = buf;
+    glDeleteProgram(prog);
+    return 0;
+  }
+  return prog;
+}
+
+const char* kRayShader = R"(
+layout(local_size_x = 64) in;
+struct BenchRay { vec4 origin; vec4 direction; };  // origin.w = tmax
+layout(std430, binding = 5) readonly buffer BenchRays { BenchRay rays[]; };
+layout(std430, binding = 6) writeonly buffer BenchOut { float results[]; };
+layout(location = 0) uniform int interpolated;
+layout(location = 1) uniform uint firstRay;
+void main() {
+  uint id = gl_GlobalInvocationID.x + firstRay;
+  if (id >= uint(rays.length())) return;
+  BenchRay r = rays[id];
+  results[id] = interpolated != 0 ? vffVisibility(r.origin.xyz, r.direction.xyz, 0.0, r.origin.w, -1.0)
+                                  : (vffOccluded(r.origin.xyz, r.direction.xyz, 0.0, r.origin.w, -1.0) ? 0.0 : 1.0);
+}
+)";
+
+// CPU work split over threads.
+template <class Fn>
+void parallel(unsigned threads, size_t count, Fn&& fn) {
+  std::vector<std::thread> pool;
+  const size_t chunk = (count + threads - 1) / threads;
+  for (unsigned t = 0; t < threads; ++t) {
+    const size_t b = std::min(count, t * chunk), e = std::min(count, b + chunk);
+    pool.emplace_back([&, b, e] { fn(b, e); });
+  }
+  for (auto& th : pool) th.join();
+}
+
+int usage() {
+  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--threads N]\n");
+  return 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace vff;
+  std::string fieldPath, meshPath = "/usr/share/glmark2/models/bunny.obj";
+  int size = 512, spp = 256;
+  unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> const char* { return i + 1 < argc ? argv[++i] : nullptr; };
+    const char* v = nullptr;
+    if (a == "--help" || a == "-h") {
+      usage();
+      return 0;
+    } else if (a == "--field" && (v = next())) {
+      fieldPath = v;
+    } else if (a == "--mesh" && (v = next())) {
+      meshPath = v;
+    } else if (a == "--size" && (v = next())) {
+      size = std::atoi(v);
+    } else if (a == "--spp" && (v = next())) {
+      spp = std::atoi(v);
+    } else if (a == "--threads" && (v = next())) {
+      threads = unsigned(std::max(1, std::atoi(v)));
+    } else {
+      return usage();
+    }
+  }
+  if (size < 8 || size % 8 != 0 || spp < 1) {
+    std::fprintf(stderr, "vff-gpu-bench: --size must be a positive multiple of 8 and --spp positive\n");
+    return 1;
+  }
+  const test::HeadlessGl& gl = test::headlessGl();
+  if (!gl.ok) {
+    std::fprintf(stderr, "vff-gpu-bench: no headless OpenGL 4.3 context: %s\n", gl.error.c_str());
+    return 4;
+  }
+  std::printf("GPU: %s (GL_RENDERER: %s)\n", gl.renderer.c_str(), reinterpret_cast<const char*>(glGetString(GL_RENDERER)));
+  std::printf("CPU baseline: vff::FieldQuery on %u thread(s)\n", threads);
+
+  // The field, and the ground height (the mesh's lowest point).
+  Result<File> file = makeError(Code::kInvalidArgument, "no field");
+  float groundY = 0;
+  if (!fieldPath.empty()) {
+    file = File::open(fieldPath);
+    if (!file) {
+      std::fprintf(stderr, "vff-gpu-bench: %s\n", file.error().toString().c_str());
+      return 2;
+    }
+    groundY = file->field().sphere.center[1] - file->field().sphere.radius;
+    std::printf("field: %s\n", fieldPath.c_str());
+  } else {
+    bake::Mesh mesh;
+    std::string name = meshPath;
+    if (std::filesystem::exists(meshPath)) {
+      auto m = bake::loadMesh(meshPath);
+      if (!m) {
+        std::fprintf(stderr, "vff-gpu-bench: %s\n", m.error().toString().c_str());
+        return 2;
+      }
+      mesh = std::move(*m);
+    } else {
+      mesh = bake::makeShape("torus-knot");
+      name = "torus-knot (procedural; " + meshPath + " not found)";
+    }
+    groundY = INFINITY;
+    for (size_t v = 1; v < mesh.positions.size(); v += 3) groundY = std::min(groundY, mesh.positions[v]);
+    auto scene = bake::Scene::create(mesh);
+    if (!scene) {
+      std::fprintf(stderr, "vff-gpu-bench: %s\n", scene.error().toString().c_str());
+      return 4;
+    }
+    bake::BakeOptions bo;
+    bo.positionScheme = PositionScheme::kOctaHemi2;
+    bo.positionParam = 32;
+    bo.mapResolution = 64;
+    bo.encoding = DistanceEncoding::kUnorm8Diameter;
+    const auto t0 = Clock::now();
+    auto baked = bake::bakeField(*scene, bo);
+    if (!baked) {
+      std::fprintf(stderr, "vff-gpu-bench: %s\n", baked.error().toString().c_str());
+      return 4;
+    }
+    auto bytes = writeMemory(baked->field, baked->distance);
+    if (!bytes) {
+      std::fprintf(stderr, "vff-gpu-bench: %s\n", bytes.error().toString().c_str());
+      return 4;
+    }
+    file = File::openBuffer(std::move(*bytes));
+    std::printf("field: %s baked in %.1f s\n", name.c_str(), seconds(t0, Clock::now()));
+  }
+  if (!file) return 4;
+  const FieldDesc& f = file->field();
+  std::printf("  %u maps, %ux%u, distance encoding %u, R = %g\n", f.mapCount, f.mapResolution, f.mapResolution,
+              unsigned(f.distanceEncoding), double(f.sphere.radius));
+  auto gpu = gl::loadField(*file);
+  auto cpu = FieldQuery::fromFile(*file);
+  if (!gpu || !cpu) {
+    std::fprintf(stderr, "vff-gpu-bench: %s\n", (!gpu ? gpu.error() : cpu.error()).toString().c_str());
+    return 4;
+  }
+  if (file->layout().target == LayoutTarget::kTexture3D) {
+    std::fprintf(stderr, "vff-gpu-bench: 3D-texture layouts are not benchmarked\n");
+    return 4;
+  }
+  std::string log;
+  const GLuint rayProg = buildProgram(kRayShader, &log);
+  const GLuint aoProg = rayProg ? buildProgram(gpubench::kAoShader, &log) : 0;
+  if (!rayProg || !aoProg) {
+    std::fprintf(stderr, "vff-gpu-bench: shader: %s\n", log.c_str());
+    return 4;
+  }
+
+  // ---- Queries per second ----
+  const Vec3 c{f.sphere.center[0], f.sphere.center[1], f.sphere.center[2]};
+  const float R = f.sphere.radius;
+  std::printf("\nfield queries/s (random rays: origins 1.05-3 R from the centre towards points within 1.1 R, tmax 2 R;\n"
+              "GPU wall time around dispatch + glFinish, best of 2; CPU on %u thread(s))\n", threads);
+  std::printf("| rays | query | GPU rays/s | CPU rays/s | GPU/CPU |\n|---|---|---|---|---|\n");
+  for (int logN = 20; logN <= 22; ++logN) {
+    const size_t n = size_t(1) << logN;
+    std::mt19937_64 g{uint64_t(logN)};
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    auto dir = [&] {
+      const float z = 2 * u(g) - 1, phi = 6.2831853f * u(g);
+      const float r = std::sqrt(std::max(0.0f, 1 - z * z));
+      return Vec3{r * std::cos(phi), r * std::sin(phi), z};
+    };
+    std::vector<float> rayData(n * 8);
+    std::vector<Ray> rays(n);
+    for (size_t i = 0; i < n; ++i) {
+      const Vec3 a = dir(), b = dir();
+      const float s = R * (1.05f + 2.0f * u(g)), s2 = R * 1.1f * std::cbrt(u(g));
+      const Vec3 o{c.x + a.x * s, c.y + a.y * s, c.z + a.z * s};
+      const Vec3 d{c.x + b.x * s2 - o.x, c.y + b.y * s2 - o.y, c.z + b.z * s2 - o.z};
+      const float l = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+      const Vec3 w{d.x / l, d.y / l, d.z / l};
+      rays[i] = Ray{o, w, 0.0f, 2.0f * R};
+      float* r = &rayData[i * 8];
+      r[0] = o.x, r[1] = o.y, r[2] = o.z, r[3] = 2.0f * R, r[4] = w.x, r[5] = w.y, r[6] = w.z, r[7] = 0;
+    }
+    GLuint bufs[2];
+    glGenBuffers(2, bufs);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[0]);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(rayData.size() * 4), rayData.data(), GL_STATIC_DRAW);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(n * 4), nullptr, GL_STREAM_READ);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, bufs[0]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, bufs[1]);
+    gpu->bind();
+    glUseProgram(rayProg);
+    for (int interp = 0; interp < 2; ++interp) {
+      glUniform1i(0, interp);
+      double best = 1e30;
+      for (int rep = 0; rep < 2; ++rep) {
+        glFinish();
+        const auto t0 = Clock::now();
+        // At most 2^20 rays per dispatch (GL guarantees 65535 work groups per dimension).
+        for (size_t first = 0; first < n; first += size_t(1) << 20) {
+          glUniform1ui(1, GLuint(first));
+          glDispatchCompute(GLuint((std::min(n - first, size_t(1) << 20) + 63) / 64), 1, 1);
+        }
+        glFinish();
+        best = std::min(best, seconds(t0, Clock::now()));
+      }
+      std::vector<float> gres(n);
+      glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+      glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
+      glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(n * 4), gres.data());
+      std::vector<float> cres(n);
+      QueryOptions qo;
+      qo.reconstruction = interp ? Reconstruction::kInterpolated : Reconstruction::kNearest;
+      const auto c0 = Clock::now();
+      parallel(threads, n, [&](size_t b, size_t e) {
+        for (size_t i = b; i < e; ++i)
+          cres[i] = interp ? cpu->visibility(rays[i], qo) : (cpu->occluded(rays[i], qo) ? 0.0f : 1.0f);
+      });
+      const double cpuS = seconds(c0, Clock::now());
+      size_t differ = 0;
+      for (size_t i = 0; i < n; ++i) differ += std::fabs(gres[i] - cres[i]) > 1e-4f;
+      std::printf("| 2^%d | %s | %.3g | %.3g | %.2f |   (answers differing by > 1e-4: %zu)\n", logN,
+                  interp ? "interpolated visibility" : "nearest occluded", double(n) / best, double(n) / cpuS,
+                  cpuS / best, differ);
+      std::fflush(stdout);
+    }
+    glDeleteBuffers(2, bufs);
+  }
+
+  // ---- AO render ----
+  const gpubench::AoScene s = gpubench::makeAoScene(f, groundY, size);
+  GLuint bufs[3];
+  glGenBuffers(3, bufs);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[0]);
+  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(s.gbuffer.size() * 4), s.gbuffer.data(), GL_STATIC_DRAW);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
+  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(s.directions.size() * 4), s.directions.data(), GL_STATIC_DRAW);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[2]);
+  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(size_t(size) * size * 4), nullptr, GL_STREAM_READ);
+  for (int b = 0; b < 3; ++b) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, GLuint(5 + b), bufs[b]);
+  gpu->bind();
+  glUseProgram(aoProg);
+  std::printf("\nground AO %dx%d, %d rays/px (%.3g rays), tmax 2 R; GPU vs CPU image on the 8-bit scale\n", size, size,
+              spp, double(size) * size * spp);
+  std::printf("| query | GPU s | CPU s | GPU/CPU | max | RMS |\n|---|---|---|---|---|---|\n");
+  for (int interp = 0; interp < 2; ++interp) {
+    glUniform1i(0, size);
+    glUniform1i(1, spp);
+    glUniform1i(2, interp);
+    glUniform1f(3, s.eps);
+    glUniform1f(4, s.tmax);
+    // A warm-up dispatch (drivers such as llvmpipe compile the shader at its first use), then
+    // bands of 64 rows per dispatch (keeps single dispatches short on slow drivers).
+    glUniform1i(5, 0);
+    glDispatchCompute(1, 1, 1);
+    glFinish();
+    const auto t0 = Clock::now();
+    for (int row = 0; row < size; row += 64) {
+      glUniform1i(5, row);
+      glDispatchCompute(GLuint(size / 8), GLuint(std::min(64, size - row) / 8), 1);
+    }
+    glFinish();
+    const double gpuS = seconds(t0, Clock::now());
+    std::vector<float> g(size_t(size) * size);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[2]);
+    glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(g.size() * 4), g.data());
+    const auto c0 = Clock::now();
+    const std::vector<float> cimg =
+        gpubench::cpuAo(*cpu, s, spp, interp ? Reconstruction::kInterpolated : Reconstruction::kNearest, threads);
+    const double cpuS = seconds(c0, Clock::now());
+    const gpubench::AoDiff d = gpubench::compareAo(cimg, g);
+    std::printf("| %s | %.2f | %.2f | %.2f | %.0f | %.4f |\n", interp ? "interpolated visibility" : "nearest occluded", gpuS,
+                cpuS, cpuS / gpuS, d.max, d.rms);
+    std::fflush(stdout);
+  }
+  glDeleteBuffers(3, bufs);
+  glDeleteProgram(rayProg);
+  glDeleteProgram(aoProg);
+  if (glGetError() != GL_NO_ERROR) {
+    std::fprintf(stderr, "vff-gpu-bench: GL error\n");
+    return 4;
+  }
+  return 0;
+}

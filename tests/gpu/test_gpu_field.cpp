@@ -1,0 +1,417 @@
+// The GLSL normals, kInterpolated reconstruction and ground AO (gpu/glsl/vff_query.glsl,
+// gpu/bench/ao_scene.h) against the CPU query, on a headless EGL context.
+//
+// * Normals: for every ray where the GPU and FieldQuery::intersect (kNearest) both hit at the same
+//   t (within 1e-5 R), the GPU normal must be within 1e-5 of the CPU's (each component).
+// * kInterpolated: hit flags must agree except where the CPU's vote is within kVoteEps of a tie
+//   (visibility within kVoteEps of 0.5: hits and misses weigh the same up to rounding); t within
+//   kInterpT R and visibility within kInterpVis, everything else fails.
+// * AO: a 64 x 64 ground image, 64 rays per pixel, kNearest and kInterpolated, compared on the 8-bit
+//   scale with the CPU image computed from the same rays.
+#include <gtest/gtest.h>
+#include <GL/glcorearb.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "../../gpu/bench/ao_scene.h"
+#include "egl_context.h"
+#include "vff/bake/baker.h"
+#include "vff/bake/procedural.h"
+#include "vff/gl/loader.h"
+#include "vff/vff.h"
+
+namespace vff {
+namespace {
+
+constexpr double kNormalEps = 1e-5;
+constexpr double kVoteEps = 1e-4;
+constexpr double kInterpT = 1e-4;    // fraction of R
+constexpr double kInterpVis = 1e-4;
+
+#define VFF_REQUIRE_GL()                                                        \
+  do {                                                                          \
+    const test::HeadlessGl& gl_ = test::headlessGl();                           \
+    if (!gl_.ok) GTEST_SKIP() << "no headless OpenGL 4.3 context: " << gl_.error; \
+  } while (0)
+
+std::string readText(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+GLuint buildProgram(bool maps3D, const std::string& body) {
+  const std::string src = std::string("#version 430\n") + (maps3D ? "#define VFF_MAPS_3D\n" : "") +
+                          readText(std::string(VFF_GLSL_DIR) + "/vff_query.glsl") + body;
+  const char* p = src.c_str();
+  GLuint sh = glCreateShader(GL_COMPUTE_SHADER);
+  glShaderSource(sh, 1, &p, nullptr);
+  glCompileShader(sh);
+  GLint ok = 0;
+  glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
+  char log[8192] = {};
+  glGetShaderInfoLog(sh, sizeof(log), nullptr, log);
+  EXPECT_TRUE(ok) << log;
+  GLuint prog = glCreateProgram();
+  glAttachShader(prog, sh);
+  glLinkProgram(prog);
+  glDeleteShader(sh);
+  glGetProgramiv(prog, GL_LINK_STATUS, &ok);
+  EXPECT_TRUE(ok);
+  return ok ? prog : 0;
+}
+
+// One ray per invocation: both reconstructions.
+const char* kMain = R"(
+layout(local_size_x = 64) in;
+struct TestRay { vec4 origin; vec4 direction; vec4 range; };
+struct TestOut { vec4 nearest; vec4 nearestNormal; vec4 interp; vec4 interpNormal; };
+layout(std430, binding = 3) readonly buffer TestRays { TestRay rays[]; };
+layout(std430, binding = 4) writeonly buffer TestOuts { TestOut outs[]; };
+void main() {
+  uint id = gl_GlobalInvocationID.x;
+  if (id >= uint(rays.length())) return;
+  TestRay r = rays[id];
+  VffHit a = vffIntersect(r.origin.xyz, r.direction.xyz, r.range.x, r.range.y, r.range.z);
+  float vis;
+  VffHit b = vffQuery(r.origin.xyz, r.direction.xyz, r.range.x, r.range.y, r.range.z, true, vis);
+  TestOut o;
+  o.nearest = vec4(a.hit ? 1.0 : 0.0, a.t, a.hasNormal ? 1.0 : 0.0, 0.0);
+  o.nearestNormal = vec4(a.normal, 0.0);
+  o.interp = vec4(b.hit ? 1.0 : 0.0, b.t, b.hasNormal ? 1.0 : 0.0, vis);
+  o.interpNormal = vec4(b.normal, 0.0);
+  outs[id] = o;
+}
+)";
+
+struct GpuRay {
+  float origin[4], direction[4], range[4];
+};
+struct GpuOut {
+  float nearest[4], nearestNormal[4], interp[4], interpNormal[4];
+};
+
+std::vector<GpuRay> makeRays(const FieldDesc& f, uint32_t count, uint64_t seed) {
+  std::mt19937_64 g(seed);
+  auto uni = [&] { return float(std::uniform_real_distribution<double>(0, 1)(g)); };
+  auto dir = [&] {
+    const float z = 2 * uni() - 1, phi = 6.2831853f * uni();
+    const float r = std::sqrt(std::max(0.0f, 1 - z * z));
+    return Vec3{r * std::cos(phi), r * std::sin(phi), z};
+  };
+  const Vec3 c{f.sphere.center[0], f.sphere.center[1], f.sphere.center[2]};
+  const float R = f.sphere.radius;
+  std::vector<GpuRay> rays(count);
+  for (uint32_t r = 0; r < count; ++r) {
+    Vec3 o, d;
+    float tmin = 0, tmax = INFINITY;
+    if (r % 4 != 3) {  // mostly from outside: the interpolated path
+      const Vec3 a = dir(), b = dir();
+      const float s = R * (1.05f + 2.0f * uni()), s2 = R * 1.1f * std::cbrt(uni());
+      o = Vec3{c.x + a.x * s, c.y + a.y * s, c.z + a.z * s};
+      d = Vec3{c.x + b.x * s2 - o.x, c.y + b.y * s2 - o.y, c.z + b.z * s2 - o.z};
+      if (r % 8 == 2) d = Vec3{d.x * 2.5f, d.y * 2.5f, d.z * 2.5f};
+      if (r % 16 == 4) tmax = 1.5f * uni();
+    } else {
+      const Vec3 a = dir();
+      const float s = R * 0.95f * std::cbrt(uni());
+      o = Vec3{c.x + a.x * s, c.y + a.y * s, c.z + a.z * s};
+      d = dir();
+    }
+    rays[r] = GpuRay{{o.x, o.y, o.z, 0}, {d.x, d.y, d.z, 0}, {tmin, tmax, r % 3 == 0 ? 0.0f : -1.0f, 0}};
+  }
+  return rays;
+}
+
+std::vector<GpuOut> runRays(const gl::GpuField& field, GLuint program, const std::vector<GpuRay>& rays) {
+  GLuint bufs[2];
+  glGenBuffers(2, bufs);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[0]);
+  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(rays.size() * sizeof(GpuRay)), rays.data(), GL_STATIC_DRAW);
+  std::vector<GpuOut> out(rays.size());
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
+  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(out.size() * sizeof(GpuOut)), nullptr, GL_STREAM_READ);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bufs[0]);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, bufs[1]);
+  field.bind();
+  glUseProgram(program);
+  glDispatchCompute(GLuint((rays.size() + 63) / 64), 1, 1);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
+  glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(out.size() * sizeof(GpuOut)), out.data());
+  glDeleteBuffers(2, bufs);
+  EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
+  return out;
+}
+
+struct FieldCase {
+  PositionScheme positions;
+  DirectionScheme directions;
+  DistanceEncoding encoding;
+  LayoutTarget target = LayoutTarget::kTexture2DArray;
+};
+
+std::string caseName(const FieldCase& c) {
+  std::string s = c.positions == PositionScheme::kOctaHemi2            ? "OctaHemi2"
+                  : c.positions == PositionScheme::kEqualAreaOctaGrid ? "EaOctaGrid"
+                                                                       : "Fibonacci";
+  s += c.directions == DirectionScheme::kConcentricEqualArea ? "_Concentric" : "_HemiOct";
+  switch (c.encoding) {
+    case DistanceEncoding::kUnorm8Diameter: s += "_Unorm8Diameter"; break;
+    case DistanceEncoding::kUnorm8Chord: s += "_Unorm8Chord"; break;
+    case DistanceEncoding::kUnorm16Diameter: s += "_Unorm16Diameter"; break;
+    default: s += "_Bit1"; break;
+  }
+  if (c.target == LayoutTarget::kTexture3D) s += "_3D";
+  return s;
+}
+
+// A torus knot with normals, several slices, gutter 1 (0 for bit1).
+Result<File> bakeFile(const FieldCase& c) {
+  static const bake::Mesh mesh = bake::makeShape("torus-knot");
+  auto scene = bake::Scene::create(mesh);
+  if (!scene) return scene.error();
+  bake::BakeOptions o;
+  o.positionScheme = c.positions;
+  o.positionParam = c.positions == PositionScheme::kOctaHemi2 ? 4u : c.positions == PositionScheme::kEqualAreaOctaGrid ? 9u : 100u;
+  o.directionScheme = c.directions;
+  o.mapResolution = 32;
+  o.encoding = c.encoding;
+  o.normals = true;
+  auto baked = bake::bakeField(*scene, o);
+  if (!baked) return baked.error();
+  WriteOptions w;
+  w.layout.target = c.target;
+  w.layout.maxTextureSize = 256;
+  w.layout.gutter = c.encoding == DistanceEncoding::kBit1 ? 0 : 1;
+  auto bytes = writeMemory(baked->field, baked->distance, baked->normals, w);
+  if (!bytes) return bytes.error();
+  return File::openBuffer(std::move(*bytes));
+}
+
+class GpuField : public ::testing::TestWithParam<FieldCase> {};
+
+TEST_P(GpuField, NormalsAndInterpolatedMatchCpu) {
+  VFF_REQUIRE_GL();
+  auto file = bakeFile(GetParam());
+  ASSERT_TRUE(file.ok()) << file.error().toString();
+  ASSERT_TRUE(file->hasNormals());
+  const FieldDesc& f = file->field();
+  const float R = f.sphere.radius;
+  auto gpu = gl::loadField(*file);
+  ASSERT_TRUE(gpu.ok()) << gpu.error().toString();
+  ASSERT_NE(gpu->normalsTexture(), 0u);
+  const GLuint prog = buildProgram(file->layout().target == LayoutTarget::kTexture3D, kMain);
+  ASSERT_NE(prog, 0u);
+  auto cpu = FieldQuery::fromFile(*file);
+  ASSERT_TRUE(cpu.ok()) << cpu.error().toString();
+  const std::vector<GpuRay> rays = makeRays(f, 8192, 77);
+  const std::vector<GpuOut> out = runRays(*gpu, prog, rays);
+  glDeleteProgram(prog);
+
+  uint64_t nHits = 0, nNormals = 0, nExact = 0, nFlag = 0, nFail = 0;
+  double nMax = 0;
+  uint64_t iRays = 0, iAgree = 0, iTie = 0, iHits = 0, iFail = 0, iNormals = 0;
+  double iMaxT = 0, iMaxVis = 0, iMaxN = 0;
+  std::string first;
+  auto fail = [&](size_t r, const std::string& why) {
+    if (first.empty()) first = "ray " + std::to_string(r) + ": " + why;
+  };
+  for (size_t r = 0; r < rays.size(); ++r) {
+    const GpuRay& g = rays[r];
+    const Ray ray{{g.origin[0], g.origin[1], g.origin[2]}, {g.direction[0], g.direction[1], g.direction[2]},
+                  g.range[0], g.range[1]};
+    const double len = std::sqrt(double(ray.direction.x) * ray.direction.x + double(ray.direction.y) * ray.direction.y +
+                                 double(ray.direction.z) * ray.direction.z);
+    const GpuOut& o = out[r];
+    // kNearest and its normal.
+    QueryOptions qn;
+    qn.intraBias = g.range[2];
+    const QueryHit h = cpu->intersect(ray, qn);
+    const bool gh = o.nearest[0] != 0;
+    if (gh != h.hit) {
+      ++nFlag;  // allowed only at a boundary; test_gpu_query.cpp classifies these, here none occur
+    } else if (h.hit) {
+      ++nHits;
+      if (std::fabs(double(o.nearest[1]) - double(h.t)) * len > 1e-5 * R) continue;
+      const bool hasN = o.nearest[2] != 0;
+      if (hasN != h.hasNormal) {
+        ++nFail;
+        fail(r, "hasNormal differs");
+        continue;
+      }
+      ++nNormals;
+      const double e = std::max({std::fabs(double(o.nearestNormal[0]) - h.normal.x),
+                                 std::fabs(double(o.nearestNormal[1]) - h.normal.y),
+                                 std::fabs(double(o.nearestNormal[2]) - h.normal.z)});
+      nMax = std::max(nMax, e);
+      nExact += e == 0;
+      if (e > kNormalEps) {
+        ++nFail;
+        fail(r, "nearest normal differs by " + std::to_string(e));
+      }
+    }
+    // kInterpolated.
+    QueryOptions qi = qn;
+    qi.reconstruction = Reconstruction::kInterpolated;
+    const QueryHit hi = cpu->intersect(ray, qi);
+    const float vis = cpu->visibility(ray, qi);
+    ++iRays;
+    const double dv = std::fabs(double(o.interp[3]) - double(vis));
+    iMaxVis = std::max(iMaxVis, dv);
+    if (dv > kInterpVis) {
+      ++iFail;
+      fail(r, "interpolated visibility " + std::to_string(o.interp[3]) + " vs " + std::to_string(vis));
+      continue;
+    }
+    const bool gi = o.interp[0] != 0;
+    if (gi != hi.hit) {
+      if (std::fabs(double(vis) - 0.5) <= kVoteEps) {
+        ++iTie;
+      } else {
+        ++iFail;
+        fail(r, "interpolated hit flag differs, visibility " + std::to_string(vis));
+      }
+      continue;
+    }
+    ++iAgree;
+    if (!hi.hit) continue;
+    ++iHits;
+    const double dt = std::fabs(double(o.interp[1]) - double(hi.t)) * len / R;
+    iMaxT = std::max(iMaxT, dt);
+    if (dt > kInterpT) {
+      ++iFail;
+      fail(r, "interpolated t differs by " + std::to_string(dt) + " R");
+      continue;
+    }
+    if ((o.interp[2] != 0) != hi.hasNormal) {
+      ++iFail;
+      fail(r, "interpolated hasNormal differs");
+      continue;
+    }
+    if (hi.hasNormal) {
+      ++iNormals;
+      const double e = std::max({std::fabs(double(o.interpNormal[0]) - hi.normal.x),
+                                 std::fabs(double(o.interpNormal[1]) - hi.normal.y),
+                                 std::fabs(double(o.interpNormal[2]) - hi.normal.z)});
+      iMaxN = std::max(iMaxN, e);
+      if (e > 1e-4) {
+        ++iFail;
+        fail(r, "interpolated normal differs by " + std::to_string(e));
+      }
+    }
+  }
+  std::printf("[ gpu ] %s: kNearest: %llu common hits, %llu normals compared (%llu bit-identical), max |n_gpu - "
+              "n_cpu| = %.3g, hit-flag mismatches %llu\n",
+              caseName(GetParam()).c_str(), (unsigned long long)nHits, (unsigned long long)nNormals,
+              (unsigned long long)nExact, nMax, (unsigned long long)nFlag);
+  std::printf("[ gpu ] %s: kInterpolated: %llu rays, agreement %.3f%%, vote ties %llu, failures %llu; %llu hits, "
+              "max |t_gpu - t_cpu| = %.3g R, max |vis_gpu - vis_cpu| = %.3g, %llu normals, max diff %.3g\n",
+              caseName(GetParam()).c_str(), (unsigned long long)iRays, 100.0 * double(iAgree) / double(iRays),
+              (unsigned long long)iTie, (unsigned long long)iFail, (unsigned long long)iHits, iMaxT, iMaxVis,
+              (unsigned long long)iNormals, iMaxN);
+  EXPECT_EQ(nFail, 0u) << first;
+  EXPECT_EQ(nFlag, 0u);
+  EXPECT_EQ(iFail, 0u) << first;
+  EXPECT_GT(nNormals, rays.size() / 8);
+  EXPECT_GT(iHits, rays.size() / 8);
+}
+
+std::vector<FieldCase> fieldCases() {
+  std::vector<FieldCase> cases;
+  for (auto p : {PositionScheme::kOctaHemi2, PositionScheme::kEqualAreaOctaGrid, PositionScheme::kSphericalFibonacci})
+    for (auto d : {DirectionScheme::kConcentricEqualArea, DirectionScheme::kHemiOctahedral})
+      cases.push_back({p, d, DistanceEncoding::kUnorm8Diameter});
+  cases.push_back({PositionScheme::kOctaHemi2, DirectionScheme::kHemiOctahedral, DistanceEncoding::kUnorm8Chord});
+  cases.push_back({PositionScheme::kSphericalFibonacci, DirectionScheme::kConcentricEqualArea,
+                   DistanceEncoding::kUnorm16Diameter, LayoutTarget::kTexture3D});
+  cases.push_back({PositionScheme::kEqualAreaOctaGrid, DirectionScheme::kConcentricEqualArea, DistanceEncoding::kBit1});
+  return cases;
+}
+
+INSTANTIATE_TEST_SUITE_P(Fields, GpuField, ::testing::ValuesIn(fieldCases()),
+                         [](const ::testing::TestParamInfo<FieldCase>& i) { return caseName(i.param); });
+
+// ---- Ground AO ---------------------------------------------------------------------------------------
+
+TEST(GpuAo, GroundAoMatchesCpu) {
+  VFF_REQUIRE_GL();
+  const bake::Mesh mesh = bake::makeShape("torus-knot");
+  auto scene = bake::Scene::create(mesh);
+  ASSERT_TRUE(scene.ok());
+  bake::BakeOptions bo;
+  bo.positionScheme = PositionScheme::kOctaHemi2;
+  bo.positionParam = 8;  // 290 maps
+  bo.mapResolution = 32;
+  bo.encoding = DistanceEncoding::kUnorm8Diameter;
+  auto baked = bake::bakeField(*scene, bo);
+  ASSERT_TRUE(baked.ok()) << baked.error().toString();
+  auto bytes = writeMemory(baked->field, baked->distance);
+  ASSERT_TRUE(bytes.ok());
+  auto file = File::openBuffer(std::move(*bytes));
+  ASSERT_TRUE(file.ok());
+  float minY = INFINITY;
+  for (size_t v = 1; v < mesh.positions.size(); v += 3) minY = std::min(minY, mesh.positions[v]);
+  constexpr int kSize = 64, kRays = 64;
+  const gpubench::AoScene s = gpubench::makeAoScene(file->field(), minY, kSize);
+  auto gpu = gl::loadField(*file);
+  ASSERT_TRUE(gpu.ok()) << gpu.error().toString();
+  auto cpu = FieldQuery::fromFile(*file);
+  ASSERT_TRUE(cpu.ok());
+  const GLuint prog = buildProgram(false, gpubench::kAoShader);
+  ASSERT_NE(prog, 0u);
+  GLuint bufs[3];
+  glGenBuffers(3, bufs);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[0]);
+  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(s.gbuffer.size() * 4), s.gbuffer.data(), GL_STATIC_DRAW);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
+  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(s.directions.size() * 4), s.directions.data(), GL_STATIC_DRAW);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[2]);
+  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(kSize * kSize * 4), nullptr, GL_STREAM_READ);
+  for (int b = 0; b < 3; ++b) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, GLuint(5 + b), bufs[b]);
+  gpu->bind();
+  glUseProgram(prog);
+  for (Reconstruction r : {Reconstruction::kNearest, Reconstruction::kInterpolated}) {
+    const bool interp = r == Reconstruction::kInterpolated;
+    glUniform1i(0, kSize);
+    glUniform1i(1, kRays);
+    glUniform1i(2, interp ? 1 : 0);
+    glUniform1f(3, s.eps);
+    glUniform1f(4, s.tmax);
+    glUniform1i(5, 0);
+    glDispatchCompute(kSize / 8, kSize / 8, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    std::vector<float> g(size_t(kSize) * kSize);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[2]);
+    glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(g.size() * 4), g.data());
+    const std::vector<float> c = gpubench::cpuAo(*cpu, s, kRays, r, 2);
+    const gpubench::AoDiff d = gpubench::compareAo(c, g);
+    double mean = 0;
+    for (float v : c) mean += v;
+    mean /= double(c.size());
+    std::printf("[ gpu ] ground AO %dx%d, %d rays/px, %s: mean AO %.4f; GPU vs CPU on the 8-bit scale: max %.0f, "
+                "RMS %.4f, %llu of %d pixels differ\n",
+                kSize, kSize, kRays, interp ? "kInterpolated visibility" : "kNearest occluded", mean, d.max, d.rms,
+                (unsigned long long)d.differing, kSize * kSize);
+    // Tolerance: at most one ray in 64 answered differently (4 levels) for kNearest; float
+    // summation only (1 level) for kInterpolated.
+    EXPECT_LE(d.max, interp ? 1.0 : 4.0);
+    EXPECT_LE(d.rms, interp ? 0.1 : 0.25);
+    EXPECT_LT(mean, 0.99);  // the object does occlude the ground
+  }
+  glDeleteBuffers(3, bufs);
+  glDeleteProgram(prog);
+  EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
+}
+
+}  // namespace
+}  // namespace vff
