@@ -1,0 +1,47 @@
+// convert.h - what vff-convert's parts share: a whole field held in memory, and the EXR side.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "vff/vff.h"
+
+namespace vff::convert {
+
+// A field with its raw planes, plus what is needed to write it again as it was.
+struct FieldData {
+  FieldDesc field;
+  LayoutDesc layout;              // the source's packed layout (maps are placed by it in the EXR)
+  std::string metadata;           // META JSON text, empty for none
+  Codec codec = Codec::kStored;   // the source's block codec (of its first distance block)
+  uint32_t mapsPerBlock = 0;      // the source's G as a WriteOptions value (0: the writer's automatic G)
+  std::vector<uint8_t> distance;  // mapCount * distanceMapBytes
+  std::vector<uint8_t> normals;   // mapCount * normalMapBytes, empty without a normal field
+};
+
+struct ExrWriteOptions {
+  bool half = false;  // HALF instead of FLOAT for Y and the normal's RGB
+};
+
+// Writes `data` as a multi-part OpenEXR file through a temporary file in the same folder and a
+// rename: parts "slice.S" (channels Y, miss) and, with normals, "normal.S" (channels R, G, B), each
+// sliceWidth x sliceHeight with the slice's gutters and unused tiles, and the string attribute
+// "vff.field" (JSON) in the first part. Fails with kIoWrite naming the file.
+Status writeExr(const std::string& path, const FieldData& data, const ExrWriteOptions& options);
+
+struct ExrReadReport {
+  bool half = false;             // Y is stored as HALF
+  uint64_t inexactTexels = 0;    // hits whose Y is not what the exporter writes for any code
+  uint64_t ambiguousTexels = 0;  // HALF hits whose Y the exporter writes for more than one code
+  uint64_t inexactNormals = 0;   // normals whose RGB is not a decoded oct-snorm16 normal
+};
+
+// Reads an EXR written by writeExr back into raw planes: each hit's Y is encoded again with
+// encodeDistance, the normal's RGB with encodeNormal; `report` counts values that were not exact.
+Result<FieldData> readExr(const std::string& path, ExrReadReport* report);
+
+// True when the file starts with the OpenEXR magic number.
+bool looksLikeExr(const std::string& path);
+
+}  // namespace vff::convert
