@@ -155,7 +155,7 @@ void FieldQuery::Impl::build() {
   spacing = std::sqrt(4.0f * kPi / float(n));
   // The kernel reaches 1.3 mean spacings (ground AO under the bunny: 1.0 and 1.6 are worse or
   // slower; vff-experiments ao).
-  const float r = 1.3f * spacing;
+  const float r = kQueryKernelSpacings * spacing;
   kernelRadius2 = r * r;
   defaultBias = defaultIntraBias(field);
   neighbours = queryNeighbours(positions);

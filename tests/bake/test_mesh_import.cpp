@@ -155,9 +155,19 @@ TEST_F(MeshImport, HostileObjAndPlyGetClearErrors) {
       {"keyword.ply", "ply\nformat ascii 1.0\nproper3 0 2 3\nend_header\n", "line 3: unknown PLY header keyword"},
       {"version.ply", "ply\nformat ascii ~1.0\nend_header\n", "PLY format line"},
       {"count.ply", "ply\nformat ascii 1.0\nelement vertex y\nend_header\n", "PLY element line"},
+      {"list.ply",
+       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+       "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n"
+       "5555555555553 0 1 2\n",
+       "a list length is not an integer"},
+      {"short.ply",
+       "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+       "property float z\nend_header\n\x01\x02\x03",
+       "the file ends inside the body"},
       {"index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n", "face index '7' is not a vertex"},
       {"corners.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n99999999 0 1 2\n", "corner count"},
       {"counts.off", "OFF\n-3 1 0\n", "counts line"},
+      {"sameline.off", "OFF\t0 0\n", "own line"},
   };
   for (const Case& c : cases) {
     auto m = loadMesh(write(c.name, c.text));

@@ -119,7 +119,7 @@ Result<FieldBlock> makeFieldBlock(const FieldDesc& field, const LayoutDesc& layo
   b.twoRadius = 2.0f * radius;
   // As FieldQuery::Impl::build.
   const float spacing = std::sqrt(4.0f * kPi / float(field.mapCount));
-  const float r = 1.3f * spacing;
+  const float r = kQueryKernelSpacings * spacing;
   b.kernelRadius2 = r * r;
   return b;
 }

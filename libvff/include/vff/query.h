@@ -89,6 +89,8 @@ float defaultIntraBias(const FieldDesc& field) noexcept;
 // at 1 and 1.6 mean spacings), padded with UINT32_MAX: mapCount * kQueryNeighbours entries. A GPU
 // port of kInterpolated uploads them (gpu/loader).
 inline constexpr uint32_t kQueryNeighbours = 8;
+// The radius of kInterpolated's kernel, in mean sample spacings sqrt(4 pi / mapCount).
+inline constexpr float kQueryKernelSpacings = 1.3f;
 std::vector<uint32_t> queryNeighbours(const PositionSet& positions);
 
 struct QueryHit {

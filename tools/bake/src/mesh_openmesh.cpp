@@ -4,6 +4,7 @@
 #include <OpenMesh/Core/System/omstream.hh>
 
 #include <fstream>
+#include <map>
 #include <set>
 #include <vector>
 #include <sstream>
@@ -14,15 +15,39 @@
 namespace vff::bake::detail {
 namespace {
 
-// OpenMesh's PLY reader loops forever on a header that never reaches `end_header` or holds an
-// unknown keyword (found by tests/fuzz, fuzz_mesh). The header is checked here first: the magic
-// line, then only the keywords of the PLY format, up to `end_header`, within 64 KiB.
-Status checkPlyHeader(const std::string& path) {
+// OpenMesh's PLY reader loops forever, or for as many steps as a garbled count says, on a header
+// that never reaches `end_header`, holds an unknown or malformed line, or a body whose list counts
+// or element counts do not match the file (found by tests/fuzz, fuzz_mesh). The file is checked
+// first: the header's grammar (within 64 KiB), then the body against it, row by row for ASCII and
+// byte by byte for binary, with list lengths of at most 65536.
+Status checkPly(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return makeError(Code::kIoOpen, path + ": cannot open");
+  struct Property {
+    bool list = false;
+    int countSize = 0, itemSize = 0;  // bytes; countSize only for lists
+    bool countSigned = false;
+  };
+  struct Element {
+    uint64_t count = 0;
+    std::vector<Property> properties;
+  };
+  static const std::map<std::string, std::pair<int, bool>> kTypes = {
+      {"char", {1, true}},    {"uchar", {1, false}},  {"int8", {1, true}},    {"uint8", {1, false}},
+      {"short", {2, true}},   {"ushort", {2, false}}, {"int16", {2, true}},   {"uint16", {2, false}},
+      {"int", {4, true}},     {"uint", {4, false}},   {"int32", {4, true}},   {"uint32", {4, false}},
+      {"float", {4, true}},   {"float32", {4, true}}, {"double", {8, true}},  {"float64", {8, true}}};
+  std::vector<Element> elements;
+  std::string format;
   std::string line;
   uint64_t read = 0;
-  for (int n = 1; std::getline(in, line); ++n) {
+  int64_t n = 0;
+  auto bad = [&](const std::string& why) {
+    return makeError(Code::kMeshParse, path + ": line " + std::to_string(n) + ": " + why);
+  };
+  bool ended = false;
+  while (!ended && std::getline(in, line)) {
+    ++n;
     read += line.size() + 1;
     if (read > 65536) return makeError(Code::kMeshParse, path + ": PLY header longer than 64 KiB");
     if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -33,38 +58,116 @@ Status checkPlyHeader(const std::string& path) {
       if (keyword != "ply") return makeError(Code::kMeshParse, path + ": line 1: not a PLY file (no 'ply' magic)");
       continue;
     }
-    if (keyword == "end_header") return {};
-    auto bad = [&](const std::string& why) {
-      return makeError(Code::kMeshParse, path + ": line " + std::to_string(n) + ": " + why);
-    };
+    if (keyword == "end_header") {
+      ended = true;
+      break;
+    }
     if (keyword == "comment" || keyword == "obj_info") continue;
     std::vector<std::string> rest;
     for (std::string w; words >> w;) rest.push_back(w);
     for (const std::string& w : rest)
       for (char ch : w)
         if (ch < 0x21 || ch > 0x7e) return bad("PLY header holds a byte that is not printable ASCII");
-    static const std::set<std::string> kTypes = {"char",  "uchar", "short", "ushort", "int",     "uint",    "float",
-                                                 "double", "int8", "uint8", "int16",  "uint16",  "int32",   "uint32",
-                                                 "float32", "float64"};
-    auto isCount = [](const std::string& w) {
-      return !w.empty() && w.size() <= 10 && w.find_first_not_of("0123456789") == std::string::npos;
-    };
     if (keyword == "format") {
       if (rest.size() != 2 || (rest[0] != "ascii" && rest[0] != "binary_little_endian" && rest[0] != "binary_big_endian") ||
           rest[1] != "1.0")
         return bad("PLY format line is not 'format ascii|binary_little_endian|binary_big_endian 1.0'");
+      format = rest[0];
     } else if (keyword == "element") {
-      if (rest.size() != 2 || !isCount(rest[1])) return bad("PLY element line is not 'element NAME COUNT'");
+      if (rest.size() != 2 || rest[1].empty() || rest[1].size() > 10 ||
+          rest[1].find_first_not_of("0123456789") != std::string::npos)
+        return bad("PLY element line is not 'element NAME COUNT'");
+      elements.push_back({std::stoull(rest[1]), {}});
     } else if (keyword == "property") {
+      if (elements.empty()) return bad("PLY property before any element");
       const bool list = !rest.empty() && rest[0] == "list";
-      if (list ? (rest.size() != 4 || !kTypes.count(rest[1]) || !kTypes.count(rest[2]))
+      if (list ? (rest.size() != 4 || !kTypes.count(rest[1]) || !kTypes.count(rest[2]) || rest[1] == "float" ||
+                  rest[1] == "float32" || rest[1] == "double" || rest[1] == "float64")
                : (rest.size() != 2 || !kTypes.count(rest[0])))
-        return bad("PLY property line is not 'property TYPE NAME' or 'property list TYPE TYPE NAME'");
+        return bad("PLY property line is not 'property TYPE NAME' or 'property list INTEGER-TYPE TYPE NAME'");
+      Property pr;
+      pr.list = list;
+      if (list) {
+        pr.countSize = kTypes.at(rest[1]).first;
+        pr.countSigned = kTypes.at(rest[1]).second;
+        pr.itemSize = kTypes.at(rest[2]).first;
+      } else {
+        pr.itemSize = kTypes.at(rest[0]).first;
+      }
+      elements.back().properties.push_back(pr);
     } else {
       return bad("unknown PLY header keyword '" + keyword.substr(0, 32) + "'");
     }
   }
-  return makeError(Code::kMeshParse, path + ": PLY header has no end_header line");
+  if (!ended) return makeError(Code::kMeshParse, path + ": PLY header has no end_header line");
+  if (format.empty()) return makeError(Code::kMeshParse, path + ": PLY header has no format line");
+  constexpr uint64_t kMaxList = 65536;
+  if (format == "ascii") {
+    std::string word;
+    auto number = [&](bool integer, uint64_t* value) {
+      if (!(in >> word)) return false;
+      std::istringstream ws(word);
+      if (integer) {
+        long long v = 0;
+        if (!(ws >> v) || ws.peek() != EOF || v < 0) return false;
+        *value = uint64_t(v);
+        return true;
+      }
+      double d = 0;
+      return bool(ws >> d) && ws.peek() == EOF;
+    };
+    for (size_t e = 0; e < elements.size(); ++e)
+      for (uint64_t row = 0; row < elements[e].count && !elements[e].properties.empty(); ++row)
+        for (const Property& pr : elements[e].properties) {
+          uint64_t items = 1;
+          if (pr.list && (!number(true, &items) || items > kMaxList))
+            return makeError(Code::kMeshParse, path + ": element " + std::to_string(e) + " row " + std::to_string(row) +
+                                                   ": a list length is not an integer from 0 to 65536");
+          for (uint64_t i = 0; i < items; ++i) {
+            uint64_t ignored = 0;
+            if (!number(false, &ignored))
+              return makeError(Code::kMeshParse, path + ": element " + std::to_string(e) + " row " +
+                                                     std::to_string(row) + ": missing or malformed value");
+          }
+        }
+    return {};
+  }
+  // Binary: walk the rows through the file's bytes.
+  const bool little = format == "binary_little_endian";
+  const std::streamoff bodyStart = in.tellg();
+  in.seekg(0, std::ios::end);
+  const uint64_t size = uint64_t(in.tellg());
+  uint64_t pos = uint64_t(bodyStart);
+  in.seekg(bodyStart);
+  std::vector<char> body(size - pos);
+  in.read(body.data(), std::streamsize(body.size()));
+  pos = 0;
+  for (size_t e = 0; e < elements.size(); ++e)
+    for (uint64_t row = 0; row < elements[e].count && !elements[e].properties.empty(); ++row)
+      for (const Property& pr : elements[e].properties) {
+        uint64_t items = 1;
+        if (pr.list) {
+          if (pos + uint64_t(pr.countSize) > body.size())
+            return makeError(Code::kMeshParse, path + ": element " + std::to_string(e) + " row " + std::to_string(row) +
+                                                   ": the file ends inside the body");
+          uint64_t v = 0;
+          for (int b = 0; b < pr.countSize; ++b) {
+            const uint64_t byte = uint8_t(body[size_t(pos) + size_t(little ? b : pr.countSize - 1 - b)]);
+            v |= byte << (8 * b);
+          }
+          const bool negative = pr.countSigned && (v >> (8 * pr.countSize - 1)) != 0;
+          if (negative || v > kMaxList)
+            return makeError(Code::kMeshParse, path + ": element " + std::to_string(e) + " row " + std::to_string(row) +
+                                                   ": a list length is not from 0 to 65536");
+          items = v;
+          pos += uint64_t(pr.countSize);
+        }
+        pos += items * uint64_t(pr.itemSize);
+        if (pos > body.size())
+          return makeError(Code::kMeshParse, path + ": element " + std::to_string(e) + " row " + std::to_string(row) +
+                                                 ": the file ends inside the body");
+      }
+  return {};
 }
 
 // OpenMesh's OBJ reader writes through invalid handles when a face refers to a vertex or normal
@@ -170,8 +273,10 @@ Status checkOff(const std::string& path) {
   }
   if (w.size() > 1 && w[1] == "BINARY")
     return makeError(Code::kMeshUnsupported, path + ": binary OFF is not supported");
-  std::vector<std::string> counts(w.begin() + 1, w.end());
-  if (counts.empty() && !next(&counts)) return bad("missing the vertex and face counts");
+  // OpenMesh reads the counts from the line after the keyword only.
+  if (w.size() > 1) return bad("the counts must be on their own line after 'OFF'");
+  std::vector<std::string> counts;
+  if (!next(&counts)) return bad("missing the vertex and face counts");
   int64_t nv = 0, nf = 0, ne = 0;
   constexpr int64_t kMax = 100000000;
   if (counts.size() < 2 || !integer(counts[0], 0, kMax, &nv) || !integer(counts[1], 0, kMax, &nf) ||
@@ -204,7 +309,7 @@ Result<Mesh> loadWithOpenMesh(const std::string& path, const std::string& ext) {
   omlog().disable();
   omout().disable();
   if (ext == "ply") {
-    if (Status s = checkPlyHeader(path); !s) return s.error();
+    if (Status s = checkPly(path); !s) return s.error();
   } else if (ext == "obj") {
     if (Status s = checkObjFaces(path); !s) return s.error();
   } else if (ext == "off") {
