@@ -241,13 +241,28 @@ Result<GpuField> loadField(const File& file, const LoadOptions& options) {
   glPixelStorei(GL_UNPACK_SKIP_PIXELS, 0);
   glPixelStorei(GL_UNPACK_SKIP_ROWS, 0);
   glPixelStorei(GL_UNPACK_SKIP_IMAGES, 0);
-  std::vector<uint8_t> slice(sliceBytes);
-  for (uint32_t s = 0; s < layout.sliceCount; ++s) {
-    if (Status st = file.readSlice(Plane::kDistance, s, slice); !st) return st.error();
-    glTexSubImage3D(out.mapsTarget_, 0, 0, 0, GLint(s), GLsizei(width), GLsizei(layout.sliceHeight), 1,
-                    GL_RED_INTEGER, type, slice.data());
-    if (Status st = checkGl("glTexSubImage3D"); !st) return st.error();
-    out.textureBytes_ += sliceBytes;
+  if (layout.gutter == 0 && !bit1) {
+    // Without gutters every map is one rectangle of its slice: upload it straight from the file's
+    // bytes (the mapped file itself for stored blocks), with no slice composed on the CPU. Tiles
+    // past the last map stay undefined; no lookup reads them.
+    for (uint32_t k = 0; k < field.mapCount; ++k) {
+      auto map = file.mapData(Plane::kDistance, k);
+      if (!map) return map.error();
+      const TilePlacement at = placeMap(layout, k);
+      glTexSubImage3D(out.mapsTarget_, 0, GLint(at.x), GLint(at.y), GLint(at.slice), GLsizei(field.mapResolution),
+                      GLsizei(field.mapResolution), 1, GL_RED_INTEGER, type, map->data());
+    }
+    if (Status st = checkGl("glTexSubImage3D (maps)"); !st) return st.error();
+    out.textureBytes_ += sliceBytes * layout.sliceCount;
+  } else {
+    std::vector<uint8_t> slice(sliceBytes);
+    for (uint32_t s = 0; s < layout.sliceCount; ++s) {
+      if (Status st = file.readSlice(Plane::kDistance, s, slice); !st) return st.error();
+      glTexSubImage3D(out.mapsTarget_, 0, 0, 0, GLint(s), GLsizei(width), GLsizei(layout.sliceHeight), 1,
+                      GL_RED_INTEGER, type, slice.data());
+      if (Status st = checkGl("glTexSubImage3D"); !st) return st.error();
+      out.textureBytes_ += sliceBytes;
+    }
   }
 
   // The normal plane: the same layout, two snorm16 per texel as GL_RG16I.
@@ -266,13 +281,25 @@ Result<GpuField> loadField(const File& file, const LoadOptions& options) {
     glTexStorage3D(out.mapsTarget_, 1, GL_RG16I, GLsizei(layout.sliceWidth), GLsizei(layout.sliceHeight),
                    GLsizei(layout.sliceCount));
     if (Status s = checkGl("glTexStorage3D (normals)"); !s) return s.error();
-    std::vector<uint8_t> nslice(normalBytes);
-    for (uint32_t s = 0; s < layout.sliceCount; ++s) {
-      if (Status st = file.readSlice(Plane::kNormal, s, nslice); !st) return st.error();
-      glTexSubImage3D(out.mapsTarget_, 0, 0, 0, GLint(s), GLsizei(layout.sliceWidth), GLsizei(layout.sliceHeight), 1,
-                      GL_RG_INTEGER, GL_SHORT, nslice.data());
-      if (Status st = checkGl("glTexSubImage3D (normals)"); !st) return st.error();
-      out.textureBytes_ += normalBytes;
+    if (layout.gutter == 0) {
+      for (uint32_t k = 0; k < field.mapCount; ++k) {  // straight from the file, as the distances
+        auto map = file.mapData(Plane::kNormal, k);
+        if (!map) return map.error();
+        const TilePlacement at = placeMap(layout, k);
+        glTexSubImage3D(out.mapsTarget_, 0, GLint(at.x), GLint(at.y), GLint(at.slice), GLsizei(field.mapResolution),
+                        GLsizei(field.mapResolution), 1, GL_RG_INTEGER, GL_SHORT, map->data());
+      }
+      if (Status st = checkGl("glTexSubImage3D (normal maps)"); !st) return st.error();
+      out.textureBytes_ += normalBytes * layout.sliceCount;
+    } else {
+      std::vector<uint8_t> nslice(normalBytes);
+      for (uint32_t s = 0; s < layout.sliceCount; ++s) {
+        if (Status st = file.readSlice(Plane::kNormal, s, nslice); !st) return st.error();
+        glTexSubImage3D(out.mapsTarget_, 0, 0, 0, GLint(s), GLsizei(layout.sliceWidth), GLsizei(layout.sliceHeight),
+                        1, GL_RG_INTEGER, GL_SHORT, nslice.data());
+        if (Status st = checkGl("glTexSubImage3D (normals)"); !st) return st.error();
+        out.textureBytes_ += normalBytes;
+      }
     }
   }
 
