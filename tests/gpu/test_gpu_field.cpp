@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "../../gpu/bench/ao_scene.h"
+#include "baked_fields.h"
 #include "egl_context.h"
 #include "vff/bake/baker.h"
 #include "vff/bake/procedural.h"
@@ -153,50 +154,9 @@ std::vector<GpuOut> runRays(const gl::GpuField& field, GLuint program, const std
   return out;
 }
 
-struct FieldCase {
-  PositionScheme positions;
-  DirectionScheme directions;
-  DistanceEncoding encoding;
-  LayoutTarget target = LayoutTarget::kTexture2DArray;
-};
-
-std::string caseName(const FieldCase& c) {
-  std::string s = c.positions == PositionScheme::kOctaHemi2            ? "OctaHemi2"
-                  : c.positions == PositionScheme::kEqualAreaOctaGrid ? "EaOctaGrid"
-                                                                       : "Fibonacci";
-  s += c.directions == DirectionScheme::kConcentricEqualArea ? "_Concentric" : "_HemiOct";
-  switch (c.encoding) {
-    case DistanceEncoding::kUnorm8Diameter: s += "_Unorm8Diameter"; break;
-    case DistanceEncoding::kUnorm8Chord: s += "_Unorm8Chord"; break;
-    case DistanceEncoding::kUnorm16Diameter: s += "_Unorm16Diameter"; break;
-    default: s += "_Bit1"; break;
-  }
-  if (c.target == LayoutTarget::kTexture3D) s += "_3D";
-  return s;
-}
-
-// A torus knot with normals, several slices, gutter 1 (0 for bit1).
-Result<File> bakeFile(const FieldCase& c) {
-  static const bake::Mesh mesh = bake::makeShape("torus-knot");
-  auto scene = bake::Scene::create(mesh);
-  if (!scene) return scene.error();
-  bake::BakeOptions o;
-  o.positionScheme = c.positions;
-  o.positionParam = c.positions == PositionScheme::kOctaHemi2 ? 4u : c.positions == PositionScheme::kEqualAreaOctaGrid ? 9u : 100u;
-  o.directionScheme = c.directions;
-  o.mapResolution = 32;
-  o.encoding = c.encoding;
-  o.normals = true;
-  auto baked = bake::bakeField(*scene, o);
-  if (!baked) return baked.error();
-  WriteOptions w;
-  w.layout.target = c.target;
-  w.layout.maxTextureSize = 256;
-  w.layout.gutter = c.encoding == DistanceEncoding::kBit1 ? 0 : 1;
-  auto bytes = writeMemory(baked->field, baked->distance, baked->normals, w);
-  if (!bytes) return bytes.error();
-  return File::openBuffer(std::move(*bytes));
-}
+using gputest::FieldCase;
+using gputest::caseName;
+Result<File> bakeFile(const FieldCase& c) { return gputest::bakeFile(c, true); }
 
 class GpuField : public ::testing::TestWithParam<FieldCase> {};
 

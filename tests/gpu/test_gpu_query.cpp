@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "baked_fields.h"
 #include "egl_context.h"
 #include "vff/bake/baker.h"
 #include "vff/bake/procedural.h"
@@ -396,52 +397,11 @@ Agreement compare(const File& file, uint32_t rayCount, uint64_t seed, const std:
 
 // ---- Baked fields ----------------------------------------------------------------------------------
 
-struct Case {
-  PositionScheme positions;
-  DirectionScheme directions;
-  DistanceEncoding encoding;
-  LayoutTarget target = LayoutTarget::kTexture2DArray;
-};
+using gputest::FieldCase;
+using gputest::caseName;
+Result<File> bakeFile(const FieldCase& c) { return gputest::bakeFile(c, false); }
 
-std::string caseName(const Case& c) {
-  std::string s = c.positions == PositionScheme::kOctaHemi2            ? "OctaHemi2"
-                  : c.positions == PositionScheme::kEqualAreaOctaGrid ? "EaOctaGrid"
-                                                                       : "Fibonacci";
-  s += c.directions == DirectionScheme::kConcentricEqualArea ? "_Concentric" : "_HemiOct";
-  switch (c.encoding) {
-    case DistanceEncoding::kUnorm8Diameter: s += "_Unorm8Diameter"; break;
-    case DistanceEncoding::kUnorm8Chord: s += "_Unorm8Chord"; break;
-    case DistanceEncoding::kUnorm16Diameter: s += "_Unorm16Diameter"; break;
-    default: s += "_Bit1"; break;
-  }
-  if (c.target == LayoutTarget::kTexture3D) s += "_3D";
-  return s;
-}
-
-// Bakes a torus knot and writes it to memory with small slices (several slices, a gutter except for
-// bit1), so the fetch crosses slices and skips gutters.
-Result<File> bakeFile(const Case& c) {
-  static const bake::Mesh mesh = bake::makeShape("torus-knot");
-  auto scene = bake::Scene::create(mesh);
-  if (!scene) return scene.error();
-  bake::BakeOptions o;
-  o.positionScheme = c.positions;
-  o.positionParam = c.positions == PositionScheme::kOctaHemi2 ? 4u : c.positions == PositionScheme::kEqualAreaOctaGrid ? 9u : 100u;
-  o.directionScheme = c.directions;
-  o.mapResolution = 32;
-  o.encoding = c.encoding;
-  auto baked = bake::bakeField(*scene, o);
-  if (!baked) return baked.error();
-  WriteOptions w;
-  w.layout.target = c.target;
-  w.layout.maxTextureSize = 256;
-  w.layout.gutter = c.encoding == DistanceEncoding::kBit1 ? 0 : 1;
-  auto bytes = writeMemory(baked->field, baked->distance, {}, w);
-  if (!bytes) return bytes.error();
-  return File::openBuffer(std::move(*bytes));
-}
-
-class GpuQuery : public ::testing::TestWithParam<Case> {};
+class GpuQuery : public ::testing::TestWithParam<FieldCase> {};
 
 TEST_P(GpuQuery, MatchesCpuNearest) {
   VFF_REQUIRE_GL();
@@ -454,8 +414,8 @@ TEST_P(GpuQuery, MatchesCpuNearest) {
   EXPECT_GT(a.exactDistances, a.rays / 4);
 }
 
-std::vector<Case> allCases() {
-  std::vector<Case> cases;
+std::vector<FieldCase> allCases() {
+  std::vector<FieldCase> cases;
   for (auto p : {PositionScheme::kOctaHemi2, PositionScheme::kEqualAreaOctaGrid, PositionScheme::kSphericalFibonacci})
     for (auto d : {DirectionScheme::kConcentricEqualArea, DirectionScheme::kHemiOctahedral})
       for (auto e : {DistanceEncoding::kUnorm8Diameter, DistanceEncoding::kUnorm8Chord,
@@ -470,7 +430,7 @@ std::vector<Case> allCases() {
 }
 
 INSTANTIATE_TEST_SUITE_P(Fields, GpuQuery, ::testing::ValuesIn(allCases()),
-                         [](const ::testing::TestParamInfo<Case>& i) { return caseName(i.param); });
+                         [](const ::testing::TestParamInfo<FieldCase>& i) { return caseName(i.param); });
 
 // ---- Conformance vectors ---------------------------------------------------------------------------
 
