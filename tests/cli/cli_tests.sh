@@ -13,31 +13,8 @@ set -euo pipefail
 : "${VFF_INSPECT:?}" "${FIXTURES:?}" "${SCHEMA:?}" "${SCHEMA_CHECK:?}" "${WORK:?}"
 
 # ---- Helpers ---------------------------------------------------------------------------------------
-fail() {
-  echo "FAIL: $*" >&2
-  exit 1
-}
-show() {
-  echo "--- stdout:" >&2
-  head -c 6000 "$WORK/out" >&2 || true
-  echo "--- stderr:" >&2
-  head -c 3000 "$WORK/err" >&2 || true
-}
-# run CMD...: runs CMD with stdout in $WORK/out, stderr in $WORK/err and the exit code in RC.
-run() {
-  set +e
-  "$@" >"$WORK/out" 2>"$WORK/err"
-  RC=$?
-  set -e
-}
+source "$(dirname "${BASH_SOURCE[0]}")/../common/cli_harness.sh"
 inspect() { run "$VFF_INSPECT" "$@"; }
-expect_rc() { [[ $RC -eq $1 ]] || { show; fail "exit code $RC, expected $1"; }; }
-expect_out() { grep -q -F -e "$1" "$WORK/out" || { show; fail "stdout lacks: $1"; }; }
-expect_out_re() { grep -q -E -e "$1" "$WORK/out" || { show; fail "stdout matches no line: $1"; }; }
-expect_err() { grep -q -F -e "$1" "$WORK/err" || { show; fail "stderr lacks: $1"; }; }
-expect_err_re() { grep -q -E -e "$1" "$WORK/err" || { show; fail "stderr matches no line: $1"; }; }
-expect_no_out() { [[ ! -s $WORK/out ]] || { show; fail "stdout is not empty"; }; }
-expect_no_err() { [[ ! -s $WORK/err ]] || { show; fail "stderr is not empty"; }; }
 # conforms FILE: the JSON in FILE conforms to the schema.
 conforms() { "$SCHEMA_CHECK" "$SCHEMA" "$1" || fail "$1 does not conform to the schema"; }
 # png_size FILE: prints "WIDTH HEIGHT" from the PNG signature and IHDR chunk, or fails.

@@ -13,28 +13,8 @@ set -euo pipefail
 : "${VFF_CONVERT:?}" "${VFF_INSPECT:?}" "${CHECK:?}" "${WORK:?}"
 
 # ---- Helpers ---------------------------------------------------------------------------------------
-fail() {
-  echo "FAIL: $*" >&2
-  exit 1
-}
-show() {
-  echo "--- stdout:" >&2
-  head -c 4000 "$WORK/out" >&2 || true
-  echo "--- stderr:" >&2
-  head -c 3000 "$WORK/err" >&2 || true
-}
-# run CMD...: runs CMD with stdout in $WORK/out, stderr in $WORK/err and the exit code in RC.
-run() {
-  set +e
-  "$@" >"$WORK/out" 2>"$WORK/err"
-  RC=$?
-  set -e
-}
+source "$(dirname "${BASH_SOURCE[0]}")/../common/cli_harness.sh"
 convert() { run "$VFF_CONVERT" "$@"; }
-expect_rc() { [[ $RC -eq $1 ]] || { show; fail "exit code $RC, expected $1"; }; }
-expect_out() { grep -q -F -e "$1" "$WORK/out" || { show; fail "stdout lacks: $1"; }; }
-expect_err() { grep -q -F -e "$1" "$WORK/err" || { show; fail "stderr lacks: $1"; }; }
-expect_no_err() { [[ ! -s $WORK/err ]] || { show; fail "stderr is not empty"; }; }
 # field OUT ENCODING [ARGS...]: writes a test field (see convert_check.cpp).
 field() { "$CHECK" write "$@" || fail "convert_check write $*"; }
 # same A B [--normal-tolerance K]: A and B hold the same field, metadata and maps.
