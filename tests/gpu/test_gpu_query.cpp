@@ -553,6 +553,9 @@ TEST(GpuLoader, RejectsLayoutBeyondTheContextLimits) {
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.error().code, Code::kUnsupported);
   EXPECT_NE(r.error().message.find("GL_MAX_TEXTURE_SIZE is 128"), std::string::npos) << r.error().message;
+  // ...and says which layout would fit, and how to repack into it.
+  EXPECT_NE(r.error().message.find("a layout that fits: "), std::string::npos) << r.error().message;
+  EXPECT_NE(r.error().message.find("--max-texture-size 128"), std::string::npos) << r.error().message;
   o = {};
   o.maxLayers = 1;
   r = gl::loadField(*file, o);

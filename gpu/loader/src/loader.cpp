@@ -77,9 +77,25 @@ struct SavedState {
   }
 };
 
-Error limitError(const char* limit, uint32_t value, const std::string& need) {
-  return makeError(Code::kUnsupported, std::string("the field's packed layout does not fit this GL context: ") +
-                                           limit + " is " + std::to_string(value) + ", the layout needs " + need);
+// The message names the limit, what the file's layout needs, and a layout that fits the context
+// (with the vff-convert options that repack the file into it), or says that none does.
+Error limitError(const char* limit, uint32_t value, const std::string& need, const FieldDesc& field,
+                 const LayoutDesc& layout, uint32_t maxSize, uint32_t maxLayers) {
+  std::string msg = std::string("the field's packed layout does not fit this GL context: ") + limit + " is " +
+                    std::to_string(value) + ", the layout needs " + need;
+  LayoutLimits fit;
+  fit.target = layout.target;
+  fit.maxTextureSize = maxSize;
+  fit.maxLayers = maxLayers;
+  fit.gutter = layout.gutter;
+  if (auto l = computeLayout(field, fit); l.ok()) {
+    msg += "; a layout that fits: " + std::to_string(l->sliceCount) + " slice(s) of " + std::to_string(l->sliceWidth) +
+           "x" + std::to_string(l->sliceHeight) + " (vff-convert IN.vff --to vff OUT.vff --max-texture-size " +
+           std::to_string(maxSize) + " --max-layers " + std::to_string(maxLayers) + ")";
+  } else {
+    msg += "; no layout of these maps fits it";
+  }
+  return makeError(Code::kUnsupported, msg);
 }
 
 }  // namespace
@@ -200,11 +216,14 @@ Result<GpuField> loadField(const File& file, const LoadOptions& options) {
   const bool bit1 = field.distanceEncoding == DistanceEncoding::kBit1;
   const uint32_t width = bit1 ? layout.sliceWidth / 8 : layout.sliceWidth;
   if (width > maxSize)
-    return limitError(sizeName, maxSize, "slices " + std::to_string(width) + " texels wide");
+    return limitError(sizeName, maxSize, "slices " + std::to_string(width) + " texels wide", field, layout, maxSize,
+                      maxLayers);
   if (layout.sliceHeight > maxSize)
-    return limitError(sizeName, maxSize, "slices " + std::to_string(layout.sliceHeight) + " texels high");
+    return limitError(sizeName, maxSize, "slices " + std::to_string(layout.sliceHeight) + " texels high", field,
+                      layout, maxSize, maxLayers);
   if (layout.sliceCount > maxLayers)
-    return limitError(layerName, maxLayers, std::to_string(layout.sliceCount) + " slices");
+    return limitError(layerName, maxLayers, std::to_string(layout.sliceCount) + " slices", field, layout, maxSize,
+                      maxLayers);
 
   GLenum internalFormat = GL_R8UI, type = GL_UNSIGNED_BYTE;
   switch (field.distanceEncoding) {
