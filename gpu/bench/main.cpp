@@ -18,9 +18,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <random>
-#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -38,39 +36,8 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
-std::string readText(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
 GLuint buildProgram(const std::string& body, std::string* log) {
-  const std::string src = "#version 430\n#define VFF_NO_NORMALS\n" + readText(std::string(VFF_GLSL_DIR) + "/vff_query.glsl") + body;
-  const char* p = src.c_str();
-  GLuint sh = glCreateShader(GL_COMPUTE_SHADER);
-  glShaderSource(sh, 1, &p, nullptr);
-  glCompileShader(sh);
-  GLint ok = 0;
-  char buf[8192] = {};
-  glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    glGetShaderInfoLog(sh, sizeof(buf), nullptr, buf);
-    *log = buf;
-    return 0;
-  }
-  GLuint prog = glCreateProgram();
-  glAttachShader(prog, sh);
-  glLinkProgram(prog);
-  glDeleteShader(sh);
-  glGetProgramiv(prog, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    glGetProgramInfoLog(prog, sizeof(buf), nullptr, buf);
-    *log = buf;
-    glDeleteProgram(prog);
-    return 0;
-  }
-  return prog;
+  return vff::test::buildQueryProgram("#define VFF_NO_NORMALS\n", body, log);
 }
 
 const char* kRayShader = R"(

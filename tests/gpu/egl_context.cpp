@@ -5,6 +5,8 @@
 #include <GL/glcorearb.h>
 
 #include <cstring>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 namespace vff::test {
@@ -90,6 +92,38 @@ HeadlessGl make() {
 const HeadlessGl& headlessGl() {
   static const HeadlessGl gl = make();
   return gl;
+}
+
+unsigned buildQueryProgram(const std::string& defines, const std::string& body, std::string* log) {
+  std::ifstream include(std::string(VFF_GLSL_DIR) + "/vff_query.glsl");
+  std::stringstream text;
+  text << include.rdbuf();
+  const std::string src = "#version 430\n" + defines + text.str() + body;
+  const char* p = src.c_str();
+  const GLuint sh = glCreateShader(GL_COMPUTE_SHADER);
+  glShaderSource(sh, 1, &p, nullptr);
+  glCompileShader(sh);
+  GLint ok = 0;
+  char buf[8192] = {};
+  glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    glGetShaderInfoLog(sh, sizeof(buf), nullptr, buf);
+    glDeleteShader(sh);
+    *log = std::string("compile: ") + buf;
+    return 0;
+  }
+  const GLuint prog = glCreateProgram();
+  glAttachShader(prog, sh);
+  glLinkProgram(prog);
+  glDeleteShader(sh);
+  glGetProgramiv(prog, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    glGetProgramInfoLog(prog, sizeof(buf), nullptr, buf);
+    glDeleteProgram(prog);
+    *log = std::string("link: ") + buf;
+    return 0;
+  }
+  return prog;
 }
 
 }  // namespace vff::test

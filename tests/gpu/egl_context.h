@@ -15,4 +15,8 @@ struct HeadlessGl {
 // Makes (once per process) a GL 4.3 core context current on the calling thread.
 const HeadlessGl& headlessGl();
 
+// Compiles and links a compute program from "#version 430", `defines`, gpu/glsl/vff_query.glsl
+// and `body` (GL has no #include). Returns the program, or 0 with the compile or link log in *log.
+unsigned buildQueryProgram(const std::string& defines, const std::string& body, std::string* log);
+
 }  // namespace vff::test

@@ -15,9 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <random>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -43,32 +41,11 @@ constexpr double kInterpVis = 1e-4;
     if (!gl_.ok) GTEST_SKIP() << "no headless OpenGL 4.3 context: " << gl_.error; \
   } while (0)
 
-std::string readText(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
 GLuint buildProgram(bool maps3D, const std::string& body) {
-  const std::string src = std::string("#version 430\n") + (maps3D ? "#define VFF_MAPS_3D\n" : "") +
-                          readText(std::string(VFF_GLSL_DIR) + "/vff_query.glsl") + body;
-  const char* p = src.c_str();
-  GLuint sh = glCreateShader(GL_COMPUTE_SHADER);
-  glShaderSource(sh, 1, &p, nullptr);
-  glCompileShader(sh);
-  GLint ok = 0;
-  glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
-  char log[8192] = {};
-  glGetShaderInfoLog(sh, sizeof(log), nullptr, log);
-  EXPECT_TRUE(ok) << log;
-  GLuint prog = glCreateProgram();
-  glAttachShader(prog, sh);
-  glLinkProgram(prog);
-  glDeleteShader(sh);
-  glGetProgramiv(prog, GL_LINK_STATUS, &ok);
-  EXPECT_TRUE(ok);
-  return ok ? prog : 0;
+  std::string log;
+  const GLuint prog = test::buildQueryProgram(maps3D ? "#define VFF_MAPS_3D\n" : "", body, &log);
+  EXPECT_NE(prog, 0u) << log;
+  return prog;
 }
 
 // One ray per invocation: both reconstructions.

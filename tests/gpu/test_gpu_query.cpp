@@ -19,9 +19,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <random>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -52,12 +50,6 @@ float dot3(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
 // ---- GL plumbing -----------------------------------------------------------------------------------
 
-std::string readText(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
 
 // The test's compute shader: one ray per invocation.
 const char* kMain = R"(
@@ -100,32 +92,9 @@ static_assert(sizeof(GpuRay) == 48 && sizeof(GpuOut) == 32);
 
 // Compiles the program (2D array or 3D slices); empty string on success, else the log.
 std::string buildProgram(bool maps3D, GLuint* program) {
-  const std::string src = std::string("#version 430\n") + (maps3D ? "#define VFF_MAPS_3D\n" : "") +
-                          readText(std::string(VFF_GLSL_DIR) + "/vff_query.glsl") + kMain;
-  const char* p = src.c_str();
-  GLuint sh = glCreateShader(GL_COMPUTE_SHADER);
-  glShaderSource(sh, 1, &p, nullptr);
-  glCompileShader(sh);
-  GLint ok = 0;
-  glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
-  char log[8192] = {};
-  if (!ok) {
-    glGetShaderInfoLog(sh, sizeof(log), nullptr, log);
-    glDeleteShader(sh);
-    return std::string("compile: ") + log;
-  }
-  GLuint prog = glCreateProgram();
-  glAttachShader(prog, sh);
-  glLinkProgram(prog);
-  glDeleteShader(sh);
-  glGetProgramiv(prog, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    glGetProgramInfoLog(prog, sizeof(log), nullptr, log);
-    glDeleteProgram(prog);
-    return std::string("link: ") + log;
-  }
-  *program = prog;
-  return {};
+  std::string log;
+  *program = test::buildQueryProgram(maps3D ? "#define VFF_MAPS_3D\n" : "", kMain, &log);
+  return log;
 }
 
 // Runs the rays through the shader.
@@ -467,27 +436,16 @@ INSTANTIATE_TEST_SUITE_P(Valid, GpuConformance, ::testing::ValuesIn(validVectors
 // Runs `body` (GLSL statements that write vec4 res[8] for invocation id < count) after the include;
 // returns 8 vec4 per invocation.
 std::vector<float> runProbe(const std::string& body, uint32_t count) {
-  const std::string src = std::string("#version 430\n") + readText(std::string(VFF_GLSL_DIR) + "/vff_query.glsl") +
-                          "layout(local_size_x = 64) in;\n"
-                          "layout(std430, binding = 4) writeonly buffer ProbeOut { vec4 outs[]; };\n"
-                          "void main() { uint id = gl_GlobalInvocationID.x; if (id >= " +
-                          std::to_string(count) + "u) return; vec4 res[8];\n for (int q = 0; q < 8; ++q) res[q] = vec4(0.0);\n" + body +
-                          "\n for (int q = 0; q < 8; ++q) outs[8u * id + uint(q)] = res[q]; }\n";
-  const char* p = src.c_str();
-  GLuint sh = glCreateShader(GL_COMPUTE_SHADER);
-  glShaderSource(sh, 1, &p, nullptr);
-  glCompileShader(sh);
-  GLint ok = 0;
-  glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
-  char log[8192] = {};
-  glGetShaderInfoLog(sh, sizeof(log), nullptr, log);
-  EXPECT_TRUE(ok) << log;
-  GLuint prog = glCreateProgram();
-  glAttachShader(prog, sh);
-  glLinkProgram(prog);
-  glDeleteShader(sh);
-  glGetProgramiv(prog, GL_LINK_STATUS, &ok);
-  EXPECT_TRUE(ok);
+  std::string log;
+  const GLuint prog = test::buildQueryProgram(
+      "",
+      "layout(local_size_x = 64) in;\n"
+      "layout(std430, binding = 4) writeonly buffer ProbeOut { vec4 outs[]; };\n"
+      "void main() { uint id = gl_GlobalInvocationID.x; if (id >= " +
+          std::to_string(count) + "u) return; vec4 res[8];\n for (int q = 0; q < 8; ++q) res[q] = vec4(0.0);\n" + body +
+          "\n for (int q = 0; q < 8; ++q) outs[8u * id + uint(q)] = res[q]; }\n",
+      &log);
+  EXPECT_NE(prog, 0u) << log;
   GLuint buf;
   glGenBuffers(1, &buf);
   glBindBuffer(GL_SHADER_STORAGE_BUFFER, buf);
