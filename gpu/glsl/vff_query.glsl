@@ -213,22 +213,10 @@ vec3 vffSquareToHemisphere(uint scheme, vec2 uv) {
   return vec3(s * cos(phi), s * sin(phi), 1.0 - r2);
 }
 
-// cos(alpha) of the direction through square point uv: the z of vffSquareToHemisphere, computed
-// without sin and cos (bit-identical to the CPU's texelDirection(...).z).
+// cos(alpha) of the direction through square point uv: the z of vffSquareToHemisphere (which does
+// not depend on its sin and cos, so compilers drop them).
 float vffSquareToCosAlpha(uint scheme, vec2 uv) {
-  precise float a = clamp(uv.x, -1.0, 1.0);
-  precise float b = clamp(uv.y, -1.0, 1.0);
-  if (scheme == VFF_DIRECTION_HEMI_OCTAHEDRAL) {
-    precise float x = (a + b) * 0.5;
-    precise float y = (a - b) * 0.5;
-    precise float z = 1.0 - abs(x) - abs(y);
-    precise float ss = x * x + y * y + z * z;
-    precise float len = vffSqrt(ss);
-    return vffDivide(z, len);
-  }
-  precise float r = (a == 0.0 && b == 0.0) ? 0.0 : (abs(a) > abs(b) ? a : b);
-  precise float c = 1.0 - r * r;
-  return c;
+  return vffSquareToHemisphere(scheme, uv).z;
 }
 
 ivec2 vffSquareToTexel(vec2 uv, int M) {
