@@ -59,6 +59,7 @@ struct FieldQuery::Impl {
   float spacing = 0;                 // mean angular spacing sqrt(4 pi / mapCount)
   float kernelRadius2 = 0;           // squared chord radius of the interpolation kernel
   float defaultBias = 0;             // fraction of R
+  std::vector<float> chordScale;     // unorm8-chord: 2R cos(alpha) / 254 per texel (M * M)
   uint64_t payload = 0;
 
   Sample texel(uint32_t k, uint32_t i, uint32_t j) const noexcept {
@@ -75,8 +76,7 @@ struct FieldQuery::Impl {
       }
       case DistanceEncoding::kUnorm8Chord: {
         const uint32_t c = map[t];
-        const float cosAlpha = texelDirection(field.directionScheme, m, i, j).z;
-        return {c != 255u, float(c) * (2.0f * radius * cosAlpha / 254.0f)};
+        return {c != 255u, float(c) * chordScale[t]};
       }
       case DistanceEncoding::kBit1:
         return {((map[t / 8] >> (t % 8)) & 1u) != 0, 0.0f};
@@ -158,6 +158,12 @@ void FieldQuery::Impl::build() {
   const float r = kQueryKernelSpacings * spacing;
   kernelRadius2 = r * r;
   defaultBias = defaultIntraBias(field);
+  if (field.distanceEncoding == DistanceEncoding::kUnorm8Chord) {
+    chordScale.resize(size_t(m) * m);
+    for (uint32_t j = 0; j < m; ++j)
+      for (uint32_t i = 0; i < m; ++i)
+        chordScale[size_t(j) * m + i] = 2.0f * radius * texelDirection(field.directionScheme, m, i, j).z / 254.0f;
+  }
   neighbours = queryNeighbours(positions);
 }
 

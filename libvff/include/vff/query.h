@@ -104,7 +104,8 @@ struct QueryHit {
 
 // A query-ready view of one field. Borrows its maps: from a File (which must outlive the
 // FieldQuery) or from caller memory. Holds a small table per positional sample (its position,
-// tangent frame and neighbour list: 80 bytes per map), nothing per texel.
+// tangent frame and neighbour list: 80 bytes per map) and, for unorm8-chord, the decode scale of
+// each texel of a map (4 bytes per texel of one map).
 class FieldQuery {
  public:
   FieldQuery() noexcept;  // empty: every ray misses
