@@ -132,29 +132,40 @@ Status checkPly(const std::string& path) {
         }
     return {};
   }
-  // Binary: walk the rows through the file's bytes.
+  // Binary: walk the rows through the file, reading only the list lengths. Elements without lists
+  // have a fixed row size and are stepped over whole.
   const bool little = format == "binary_little_endian";
-  const std::streamoff bodyStart = in.tellg();
+  const uint64_t bodyStart = uint64_t(in.tellg());
   in.seekg(0, std::ios::end);
   const uint64_t size = uint64_t(in.tellg());
-  uint64_t pos = uint64_t(bodyStart);
-  in.seekg(bodyStart);
-  std::vector<char> body(size - pos);
-  in.read(body.data(), std::streamsize(body.size()));
-  pos = 0;
-  for (size_t e = 0; e < elements.size(); ++e)
-    for (uint64_t row = 0; row < elements[e].count && !elements[e].properties.empty(); ++row)
-      for (const Property& pr : elements[e].properties) {
+  uint64_t pos = bodyStart;
+  auto ends = [&](size_t e, uint64_t row) {
+    return makeError(Code::kMeshParse, path + ": element " + std::to_string(e) + " row " + std::to_string(row) +
+                                           ": the file ends inside the body");
+  };
+  for (size_t e = 0; e < elements.size(); ++e) {
+    const Element& el = elements[e];
+    bool hasList = false;
+    uint64_t rowBytes = 0;
+    for (const Property& pr : el.properties) {
+      hasList = hasList || pr.list;
+      rowBytes += uint64_t(pr.itemSize);
+    }
+    if (!hasList) {
+      if (rowBytes != 0 && el.count > (size - pos) / rowBytes) return ends(e, (size - pos) / rowBytes);
+      pos += el.count * rowBytes;
+      continue;
+    }
+    for (uint64_t row = 0; row < el.count; ++row)
+      for (const Property& pr : el.properties) {
         uint64_t items = 1;
         if (pr.list) {
-          if (pos + uint64_t(pr.countSize) > body.size())
-            return makeError(Code::kMeshParse, path + ": element " + std::to_string(e) + " row " + std::to_string(row) +
-                                                   ": the file ends inside the body");
+          if (pos + uint64_t(pr.countSize) > size) return ends(e, row);
+          unsigned char bytes[4] = {};
+          in.seekg(std::streamoff(pos));
+          in.read(reinterpret_cast<char*>(bytes), pr.countSize);
           uint64_t v = 0;
-          for (int b = 0; b < pr.countSize; ++b) {
-            const uint64_t byte = uint8_t(body[size_t(pos) + size_t(little ? b : pr.countSize - 1 - b)]);
-            v |= byte << (8 * b);
-          }
+          for (int k = 0; k < pr.countSize; ++k) v |= uint64_t(bytes[little ? k : pr.countSize - 1 - k]) << (8 * k);
           const bool negative = pr.countSigned && (v >> (8 * pr.countSize - 1)) != 0;
           if (negative || v > kMaxList)
             return makeError(Code::kMeshParse, path + ": element " + std::to_string(e) + " row " + std::to_string(row) +
@@ -163,10 +174,9 @@ Status checkPly(const std::string& path) {
           pos += uint64_t(pr.countSize);
         }
         pos += items * uint64_t(pr.itemSize);
-        if (pos > body.size())
-          return makeError(Code::kMeshParse, path + ": element " + std::to_string(e) + " row " + std::to_string(row) +
-                                                 ": the file ends inside the body");
+        if (pos > size) return ends(e, row);
       }
+  }
   return {};
 }
 
