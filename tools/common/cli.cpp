@@ -121,10 +121,14 @@ std::string hex(uint64_t value) {
   return buf;
 }
 
-std::string hex64(uint64_t value) {
+std::string hexDigits64(uint64_t value) {
   char buf[24];
-  (void)std::snprintf(buf, sizeof buf, "0x%016" PRIx64, value);
+  (void)std::snprintf(buf, sizeof buf, "%016" PRIx64, value);
   return buf;
+}
+
+std::string hex64(uint64_t value) {
+  return "0x" + hexDigits64(value);
 }
 
 Result<std::vector<uint8_t>> readStdin() {

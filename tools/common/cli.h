@@ -94,6 +94,8 @@ std::string formatBytes(uint64_t bytes);
 std::string hex(uint64_t value);
 // "0x0123456789abcdef" (always 16 digits, for checksums)
 std::string hex64(uint64_t value);
+// "0123456789abcdef": the same without the prefix (the spelling of vff.source.xxh3 in META)
+std::string hexDigits64(uint64_t value);
 
 // ---- Files --------------------------------------------------------------------------------------
 // The whole of standard input (for a FILE argument of "-"). Fails with kIoRead.

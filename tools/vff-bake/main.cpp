@@ -216,7 +216,7 @@ int main(int argc, char** argv) {
   nlohmann::json meta = {
       {"vff.generator", "vff-bake"},
       {"vff.generatorVersion", vff::kLibraryVersion},
-      {"vff.source", {{"name", baseName(o.mesh)}, {"format", info.format}, {"xxh3", vff::cli::hex64(vff::bake::meshHash(*mesh)).substr(2)},
+      {"vff.source", {{"name", baseName(o.mesh)}, {"format", info.format}, {"xxh3", vff::cli::hexDigits64(vff::bake::meshHash(*mesh))},
                       {"vertices", mesh->vertexCount()}, {"triangles", mesh->triangleCount()}}},
       {"vff.bake", {{"rayOrigin", "texel centre"}, {"sphere", bo.sphere ? "user" : "minimal-enclosing"},
                     {"twoSided", true}, {"normals", o.normals ? (mesh->normals.empty() ? "geometric" : "interpolated") : "none"}}}};
