@@ -3,6 +3,7 @@
 #include <xxhash.h>
 #include <zstd.h>
 
+#include <new>
 #include <cstring>
 #include <string>
 
@@ -81,6 +82,28 @@ Status decompress(Codec codec, std::span<const uint8_t> stored, std::span<uint8_
     }
   }
   return makeError(failCode, "unknown codec " + std::to_string(unsigned(codec)));
+}
+
+Status decodeBlock(Codec codec, Filter filter, const BlockShape& shape, std::span<const uint8_t> stored,
+                   std::span<uint8_t> out, Code failCode) {
+  if (filter == Filter::kNone) return decompress(codec, stored, out, failCode);
+  if (codec != Codec::kZstd) return makeError(failCode, "a filtered block must use codec zstd");
+  const unsigned long long content = ZSTD_getFrameContentSize(stored.data(), stored.size());
+  if (content == ZSTD_CONTENTSIZE_ERROR) return makeError(failCode, "not a zstd frame");
+  if (content == ZSTD_CONTENTSIZE_UNKNOWN) return makeError(failCode, "zstd frame does not declare its content size");
+  const uint64_t bound = filteredBound(filter, out.size());
+  if (content > bound)
+    return makeError(failCode, "zstd frame declares " + std::to_string(content) + " bytes, more than the " +
+                                   std::to_string(bound) + " a " + filterName(filter) + " block of " +
+                                   std::to_string(out.size()) + " bytes can hold");
+  std::vector<uint8_t> filtered;
+  try {
+    filtered.resize(size_t(content));
+  } catch (const std::bad_alloc&) {
+    return makeError(Code::kOutOfMemory, "cannot allocate a filtered block");
+  }
+  if (Status st = decompress(codec, stored, filtered, failCode); !st) return st;
+  return unapplyFilter(filter, shape, filtered, out, failCode);
 }
 
 }  // namespace vff::detail

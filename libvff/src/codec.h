@@ -7,6 +7,7 @@
 
 #include "vff/error.h"
 #include "vff/format.h"
+#include "filter.h"
 
 namespace vff::detail {
 
@@ -33,5 +34,11 @@ Status compress(Codec codec, int level, std::span<const uint8_t> raw, std::vecto
 // content size equals out.size(); anything else is an error with code `failCode`.
 Status decompress(Codec codec, std::span<const uint8_t> stored, std::span<uint8_t> out,
                   Code failCode);
+
+// Decodes a plane block's stored bytes (its codec, then its filter) into exactly out.size() bytes
+// (the block's rawSize). A filtered frame may declare at most filteredBound() bytes, so a hostile
+// one cannot make the decoder allocate more than that.
+Status decodeBlock(Codec codec, Filter filter, const BlockShape& shape, std::span<const uint8_t> stored,
+                   std::span<uint8_t> out, Code failCode);
 
 }  // namespace vff::detail

@@ -14,7 +14,11 @@ const char* codecName(Codec codec) noexcept {
 }
 
 const char* filterName(Filter filter) noexcept {
-  return filter == Filter::kNone ? "none" : "unknown";
+  switch (filter) {
+    case Filter::kNone: return "none";
+    case Filter::kHitsMed: return "hits-med";
+  }
+  return "unknown";
 }
 
 const char* positionSchemeName(PositionScheme s) noexcept {

@@ -506,9 +506,29 @@ class Parser {
           return false;
       }
       if (blk.filter != Filter::kNone) {
-        ok = false;
-        if (!report(Code::kBlockFilter, tag, where + 21, "block " + num(bi) + " has unknown filter " + num(e[21])))
-          return false;
+        if (blk.filter != Filter::kHitsMed) {
+          ok = false;
+          if (!report(Code::kBlockFilter, tag, where + 21, "block " + num(bi) + " has unknown filter " + num(e[21])))
+            return false;
+        } else if (!filterApplies(blk.filter, plane, f)) {
+          ok = false;
+          if (!report(Code::kBlockFilter, tag, where + 21,
+                      "block " + num(bi) + " uses filter hits-med, which applies only to distance planes with an "
+                      "8-bit encoding, not to this " + std::string(planeName(plane)) + " plane of " +
+                      (plane == Plane::kDistance ? distanceEncodingName(f.distanceEncoding)
+                                                 : normalEncodingName(f.normalEncoding))))
+            return false;
+        } else if (blk.codec != Codec::kZstd) {
+          ok = false;
+          if (!report(Code::kBlockFilter, tag, where + 21,
+                      "block " + num(bi) + " uses filter hits-med with codec " + codecName(blk.codec) +
+                          "; a filtered block must use zstd"))
+            return false;
+        } else if (!(out_->info.incompatFeatures & kFeatureFilters)) {
+          if (!report(Code::kFeatureBit, tag, where + 21,
+                      "block " + num(bi) + " uses a filter but the filters feature bit (incompatFeatures bit 1) is clear"))
+            return false;
+        }
       }
       if (ok && opt_.verifyPlaneChecksums &&
           xxh3(sec.subspan(rel, blk.storedSize)) != blk.checksum) {

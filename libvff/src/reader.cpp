@@ -66,7 +66,7 @@ struct File::Impl {
         c.error = makeError(Code::kOutOfMemory, "cannot allocate a decoded block", tag, b.offset);
         return;
       }
-      Status st = detail::decompress(b.codec, stored, c.data, Code::kBlockDecode);
+      Status st = detail::decodeBlock(b.codec, b.filter, {parsed.field.mapResolution}, stored, c.data, Code::kBlockDecode);
       if (!st) {
         c.error = makeError(Code::kBlockDecode, "block " + std::to_string(bi) + ": " + st.error().message, tag, b.offset);
         std::vector<uint8_t>().swap(c.data);
@@ -155,7 +155,7 @@ Status File::decodeBlock(Plane p, uint32_t block, std::span<uint8_t> out) const 
   auto stored = impl_->bytes.subspan(b.offset, b.storedSize);
   if (impl_->options.checksums == ChecksumPolicy::kLazy && detail::xxh3(stored) != b.checksum)
     return makeError(Code::kBlockChecksum, "block checksum does not match", p == Plane::kDistance ? kTagDistance : kTagNormal, b.offset);
-  Status st = detail::decompress(b.codec, stored, out, Code::kBlockDecode);
+  Status st = detail::decodeBlock(b.codec, b.filter, {field().mapResolution}, stored, out, Code::kBlockDecode);
   if (!st) return makeError(Code::kBlockDecode, st.error().message, p == Plane::kDistance ? kTagDistance : kTagNormal, b.offset);
   return {};
 }

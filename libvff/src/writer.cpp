@@ -125,6 +125,7 @@ struct PlaneState {
   std::vector<uint8_t> pending;  // raw bytes of the current, incomplete block
   std::vector<uint8_t> index;    // block entries
   bool anyZstd = false;
+  bool anyFilter = false;
   bool done = false;
 };
 
@@ -231,7 +232,9 @@ struct Writer::Impl {
     PlaneState& ps = planes[size_t(p)];
     std::vector<std::vector<uint8_t>> stored(raws.size());
     std::vector<Codec> codecs(raws.size(), options.codec);
+    std::vector<Filter> filters(raws.size(), Filter::kNone);
     std::vector<Status> status(raws.size());
+    const Filter tryFilter = p == Plane::kDistance ? options.filter : Filter::kNone;
     if (options.codec == Codec::kStored) {
       for (size_t i = 0; i < raws.size(); ++i) codecs[i] = Codec::kStored;
     } else {
@@ -239,8 +242,18 @@ struct Writer::Impl {
       auto work = [&] {
         for (size_t i; (i = next++) < raws.size();) {
           status[i] = detail::compress(options.codec, options.zstdLevel, raws[i], &stored[i]);
+          if (status[i] && tryFilter != Filter::kNone) {  // keep the filtered frame only when smaller
+            std::vector<uint8_t> filtered;
+            status[i] = detail::compress(options.codec, options.zstdLevel,
+                                         detail::applyFilter(tryFilter, {field.mapResolution}, raws[i]), &filtered);
+            if (status[i] && filtered.size() < stored[i].size()) {
+              stored[i].swap(filtered);
+              filters[i] = tryFilter;
+            }
+          }
           if (status[i] && stored[i].size() >= raws[i].size()) {  // incompressible: store it
             codecs[i] = Codec::kStored;
+            filters[i] = Filter::kNone;
             std::vector<uint8_t>().swap(stored[i]);
           }
         }
@@ -259,7 +272,8 @@ struct Writer::Impl {
       store<uint64_t>(e + 8, bytes.size());
       store<uint32_t>(e + 16, uint32_t(raws[i].size()));
       e[20] = uint8_t(codecs[i]);
-      e[21] = uint8_t(Filter::kNone);
+      e[21] = uint8_t(filters[i]);
+      if (filters[i] != Filter::kNone) ps.anyFilter = true;
       store<uint64_t>(e + 24, detail::xxh3(bytes));
       if (codecs[i] == Codec::kZstd) ps.anyZstd = true;
       Status st = sink->write(ps.sectionOffset + ps.nextBlock, bytes);
@@ -367,12 +381,14 @@ struct Writer::Impl {
     for (const auto& s : sections)
       if (s.codec == Codec::kZstd) incompat |= kFeatureZstd;
     if (planes[0].anyZstd || planes[1].anyZstd) incompat |= kFeatureZstd;
+    if (planes[0].anyFilter || planes[1].anyFilter) incompat |= kFeatureFilters;
     const SectionRecord& last = sections.back();
     const uint64_t fileSize = last.offset + last.storedSize;
     std::vector<uint8_t> head(kHeaderSize + sections.size() * kSectionEntrySize, 0);
     std::copy(std::begin(kMagic), std::end(kMagic), head.begin());
     store<uint16_t>(&head[8], kVersionMajor);
-    store<uint16_t>(&head[10], kVersionMinor);
+    // The lowest version that holds the file: 1.0 unless a 1.1 feature (a filter) is used.
+    store<uint16_t>(&head[10], uint16_t((incompat & kFeatureFilters) ? 1 : 0));
     store<uint32_t>(&head[12], kHeaderSize);
     store<uint64_t>(&head[16], fileSize);
     store<uint64_t>(&head[24], incompat);
@@ -422,6 +438,15 @@ Result<std::unique_ptr<Writer::Impl>> prepare(const FieldDesc& field, const Writ
     return makeError(Code::kInvalidArgument, "unknown codec");
   if (options.codec == Codec::kZstd && (options.zstdLevel < 1 || options.zstdLevel > 22))
     return makeError(Code::kInvalidArgument, "zstd level must be in [1, 22]");
+  if (options.filter != Filter::kNone) {
+    if (options.filter != Filter::kHitsMed) return makeError(Code::kInvalidArgument, "unknown filter");
+    if (options.codec != Codec::kZstd)
+      return makeError(Code::kInvalidArgument, "a block filter needs codec zstd");
+    if (!detail::filterApplies(options.filter, Plane::kDistance, field))
+      return makeError(Code::kInvalidArgument, std::string("filter ") + filterName(options.filter) +
+                                                   " does not apply to the distance encoding " +
+                                                   distanceEncodingName(field.distanceEncoding));
+  }
   auto layout = computeLayout(field, options.layout);
   if (!layout) return std::move(layout).error();
   auto impl = std::make_unique<Writer::Impl>();

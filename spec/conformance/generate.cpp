@@ -212,6 +212,22 @@ struct Vff {
     sealAll();
   }
 
+  // Replaces the stored bytes of the last block of plane `tag`, which must be the file's last
+  // section: the block, section and file sizes follow, and everything is re-sealed.
+  void replaceLastBlock(uint32_t tag, std::span<const uint8_t> stored) {
+    const uint64_t e = entry(tag), off = sec(tag);
+    if (off + secSize(tag) != b.size()) die("replaceLastBlock: '" + sectionTagName(tag) + "' is not the last section");
+    const uint32_t last = blockCount(tag) - 1;
+    const uint64_t rel = blockRel(tag, last);
+    b.resize(off + rel);
+    b.insert(b.end(), stored.begin(), stored.end());
+    st64(b, blockEntry(tag, last) + 8, stored.size());
+    st64(b, e + 16, rel + stored.size());
+    st64(b, e + 24, rel + stored.size());
+    setFileSize();
+    sealAll();
+  }
+
   // Replaces a stored section's bytes (it must keep fitting before the next section).
   void replaceStored(uint32_t tag, std::string_view text) {
     const uint64_t e = entry(tag), off = sec(tag), old = secSize(tag);
@@ -340,6 +356,67 @@ Content makeContent(const FieldDesc& f) {
       }
   }
   return c;
+}
+
+// ---- Filter 1 (hits-med), written from spec/format.md independently of libvff --------------------
+// The filtered stream of a block of 8-bit maps: the hit mask (bit t % 8 of byte t / 8 set for a hit
+// at block texel t), then one residual (code - prediction) mod 256 per hit, in texel order.
+uint8_t hitsMedPrediction(const uint8_t* map, uint32_t m, uint32_t x, uint32_t y, uint8_t last) {
+  auto at = [&](int xx, int yy) -> int {
+    if (xx < 0 || yy < 0) return -1;
+    const uint8_t c = map[uint32_t(yy) * m + uint32_t(xx)];
+    return c == 255 ? -1 : c;
+  };
+  const int a = at(int(x) - 1, int(y)), b = at(int(x), int(y) - 1), c = at(int(x) - 1, int(y) - 1);
+  if (a >= 0 && b >= 0) {
+    if (c < 0) return uint8_t((a + b) / 2);
+    if (c >= std::max(a, b)) return uint8_t(std::min(a, b));
+    if (c <= std::min(a, b)) return uint8_t(std::max(a, b));
+    return uint8_t(a + b - c);
+  }
+  if (a >= 0) return uint8_t(a);
+  if (b >= 0) return uint8_t(b);
+  if (c >= 0) return uint8_t(c);
+  return last;
+}
+
+Bytes hitsMedStream(std::span<const uint8_t> raw, uint32_t m) {
+  Bytes out((raw.size() + 7) / 8, 0);
+  for (size_t t = 0; t < raw.size(); ++t)
+    if (raw[t] != 255) out[t / 8] = uint8_t(out[t / 8] | 1u << (t % 8));
+  for (size_t first = 0; first < raw.size(); first += size_t(m) * m) {
+    uint8_t last = 0;
+    for (uint32_t y = 0; y < m; ++y)
+      for (uint32_t x = 0; x < m; ++x) {
+        const uint8_t code = raw[first + size_t(y) * m + x];
+        if (code == 255) continue;
+        out.push_back(uint8_t(code - hitsMedPrediction(&raw[first], m, x, y, last)));
+        last = code;
+      }
+  }
+  return out;
+}
+
+Bytes zstdFrame(std::span<const uint8_t> raw) {
+  Bytes out(ZSTD_compressBound(raw.size()));
+  ZSTD_CCtx* c = ZSTD_createCCtx();
+  ZSTD_CCtx_setParameter(c, ZSTD_c_compressionLevel, kZstdLevel);
+  ZSTD_CCtx_setParameter(c, ZSTD_c_contentSizeFlag, 1);
+  ZSTD_CCtx_setParameter(c, ZSTD_c_checksumFlag, 0);
+  ZSTD_CCtx_setParameter(c, ZSTD_c_dictIDFlag, 0);
+  const size_t n = ZSTD_compress2(c, out.data(), out.size(), raw.data(), raw.size());
+  ZSTD_freeCCtx(c);
+  if (ZSTD_isError(n)) die("zstd compression failed");
+  out.resize(n);
+  return out;
+}
+
+Bytes zstdContent(std::span<const uint8_t> frame) {
+  const unsigned long long n = ZSTD_getFrameContentSize(frame.data(), frame.size());
+  if (n == ZSTD_CONTENTSIZE_ERROR || n == ZSTD_CONTENTSIZE_UNKNOWN || n > (1u << 24)) die("not a sized zstd frame");
+  Bytes out(n);
+  if (ZSTD_decompress(out.data(), out.size(), frame.data(), frame.size()) != n) die("zstd frame does not decode");
+  return out;
 }
 
 // ---- The packed slices, composed independently of File::readSlice --------------------------------
@@ -521,6 +598,11 @@ std::vector<ValidCase> validCases() {
                makeField(DE::kBit1, NE::kOctSnorm16, PS::kSphericalFibonacci, 6, DS::kConcentricEqualArea, 16,
                          {{0.0f, 0.0f, -0.5f}, 1.0f}),
                makeOptions(Codec::kZstd, LT::kTexture3D, 0, 32, 5), true});
+  v.push_back({"u8d-zstd-hits-med",
+               "format 1.1: unorm8-diameter, zstd with filter 1 hits-med, octa-hemi2 n=2 (26 maps of 16x16), one block",
+               makeField(DE::kUnorm8Diameter, NE::kNone, PS::kOctaHemi2, 2, DS::kConcentricEqualArea, 16, unitish),
+               makeOptions(Codec::kZstd, LT::kTexture2DArray, 0, 2048, 26)});
+  v.back().options.filter = Filter::kHitsMed;
   ValidCase unknownOptional = v[0];
   unknownOptional.name = "unknown-section-optional";
   unknownOptional.description = "u8d-stored plus an unknown section 'XTST' with flags 0 (a reader skips it)";
@@ -660,9 +742,19 @@ std::string expectedJson(const BuiltValid& v) {
     s += std::string(firstPlane ? "" : ",") + "\n    " + jstr(tag == kTagDistance ? "distance" : "normal") +
          ": {\"mapBytes\": " + std::to_string(ld32(v.bytes, sec + 4)) +
          ", \"mapsPerBlock\": " + std::to_string(ld32(v.bytes, sec + 8)) + ", \"blockCodecs\": [";
-    for (uint32_t b = 0; b < file.blockCount(tag); ++b)
+    bool filtered = false;
+    for (uint32_t b = 0; b < file.blockCount(tag); ++b) {
       s += std::string(b ? ", " : "") + jstr(codecName(Codec(v.bytes[file.blockEntry(tag, b) + 20])));
-    s += "]}";
+      filtered |= v.bytes[file.blockEntry(tag, b) + 21] != 0;
+    }
+    s += "]";
+    if (filtered) {  // format 1.1 files only: the 1.0 vectors keep their expected text
+      s += ", \"blockFilters\": [";
+      for (uint32_t b = 0; b < file.blockCount(tag); ++b)
+        s += std::string(b ? ", " : "") + jstr(filterName(Filter(v.bytes[file.blockEntry(tag, b) + 21])));
+      s += "]";
+    }
+    s += "}";
     firstPlane = false;
   }
   s += "\n  },\n";
@@ -764,6 +856,28 @@ void checkValid(const BuiltValid& v) {
     if (!anyZstdBlock) fail(n + ": a zstd vector without any zstd block");
     if (v.c.metadata && ld16(v.bytes, file.entry(kTagMetadata) + 32) != 1) fail(n + ": metadata was not compressed");
   }
+  if (v.c.options.filter == Filter::kHitsMed) {
+    // Every distance block is filtered, and its frame holds exactly the stream the spec defines.
+    const uint64_t mb = distanceMapBytes(v.c.field.distanceEncoding, v.c.field.mapResolution);
+    const uint32_t g = ld32(v.bytes, file.sec(kTagDistance) + 8);
+    for (uint32_t b = 0; b < file.blockCount(kTagDistance); ++b) {
+      if (v.bytes[file.blockEntry(kTagDistance, b) + 21] != uint8_t(Filter::kHitsMed)) {
+        fail(n + ": distance block " + std::to_string(b) + " is not filtered");
+        continue;
+      }
+      const uint64_t first = uint64_t(b) * g * mb;
+      const uint64_t size = std::min<uint64_t>(uint64_t(g) * mb, v.content.distance.size() - first);
+      const auto raw = std::span<const uint8_t>(v.content.distance).subspan(first, size);
+      const auto stored = std::span<const uint8_t>(v.bytes).subspan(file.block(kTagDistance, b),
+                                                                     file.blockSize(kTagDistance, b));
+      if (zstdContent(stored) != hitsMedStream(raw, v.c.field.mapResolution))
+        fail(n + ": distance block " + std::to_string(b) + " does not hold the hits-med stream of its maps");
+    }
+    if (ld16(v.bytes, 10) != 1 || ld64(v.bytes, 24) != (kFeatureZstd | kFeatureFilters))
+      fail(n + ": a filtered file must be version 1.1 with incompatFeatures zstd | filters");
+  } else if (ld16(v.bytes, 10) != 0) {
+    fail(n + ": a file without 1.1 features must be version 1.0");
+  }
   if (v.content.hits == 0 || v.content.misses == 0) fail(n + ": the content needs both hits and misses");
 }
 
@@ -807,8 +921,8 @@ std::vector<InvalidCase> invalidCases(const std::map<std::string, BuiltValid>& v
     st16(v.b, 8, 2);
     v.sealHeader();
   });
-  add(2004, "incompat-bit1", A, "incompatFeatures bit 1 (unknown) set (header re-sealed)", [](Vff& v) {
-    st64(v.b, 24, 2);
+  add(2004, "incompat-bit2", A, "incompatFeatures bit 2 (unknown) set (header re-sealed)", [](Vff& v) {
+    st64(v.b, 24, 4);
     v.sealHeader();
   });
   // 3xxx: header
@@ -961,7 +1075,23 @@ std::vector<InvalidCase> invalidCases(const std::map<std::string, BuiltValid>& v
   edit(6006, "raw-size", Z, "zstd DIST block 0 rawSize 64 bytes too large",
        [&](Vff& v) { st32(v.b, v.blockEntry(D, 0) + 16, ld32(v.b, v.blockEntry(D, 0) + 16) + 64); });
   edit(6007, "codec-2", A, "DIST block 0 codec 2 (unknown)", [&](Vff& v) { v.b[v.blockEntry(D, 0) + 20] = 2; });
-  edit(6008, "filter-1", A, "DIST block 0 filter 1 (unknown)", [&](Vff& v) { v.b[v.blockEntry(D, 0) + 21] = 1; });
+  const std::string H = "u8d-zstd-hits-med";             // FDSC, LAYT, DIST (1 zstd block, filter hits-med)
+  edit(6008, "filter-2", H, "DIST block 0 filter 2 (unknown)", [&](Vff& v) { v.b[v.blockEntry(D, 0) + 21] = 2; });
+  edit(6008, "filter-on-stored-block", A, "DIST block 0 (stored) with filter 1 hits-med, filters bit set",
+       [&](Vff& v) {
+         v.b[v.blockEntry(D, 0) + 21] = 1;
+         st64(v.b, 24, ld64(v.b, 24) | kFeatureFilters);
+       });
+  edit(6008, "filter-on-normals", Z, "NORM block 0 (zstd) with filter 1 hits-med, filters bit set", [&](Vff& v) {
+    v.b[v.blockEntry(NM, 0) + 21] = 1;
+    st64(v.b, 24, ld64(v.b, 24) | kFeatureFilters);
+  });
+  edit(6008, "filter-on-unorm16", "u16d-zstd-normals-gutter2",
+       "unorm16-diameter DIST block 0 (zstd) with filter 1 hits-med, filters bit set", [&](Vff& v) {
+         if (v.b[v.blockEntry(D, 0) + 20] != 1) die("filter-on-unorm16: DIST block 0 is not zstd");
+         v.b[v.blockEntry(D, 0) + 21] = 1;
+         st64(v.b, 24, ld64(v.b, 24) | kFeatureFilters);
+       });
   add(6009, "checksum-field", A, "DIST block 0 checksum bit 0 flipped (section and header re-sealed)", [&](Vff& v) {
     v.b[v.blockEntry(D, 0) + 24] ^= 1;
     v.sealSections();
@@ -986,6 +1116,36 @@ std::vector<InvalidCase> invalidCases(const std::map<std::string, BuiltValid>& v
          }
          die("trailing-byte: no zstd block with a gap after it");
        });
+  // hits-med streams that are not what a writer makes (the one block of H is the file's last bytes).
+  auto refilter = [&](uint32_t id, std::string name, std::string what, std::function<void(Bytes&)> change) {
+    add(id, std::move(name), H, std::move(what), [change](Vff& v) {
+      Bytes stream = zstdContent(std::span<const uint8_t>(v.b).subspan(v.block(kTagDistance, 0),
+                                                                         v.blockSize(kTagDistance, 0)));
+      change(stream);
+      v.replaceLastBlock(kTagDistance, zstdFrame(stream));
+    });
+  };
+  const uint64_t hMaskBytes = valid.at(H).content.distance.size() / 8;
+  refilter(6010, "hits-med-missing-residual", "hits-med stream without its last residual",
+           [](Bytes& s) { s.pop_back(); });
+  refilter(6010, "hits-med-extra-residual", "hits-med stream with one residual more than the mask has hits",
+           [](Bytes& s) { s.push_back(0); });
+  refilter(6010, "hits-med-hit-decodes-to-miss",
+           "the first residual changed so that the first hit decodes to 255, the miss code", [&](Bytes& s) {
+             const Bytes& raw = valid.at(H).content.distance;
+             const uint32_t m = valid.at(H).c.field.mapResolution;
+             for (uint32_t t = 0; t < m * m; ++t)
+               if (raw[t] != 255) {
+                 s[hMaskBytes] = uint8_t(255 - hitsMedPrediction(raw.data(), m, t % m, t / m, 0));
+                 return;
+               }
+             die("hits-med-hit-decodes-to-miss: map 0 has no hit");
+           });
+  refilter(6010, "hits-med-frame-too-large",
+           "the zstd frame declares rawSize + rawSize/8 + 1 bytes, one more than any hits-med stream of the block",
+           [&](Bytes& s) { s.resize(valid.at(H).content.distance.size() + hMaskBytes + 1, 0); });
+  edit(6012, "filter-without-feature-bit", H, "a filtered block, incompatFeatures filters bit (1) clear",
+       [&](Vff& v) { st64(v.b, 24, kFeatureZstd); });
   edit(6011, "reserved", A, "DIST block entry reserved byte 22 is 1",
        [&](Vff& v) { v.b[v.blockEntry(D, 0) + 22] = 1; });
   edit(6012, "zstd-without-feature-bit", Z, "zstd sections and blocks, incompatFeatures zstd bit clear",

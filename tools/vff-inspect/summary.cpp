@@ -35,6 +35,8 @@ json featureJson(uint64_t bits, bool incompat) {
     if (!(bits & bit)) continue;
     if (incompat && bit == kFeatureZstd)
       names.push_back("zstd");
+    else if (incompat && bit == kFeatureFilters)
+      names.push_back("filters");
     else
       names.push_back("bit " + std::to_string(b));
   }

@@ -16,7 +16,7 @@ namespace vff {
 
 // ---- Versions and fixed sizes -----------------------------------------------------------------
 inline constexpr uint16_t kVersionMajor = 1;
-inline constexpr uint16_t kVersionMinor = 0;
+inline constexpr uint16_t kVersionMinor = 1;  // the newest minor version this library reads and writes
 inline constexpr uint8_t kMagic[8] = {0x89, 'V', 'F', 'F', 0x0D, 0x0A, 0x1A, 0x0A};
 inline constexpr uint32_t kHeaderSize = 64;
 inline constexpr uint32_t kSectionEntrySize = 64;
@@ -30,8 +30,9 @@ inline constexpr uint32_t kMaxMapResolution = 16384;  // so a map's bytes fit th
 
 // ---- Feature bits -----------------------------------------------------------------------------
 // incompatFeatures: a reader that does not implement a set bit must reject the file.
-inline constexpr uint64_t kFeatureZstd = 1u << 0;  // some block or section uses codec zstd
-inline constexpr uint64_t kKnownIncompatFeatures = kFeatureZstd;
+inline constexpr uint64_t kFeatureZstd = 1u << 0;     // some block or section uses codec zstd
+inline constexpr uint64_t kFeatureFilters = 1u << 1;  // some block uses a filter (format 1.1)
+inline constexpr uint64_t kKnownIncompatFeatures = kFeatureZstd | kFeatureFilters;
 // roCompatFeatures: none are defined in 1.0.
 inline constexpr uint64_t kKnownRoCompatFeatures = 0;
 
@@ -56,9 +57,13 @@ inline constexpr uint32_t kKnownSectionFlags = kSectionRequired | kSectionCopySa
 
 // ---- Codecs and filters ------------------------------------------------------------------------
 enum class Codec : uint16_t { kStored = 0, kZstd = 1 };
-enum class Filter : uint8_t { kNone = 0 };
+// A filter transforms a block's raw bytes before its codec (spec/format.md section 4).
+enum class Filter : uint8_t {
+  kNone = 0,
+  kHitsMed = 1,  // 1.1: hit mask + median-predicted hit codes; 8-bit distance planes, zstd blocks only
+};
 const char* codecName(Codec codec) noexcept;    // "stored", "zstd", "unknown"
-const char* filterName(Filter filter) noexcept;  // "none", "unknown"
+const char* filterName(Filter filter) noexcept;  // "none", "hits-med", "unknown"
 
 // ---- Sampling geometry -------------------------------------------------------------------------
 // Positional samples on the bounding sphere (spec/geometry.md).

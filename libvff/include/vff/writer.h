@@ -27,6 +27,11 @@ struct WriteOptions {
   Codec codec = Codec::kStored;  // block codec of both planes
   int zstdLevel = 19;            // 1..22, used when codec is kZstd
   uint32_t mapsPerBlock = 0;     // G; 0 picks the largest G with G * mapBytes <= 256 KiB (>= 1)
+  // Filter tried on every distance block before the codec (spec/format.md section 4): each block is
+  // compressed with and without it and the smaller is kept (a tie keeps the plain block). kHitsMed
+  // needs codec kZstd and an 8-bit distance encoding (else kInvalidArgument); a file that uses it is
+  // format 1.1 with incompatFeatures bit 1, which 1.0 readers reject.
+  Filter filter = Filter::kNone;
   LayoutLimits layout;           // limits for the packed slice layout
   // Metadata as a JSON object text, or empty for none. It is stored canonically (sorted keys,
   // no insignificant whitespace), so equal objects give equal bytes. Keys starting with "vff."
