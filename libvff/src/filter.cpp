@@ -19,23 +19,43 @@ namespace {
 
 constexpr uint8_t kMiss8 = 255;  // the miss code of unorm8-diameter and unorm8-chord
 
-// The prediction of texel (x, y) of a map from its already decoded neighbours (spec/format.md,
-// filter 1). `m` holds the map's codes so far; `last` is the previous hit of the map (0 before it).
-inline uint8_t predict(const uint8_t* m, uint32_t M, uint32_t x, uint32_t y, uint8_t last) noexcept {
-  const bool hasA = x > 0 && m[y * M + x - 1] != kMiss8;
-  const bool hasB = y > 0 && m[(y - 1) * M + x] != kMiss8;
-  const bool hasC = x > 0 && y > 0 && m[(y - 1) * M + x - 1] != kMiss8;
-  const int a = hasA ? m[y * M + x - 1] : 0;
-  const int b = hasB ? m[(y - 1) * M + x] : 0;
-  const int c = hasC ? m[(y - 1) * M + x - 1] : 0;
-  if (hasA && hasB) {
-    if (!hasC) return uint8_t((a + b) >> 1);
-    const int mx = std::max(a, b), mn = std::min(a, b);
-    return uint8_t(c >= mx ? mn : c <= mn ? mx : a + b - c);
+// The prediction of a hit from its left (a), upper (b) and upper-left (c) neighbours' codes, with
+// 255 standing for a neighbour that is a miss or outside the map (spec/format.md, filter 1); `last`
+// is the previous hit of the map (0 before the first).
+inline uint8_t predict(int a, int b, int c, uint8_t last) noexcept {
+  const int mx = std::max(a, b), mn = std::min(a, b);
+  if (mx != kMiss8) {  // the common case, a and b are hits
+    // MED is a + b - c clamped to [min(a, b), max(a, b)]: min/max compile to conditional moves,
+    // where the textbook three-way comparison would branch on the data.
+    const int med = std::min(mx, std::max(mn, a + b - c));
+    return uint8_t(c != kMiss8 ? med : (a + b) >> 1);
   }
-  if (hasA) return uint8_t(a);
-  if (hasB) return uint8_t(b);
-  return hasC ? uint8_t(c) : last;
+  if (mn != kMiss8) return uint8_t(mn);  // exactly one of a and b is a hit
+  return c != kMiss8 ? uint8_t(c) : last;
+}
+
+// Population count without relying on a POPCNT instruction (the library targets baseline x86-64,
+// where std::popcount becomes a call per byte).
+inline int popcount64(uint64_t x) noexcept {
+  x = x - ((x >> 1) & 0x5555555555555555ull);
+  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+  x = (x + (x >> 4)) & 0x0F0F0F0F0F0F0F0Full;
+  return int((x * 0x0101010101010101ull) >> 56);
+}
+
+// `n` <= 64 bits of the mask from bit `pos` on, bit 0 first.
+inline uint64_t loadBits(const uint8_t* mask, uint64_t maskSize, uint64_t pos, uint32_t n) noexcept {
+  const uint64_t at = pos >> 3;
+  const uint32_t shift = uint32_t(pos & 7);
+  uint8_t b[9] = {};
+  if (at + 9 <= maskSize)
+    std::memcpy(b, mask + at, 9);
+  else
+    std::memcpy(b, mask + at, size_t(maskSize - at));
+  uint64_t lo;
+  std::memcpy(&lo, b, 8);  // little-endian hosts (le.h's assumption for the whole library)
+  uint64_t bits = shift ? (lo >> shift) | (uint64_t(b[8]) << (64 - shift)) : lo;
+  return n == 64 ? bits : bits & ((uint64_t{1} << n) - 1);
 }
 
 uint64_t maskBytes(uint64_t texels) noexcept { return (texels + 7) / 8; }
@@ -72,7 +92,9 @@ std::vector<uint8_t> applyFilter(Filter filter, const BlockShape& shape, std::sp
       for (uint32_t x = 0; x < M; ++x) {
         const uint8_t v = m[y * M + x];
         if (v == kMiss8) continue;
-        out.push_back(uint8_t(v - predict(m, M, x, y, last)));
+        const int left = x ? m[y * M + x - 1] : kMiss8, up = y ? m[(y - 1) * M + x] : kMiss8;
+        const int upLeft = x && y ? m[(y - 1) * M + x - 1] : kMiss8;
+        out.push_back(uint8_t(v - predict(left, up, upLeft, last)));
         last = v;
       }
   }
@@ -99,37 +121,41 @@ Status unapplyFilter(Filter filter, const BlockShape& shape, std::span<const uin
                                    std::to_string(nMask) + "-byte hit mask");
   const uint8_t* mask = filtered.data();
   uint64_t hits = 0;
-  for (uint64_t i = 0; i < nMask; ++i) hits += uint64_t(std::popcount(mask[i]));
+  for (uint64_t i = 0; i < nMask; i += 8) hits += uint64_t(popcount64(loadBits(mask, nMask, i * 8, 64)));
   if (texels % 8 != 0 && (mask[nMask - 1] >> (texels % 8)) != 0)
     return makeError(failCode, "hits-med mask has bits set past the block's last texel");
   if (filtered.size() != nMask + hits)
     return makeError(failCode, "hits-med stream holds " + std::to_string(filtered.size() - nMask) +
                                    " residuals for " + std::to_string(hits) + " hits");
+  // Row by row: the row is filled with the miss code, then only the hits (the set mask bits, found
+  // 64 at a time) are predicted and written, so misses cost a memset.
   const uint8_t* res = mask + nMask;
+  const std::vector<uint8_t> missRow(M, kMiss8);  // the row above the first
   for (uint64_t first = 0; first < texels; first += mapTexels) {
     uint8_t* m = raw.data() + first;
     uint8_t last = 0;
-    uint64_t j = first;
-    for (uint32_t y = 0; y < M; ++y)
-      for (uint32_t x = 0; x < M; ++x, ++j) {
-        // Eight misses at once where the mask byte is empty and the run stays in this row.
-        if ((j & 7) == 0 && mask[j >> 3] == 0 && x + 8 <= M) {
-          std::memset(m + y * M + x, kMiss8, 8);
-          x += 7;
-          j += 7;
-          continue;
+    for (uint32_t y = 0; y < M; ++y) {
+      uint8_t* row = m + uint64_t(y) * M;
+      const uint8_t* up = y ? row - M : missRow.data();
+      std::memset(row, kMiss8, M);
+      uint32_t lastX = ~0u - 1;  // no hit in this row yet
+      for (uint32_t x0 = 0; x0 < M; x0 += 64) {
+        uint64_t bits = loadBits(mask, nMask, first + uint64_t(y) * M + x0, std::min<uint32_t>(64, M - x0));
+        while (bits) {
+          const uint32_t x = x0 + uint32_t(std::countr_zero(bits));
+          bits &= bits - 1;
+          // The left neighbour is `last` when the previous hit was at x - 1 of this row.
+          const int left = x == lastX + 1 ? last : kMiss8;
+          const uint8_t v = uint8_t(predict(left, up[x], x ? up[x - 1] : kMiss8, last) + *res++);
+          if (v == kMiss8)
+            return makeError(failCode, "hits-med residual of texel " + std::to_string(first + uint64_t(y) * M + x) +
+                                           " decodes to the miss code, but the mask marks a hit");
+          row[x] = v;
+          last = v;
+          lastX = x;
         }
-        if (!((mask[j >> 3] >> (j & 7)) & 1)) {
-          m[y * M + x] = kMiss8;
-          continue;
-        }
-        const uint8_t v = uint8_t(predict(m, M, x, y, last) + *res++);
-        if (v == kMiss8)
-          return makeError(failCode, "hits-med residual of texel " + std::to_string(j) +
-                                         " decodes to the miss code, but the mask marks a hit");
-        m[y * M + x] = v;
-        last = v;
       }
+    }
   }
   return {};
 }

@@ -20,8 +20,11 @@ struct FieldData {
   std::vector<uint8_t> normals;   // mapCount * normalMapBytes, empty without a normal field
 };
 
+enum class ExrCompression { kNone, kZip, kPiz, kDwaa };  // DWAA is lossy
+
 struct ExrWriteOptions {
   bool half = false;  // HALF instead of FLOAT for Y and the normal's RGB
+  ExrCompression compression = ExrCompression::kZip;
 };
 
 // Writes `data` as a multi-part OpenEXR file through a temporary file in the same folder and a

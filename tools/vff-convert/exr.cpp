@@ -265,7 +265,10 @@ Status writeExr(const std::string& path, const FieldData& d, const ExrWriteOptio
       Imf::Header hd(w, h);
       hd.setName((plane == 0 ? "slice." : "normal.") + std::to_string(s));
       hd.setType(Imf::SCANLINEIMAGE);
-      hd.compression() = Imf::ZIP_COMPRESSION;
+      hd.compression() = options.compression == ExrCompression::kNone  ? Imf::NO_COMPRESSION
+                         : options.compression == ExrCompression::kPiz ? Imf::PIZ_COMPRESSION
+                         : options.compression == ExrCompression::kDwaa ? Imf::DWAA_COMPRESSION
+                                                                        : Imf::ZIP_COMPRESSION;
       if (plane == 0) {
         hd.channels().insert("Y", Imf::Channel(type));
         hd.channels().insert("miss", Imf::Channel(Imf::HALF));

@@ -79,6 +79,11 @@ json planeJson(const File& file, Plane p) {
   j["lastBlockMaps"] = pi.blocks.empty() ? 0u : pi.blocks.back().mapCount;
   j["codecs"] = codecs;
   j["filters"] = filters;
+  json blocks = json::array();
+  for (const BlockInfo& b : pi.blocks)
+    blocks.push_back({{"storedBytes", b.storedSize}, {"rawBytes", b.rawSize}, {"codec", codecName(b.codec)},
+                      {"filter", filterName(b.filter)}});
+  j["blocks"] = std::move(blocks);
   j["sliceBytes"] = file.sliceBytes(p);
   return j;
 }

@@ -1,6 +1,8 @@
 // text.cpp - the human-readable rendering of a vff-inspect report document.
+#include <algorithm>
 #include <cinttypes>
 #include <string>
+#include <vector>
 
 #include "cli.h"
 #include "inspect.h"
@@ -66,6 +68,21 @@ void printPlane(std::FILE* out, const char* name, const json& p) {
                "           %" PRIu64 " blocks, %" PRIu64 " maps per block (last block %" PRIu64
                "), codecs: %s; filters: %s\n",
                u64(p["blockCount"]), u64(p["mapsPerBlock"]), u64(p["lastBlockMaps"]), codecs.c_str(), filters.c_str());
+  // Per-block stored sizes: every one for a few blocks, else the spread (JSON lists them all).
+  std::vector<uint64_t> sizes;
+  for (const auto& b : p["blocks"]) sizes.push_back(u64(b["storedBytes"]));
+  if (!sizes.empty() && sizes.size() <= 32) {
+    std::string list;
+    for (size_t i = 0; i < sizes.size(); ++i)
+      list += (i == 0 ? "" : i % 8 == 0 ? ",\n                                " : ", ") + std::to_string(sizes[i]);
+    std::fprintf(out, "           block stored bytes: %s\n", list.c_str());
+  } else if (!sizes.empty()) {
+    std::sort(sizes.begin(), sizes.end());
+    std::fprintf(out,
+                 "           block stored bytes: min %" PRIu64 ", median %" PRIu64 ", max %" PRIu64
+                 " (--format json lists every block)\n",
+                 sizes.front(), sizes[sizes.size() / 2], sizes.back());
+  }
   std::fprintf(out, "           slice %s\n", cli::formatBytes(u64(p["sliceBytes"])).c_str());
 }
 

@@ -1,0 +1,176 @@
+#!/usr/bin/env bash
+# compress_tests.sh - command-line tests of vff-compress. Every function named test_* is one ctest
+# case (tests/compress/CMakeLists.txt finds them): `bash compress_tests.sh test_NAME` runs one.
+# Environment: VFF_COMPRESS, VFF_INSPECT, VFF_BAKE, MESHGEN (vff-procedural-mesh), WORK (scratch).
+set -euo pipefail
+: "${VFF_COMPRESS:?}" "${VFF_INSPECT:?}" "${VFF_BAKE:?}" "${MESHGEN:?}" "${WORK:?}"
+source "$(dirname "${BASH_SOURCE[0]}")/../common/cli_harness.sh"
+compress() { run "$VFF_COMPRESS" "$@"; }
+valid() {
+  run "$VFF_INSPECT" "$1" --validate
+  [[ $RC -eq 0 ]] || { show; fail "$1 does not validate"; }
+}
+# bake OUT [BAKE ARGS...]: a field of the torus knot, stored blocks (the default).
+bake() {
+  local out=$1
+  shift
+  [[ -f $WORK/knot.obj ]] || "$MESHGEN" torus-knot "$WORK/knot.obj" >/dev/null || fail "mesh generator"
+  "$VFF_BAKE" "$WORK/knot.obj" -o "$out" -n 6 -m 32 -q "$@" || fail "vff-bake $*"
+}
+json() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval(sys.argv[2]))" "$WORK/out" "$1"; }
+
+test_help() {
+  compress --help
+  expect_rc 0
+  for opt in --decompress --benchmark --level --filter --maps-per-block --blocks --format --version "Exit codes:"; do
+    expect_out "$opt"
+  done
+}
+
+# Compress, validate, decompress: the result is byte-identical to the stored bake, and the maps never
+# changed on the way (the decompressed file is the original).
+test_round_trip_is_byte_identical() {
+  bake "$WORK/a.vff"
+  compress "$WORK/a.vff" "$WORK/z.vff"
+  expect_rc 0
+  expect_no_err
+  valid "$WORK/z.vff"
+  compress --decompress "$WORK/z.vff" "$WORK/b.vff"
+  expect_rc 0
+  cmp "$WORK/a.vff" "$WORK/b.vff" || fail "decompress(compress(a)) differs from a"
+}
+
+test_normals_round_trip() {
+  bake "$WORK/a.vff" --normals --encoding unorm8-chord --gutter 1
+  compress "$WORK/a.vff" "$WORK/z.vff"
+  expect_rc 0
+  valid "$WORK/z.vff"
+  compress -d "$WORK/z.vff" "$WORK/b.vff"
+  expect_rc 0
+  cmp "$WORK/a.vff" "$WORK/b.vff" || fail "the round trip with normals is not byte-identical"
+}
+
+# The filter must pay for itself on a real bake: smaller than zstd alone at the same level and G.
+test_filter_beats_zstd_alone() {
+  bake "$WORK/a.vff"
+  compress "$WORK/a.vff" "$WORK/plain.vff" --filter none --format json
+  expect_rc 0
+  local plain filtered blocks nfiltered
+  plain=$(json "d['distance']['storedBytes']")
+  [[ $(json "d['distance']['filteredBlocks']") -eq 0 ]] || fail "--filter none filtered blocks"
+  compress "$WORK/a.vff" "$WORK/f.vff" --format json
+  expect_rc 0
+  filtered=$(json "d['distance']['storedBytes']")
+  blocks=$(json "d['distance']['blocks']")
+  nfiltered=$(json "d['distance']['filteredBlocks']")
+  [[ $nfiltered -ge 1 ]] || fail "no block kept the hits-med filter"
+  [[ $filtered -lt $plain ]] || fail "hits-med ($filtered bytes) is not smaller than zstd alone ($plain bytes)"
+  [[ $(json "len(d['distance']['blockStoredBytes'])") -eq $blocks ]] || fail "per-block sizes do not match the block count"
+  [[ $(json "sum(d['distance']['blockStoredBytes'])") -eq $filtered ]] || fail "per-block sizes do not sum to the plane's"
+  echo "zstd alone $plain bytes, with hits-med $filtered bytes ($nfiltered of $blocks blocks filtered)"
+}
+
+test_same_bytes_every_time() {
+  bake "$WORK/a.vff"
+  compress "$WORK/a.vff" "$WORK/1.vff" -q
+  expect_rc 0
+  compress "$WORK/a.vff" "$WORK/2.vff" -q --maps-per-block 0
+  expect_rc 0
+  cmp "$WORK/1.vff" "$WORK/2.vff" || fail "two compressions differ"
+  compress "$WORK/1.vff" "$WORK/3.vff" -q
+  expect_rc 0
+  cmp "$WORK/1.vff" "$WORK/3.vff" || fail "compressing a compressed file changed it"
+}
+
+test_inspect_shows_codec_filter_and_blocks() {
+  bake "$WORK/a.vff"
+  compress "$WORK/a.vff" "$WORK/z.vff" --blocks
+  expect_rc 0
+  expect_out "block 0:"
+  expect_out_re "distance .* ratio [0-9.]+; [0-9]+ blocks \(zstd [0-9]+, hits-med [1-9]"
+  run "$VFF_INSPECT" "$WORK/z.vff"
+  expect_rc 0
+  expect_out "vff 1.1"
+  expect_out "zstd, filters"
+  expect_out_re "filters: hits-med [1-9]"
+  run "$VFF_INSPECT" "$WORK/z.vff" --format json
+  expect_rc 0
+  [[ $(json "d['format']['incompatFeatures']['names']") == "['zstd', 'filters']" ]] || { show; fail "json feature names"; }
+}
+
+test_unorm16_explicit_filter_is_unsupported() {
+  bake "$WORK/a.vff" --encoding unorm16-diameter
+  compress "$WORK/a.vff" "$WORK/z.vff" --filter hits-med
+  expect_rc 5
+  expect_err "a.vff"
+  expect_err "unorm16-diameter"
+  [[ ! -e $WORK/z.vff ]] || fail "an output was written"
+  # auto: zstd only, a valid 1.0 file
+  compress "$WORK/a.vff" "$WORK/z.vff" --format json
+  expect_rc 0
+  [[ $(json "d['distance']['filteredBlocks']") -eq 0 ]] || fail "a unorm16 block was filtered"
+  run "$VFF_INSPECT" "$WORK/z.vff"
+  expect_out "vff 1.0"
+}
+
+test_corrupt_input_keeps_old_output() {
+  bake "$WORK/a.vff"
+  echo "old" >"$WORK/z.vff"
+  cp "$WORK/a.vff" "$WORK/bad.vff"
+  # A byte in the middle of the distance blocks: the block checksum fails.
+  local size
+  size=$(stat -c %s "$WORK/bad.vff")
+  printf '\x5a' | dd of="$WORK/bad.vff" bs=1 seek=$((size - 1000)) conv=notrunc status=none
+  compress "$WORK/bad.vff" "$WORK/z.vff"
+  expect_rc 3
+  expect_err "bad.vff"
+  expect_err "checksum"
+  [[ $(cat "$WORK/z.vff") == old ]] || fail "the old output was touched"
+  [[ -z $(find "$WORK" -name '*.tmp*' -o -name '.*vff*' | head -1) ]] || fail "a temporary was left behind"
+}
+
+test_not_a_vff_and_missing_input() {
+  echo "hello" >"$WORK/text.vff"
+  compress "$WORK/text.vff" "$WORK/z.vff"
+  expect_rc 3
+  expect_err "text.vff"
+  compress "$WORK/none.vff" "$WORK/z.vff"
+  expect_rc 2
+  expect_err "none.vff"
+  [[ ! -e $WORK/z.vff ]] || fail "an output was written"
+}
+
+test_unwritable_output_is_io_error() {
+  bake "$WORK/a.vff"
+  compress "$WORK/a.vff" "$WORK/no/such/dir/z.vff"
+  expect_rc 2
+  expect_err "z.vff"
+}
+
+test_usage_errors() {
+  compress "$WORK/a.vff"
+  expect_rc 1
+  compress --decompress --level 3 "$WORK/a.vff" "$WORK/b.vff"
+  expect_rc 1
+  compress --filter bc7 "$WORK/a.vff" "$WORK/b.vff"
+  expect_rc 1
+  compress --level 30 "$WORK/a.vff" "$WORK/b.vff"
+  expect_rc 1
+}
+
+# The benchmark runs end to end on a small field and prints every codec and the targets line.
+test_benchmark_prints_every_codec() {
+  bake "$WORK/a.vff"
+  compress --benchmark "$WORK/a.vff" --repeat 1 --tmp "$WORK"
+  expect_rc 0
+  for c in "vff zstd-19 + hits-med" "zstd -19" "xz -9" "OpenEXR ZIP" "OpenEXR PIZ" "OpenEXR DWAA" "targets: size"; do
+    expect_out "$c"
+  done
+  [[ -z $(find "$WORK" -name '*.exr' | head -1) ]] || fail "the benchmark left an EXR behind"
+}
+
+declare -F "$1" >/dev/null || { echo "no such test: $1" >&2; exit 2; }
+rm -rf "$WORK"
+mkdir -p "$WORK"
+"$1"
+echo "PASS: $1"
