@@ -169,6 +169,15 @@ test_benchmark_prints_every_codec() {
   [[ -z $(find "$WORK" -name '*.exr' | head -1) ]] || fail "the benchmark left an EXR behind"
 }
 
+test_benchmark_candidates() {
+  bake "$WORK/a.vff"
+  compress --benchmark --candidates "$WORK/a.vff" --repeat 1 --tmp "$WORK"
+  expect_rc 0
+  for c in "none (zstd alone)" "raw - left" "raw - up" "raw - gradient" "raw - MED" "hits-med (mask + MED of hits)"; do
+    expect_out "$c"
+  done
+}
+
 declare -F "$1" >/dev/null || { echo "no such test: $1" >&2; exit 2; }
 rm -rf "$WORK"
 mkdir -p "$WORK"

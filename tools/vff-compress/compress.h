@@ -32,7 +32,8 @@ Status rewrite(const File& in, const std::string& out, const WriteOptions& optio
 
 // The benchmark: for each field file, the distance payload through our lossless codec, zstd -19 and
 // xz -9 on the raw payload, and OpenEXR ZIP, PIZ and DWAA on the EXR export; prints the table.
-// Returns a cli exit code.
-int benchmark(const std::vector<std::string>& files, int repeat, const std::string& tmpDir);
+// With `candidates`, also the sizes of the other filters hits-med was chosen over. Returns a cli
+// exit code.
+int benchmark(const std::vector<std::string>& files, int repeat, const std::string& tmpDir, bool candidates);
 
 }  // namespace vff::compress

@@ -25,6 +25,7 @@ struct Options {
   bool decompress = false;
   bool benchmark = false;
   bool blocks = false;
+  bool candidates = false;
   bool quiet = false;
   int level = 19;
   std::string filter = "auto";
@@ -85,6 +86,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--maps-per-block", o.mapsPerBlock, "maps per block G (0: about 256 KiB per block)")
       ->capture_default_str();
+  app.add_flag("--candidates", o.candidates,
+               "benchmark: also measure the filters hits-med was chosen over (left, up, gradient, MED on raw bytes)");
   app.add_flag("--blocks", o.blocks, "also list every block's stored size");
   app.add_option("--repeat", o.repeat, "benchmark repetitions (the best time is reported)")
       ->check(CLI::Range(1, 100))
@@ -99,7 +102,7 @@ int main(int argc, char** argv) {
       return vff::cli::kExitUsage;
     }
     if (o.tmpDir.empty()) o.tmpDir = std::filesystem::temp_directory_path().string();
-    return vff::compress::benchmark(o.files, o.repeat, o.tmpDir);
+    return vff::compress::benchmark(o.files, o.repeat, o.tmpDir, o.candidates);
   }
   if (o.files.size() != 2) {
     vff::cli::usageError(kProg, "give an input and an output file (or --benchmark FILES...)");
