@@ -120,7 +120,9 @@ struct FieldConfig {
 };
 
 struct BakedQuery {
-  FieldConfig config;
+  FieldConfig config;           // of a bake (the map count and size of a loaded file)
+  std::string name;             // in file names: "4226x64x64", or a loaded file's name without .vff
+  std::string description;      // in the table: the name, or "file.vff (4226x32x32 unorm8-diameter)"
   vff::bake::BakedField baked;  // owns the maps the query borrows
   vff::FieldQuery query;
   vff::Instance instance;       // the field placed in the world
@@ -140,6 +142,13 @@ inline float openShare(const ExactTracer& exact, const BakedQuery* field, const 
 // Bakes one configuration (unorm8-diameter) of the object and places it like the world's object.
 vff::Result<std::unique_ptr<BakedQuery>> bakeQuery(const World& world, const vff::bake::Scene& scene,
                                                    const FieldConfig& config, bool normals, unsigned threads);
+// Loads a field file (--field) of the world's object: every block decoded into memory, queried like a
+// bake. The file must describe the same object: its sphere must be the mesh's minimal enclosing
+// sphere (what bakeQuery uses), within 1e-5 R, and when META names the source mesh's XXH3
+// (vff.source.xxh3, kept by vff-convert) it must be the loaded mesh's. Errors: those of File::open;
+// kInvalidArgument naming the mismatch (the caller exits 3); kUnsupported when `normals` are
+// needed and the file has none.
+vff::Result<std::unique_ptr<BakedQuery>> loadQuery(const World& world, const std::string& path, bool normals);
 // Parses "4226x64x64" (or "n32m64"): maps must be an octa-hemi2 count.
 bool parseFieldConfig(const std::string& text, FieldConfig* out);
 
@@ -200,7 +209,8 @@ struct Options {
   int size = 512;
   int rays = 0;       // 0: the experiment's default (ao 256, intra-ao 121, shadows 20, reflections 4)
   unsigned threads = 0;
-  std::vector<std::string> configs;  // empty: the experiment's default field configurations
+  std::vector<std::string> configs;  // empty: the experiment's default field configurations (none with fields)
+  std::vector<std::string> fields;   // .vff files of the same mesh to evaluate besides (or instead of) bakes
   // AO range as a multiple of R. 2 R spans the whole bounding sphere, so for a plane point inside the
   // sphere the range never cuts the intra-object answer (whose hit is the LAST crossing, at most 2 R away).
   float aoDistance = 2.0f;

@@ -50,7 +50,9 @@ std::string formatTable(const std::vector<TableRow>& rows) {
 
 int runImageExperiment(const Options& o, const ImageExperiment& e) {
   std::vector<FieldConfig> configs;
-  for (const std::string& c : o.configs.empty() ? e.defaultConfigs : o.configs) {
+  // With --field and no --config, only the files are evaluated.
+  const std::vector<std::string> none;
+  for (const std::string& c : !o.configs.empty() ? o.configs : o.fields.empty() ? e.defaultConfigs : none) {
     FieldConfig fc;
     if (!parseFieldConfig(c, &fc)) {
       vff::cli::usageError(kProg, "--config " + c + ": expected MAPSxMxM with an octa-hemi2 map count (e.g. 4226x64x64)");
@@ -66,6 +68,17 @@ int runImageExperiment(const Options& o, const ImageExperiment& e) {
   World* world = &(*setup)->world;
   ExactTracer* exact = &*(*setup)->exact;
   vff::bake::Scene* scene = &*(*setup)->scene;
+  // The files of --field, checked against the mesh before anything is rendered.
+  std::vector<std::unique_ptr<BakedQuery>> files;
+  for (const std::string& path : o.fields) {
+    auto field = loadQuery(*world, path, e.normals);
+    if (!field) {
+      const int rc = vff::cli::reportError(kProg, path, field.error());
+      // A file of another mesh or sphere is an invalid input for this experiment.
+      return field.error().code == vff::Code::kInvalidArgument ? vff::cli::kExitInvalidFile : rc;
+    }
+    files.push_back(std::move(*field));
+  }
   std::error_code ec;
   std::filesystem::create_directories(o.out, ec);
   if (ec) {
@@ -92,21 +105,34 @@ int runImageExperiment(const Options& o, const ImageExperiment& e) {
   std::fprintf(stderr, "%s: %s: exact reference in %.2f s\n", kProg, e.name.c_str(), seconds);
 
   std::vector<Image> strip{reference};  // exact | first configuration nearest | interpolated
-  for (const FieldConfig& c : configs) {
-    auto field = bakeQuery(*world, *scene, c, e.normals, threads);
-    if (!field) return vff::cli::reportError(kProg, o.mesh, field.error());
-    std::fprintf(stderr, "%s: %s: baked %s in %.2f s (%.2f MiB)\n", kProg, e.name.c_str(), c.name().c_str(),
-                 (*field)->bakeSeconds, (*field)->payloadMiB());
+  // The bakes of --config, then the files of --field.
+  for (size_t source = 0; source < configs.size() + files.size(); ++source) {
+    const bool baking = source < configs.size();
+    std::unique_ptr<BakedQuery> field;
+    if (baking) {
+      auto baked = bakeQuery(*world, *scene, configs[source], e.normals, threads);
+      if (!baked) return vff::cli::reportError(kProg, o.mesh, baked.error());
+      field = std::move(*baked);
+    } else {
+      field = std::move(files[source - configs.size()]);
+    }
+    const BakedQuery& c = *field;
+    if (baking)
+      std::fprintf(stderr, "%s: %s: baked %s in %.2f s (%.2f MiB)\n", kProg, e.name.c_str(), c.name.c_str(),
+                   c.bakeSeconds, c.payloadMiB());
+    else
+      std::fprintf(stderr, "%s: %s: loaded %s (%.2f MiB)\n", kProg, e.name.c_str(), c.description.c_str(),
+                   c.payloadMiB());
     for (vff::Reconstruction r : {vff::Reconstruction::kNearest, vff::Reconstruction::kInterpolated}) {
-      const Image img = renderImage(g, threads, stream, e.makeShader(*world, *exact, field->get(), r, rays), &seconds);
+      const Image img = renderImage(g, threads, stream, e.makeShader(*world, *exact, field.get(), r, rays), &seconds);
       const ErrorStats st = compareImages(reference, img, mask);
-      const std::string name = base + "-" + c.name() + "-" + reconstructionName(r);
+      const std::string name = base + "-" + c.name + "-" + reconstructionName(r);
       if (!writeImages(img, name)) return vff::cli::kExitIo;
       if (strip.size() < 3) strip.push_back(img);
       if (auto w = writeErrorMap(reference, img, mask, 8.0f, name + "-error.png"); !w)
         return vff::cli::reportError(kProg, "", w.error());
-      rows.push_back({c.name(), reconstructionName(r), (*field)->payloadMiB(), st.rms, st.max, seconds, false});
-      std::fprintf(stderr, "%s: %s: %s %s in %.2f s, RMS %.2f\n", kProg, e.name.c_str(), c.name().c_str(),
+      rows.push_back({c.description, reconstructionName(r), c.payloadMiB(), st.rms, st.max, seconds, false});
+      std::fprintf(stderr, "%s: %s: %s %s in %.2f s, RMS %.2f\n", kProg, e.name.c_str(), c.name.c_str(),
                    reconstructionName(r), seconds, st.rms);
     }
   }

@@ -1,9 +1,13 @@
 // field_tracer.cpp - the approximation: visibility fields baked in memory with vff::bake and
 // queried with vff::FieldQuery, placed in the world with vff::Instance.
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 
+#include "cli.h"
 #include "common.h"
+#include "vff/reader.h"
 
 namespace vffx {
 
@@ -42,8 +46,69 @@ vff::Result<std::unique_ptr<BakedQuery>> bakeQuery(const World& world, const vff
   if (!baked) return std::move(baked).error();
   auto q = std::make_unique<BakedQuery>();
   q->config = config;
+  q->name = q->description = config.name();
   q->baked = std::move(*baked);
   q->bakeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  auto query = vff::FieldQuery::fromMaps(q->baked.field, q->baked.distance, q->baked.normals);
+  if (!query) return std::move(query).error();
+  q->query = std::move(*query);
+  q->instance.field = &q->query;
+  q->instance.transform = world.transform;
+  return q;
+}
+
+vff::Result<std::unique_ptr<BakedQuery>> loadQuery(const World& world, const std::string& path, bool normals) {
+  auto file = vff::File::open(path);
+  if (!file) return std::move(file).error();
+  const vff::FieldDesc& fd = file->field();
+  // The same object: the sphere the bakes use, and the mesh the file was baked from when it says.
+  const vff::Sphere& s = world.objectSphere;
+  const float tol = 1e-5f * s.radius;
+  if (std::fabs(fd.sphere.center[0] - s.center[0]) > tol || std::fabs(fd.sphere.center[1] - s.center[1]) > tol ||
+      std::fabs(fd.sphere.center[2] - s.center[2]) > tol || std::fabs(fd.sphere.radius - s.radius) > tol) {
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  "the field's bounding sphere (centre %.7g %.7g %.7g, radius %.7g) is not the mesh's minimal "
+                  "enclosing sphere (centre %.7g %.7g %.7g, radius %.7g): not a field of this mesh, or baked with "
+                  "another sphere",
+                  double(fd.sphere.center[0]), double(fd.sphere.center[1]), double(fd.sphere.center[2]),
+                  double(fd.sphere.radius), double(s.center[0]), double(s.center[1]), double(s.center[2]),
+                  double(s.radius));
+    return vff::makeError(vff::Code::kInvalidArgument, buf);
+  }
+  if (!file->metadata().empty()) {
+    const auto meta = nlohmann::json::parse(file->metadata(), nullptr, false);
+    if (meta.is_object() && meta.contains("vff.source") && meta["vff.source"].is_object() &&
+        meta["vff.source"].contains("xxh3") && meta["vff.source"]["xxh3"].is_string()) {
+      const std::string want = vff::cli::hexDigits64(vff::bake::meshHash(world.objectMesh));
+      const std::string got = meta["vff.source"]["xxh3"].get<std::string>();
+      if (got != want)
+        return vff::makeError(vff::Code::kInvalidArgument, "the field was baked from a mesh with XXH3 " + got +
+                                                               " (META vff.source.xxh3), the loaded mesh has " + want);
+    }
+  }
+  if (normals && !file->hasNormals())
+    return vff::makeError(vff::Code::kUnsupported, "this experiment needs a normal plane, and the field has none");
+
+  auto q = std::make_unique<BakedQuery>();
+  q->baked.field = fd;
+  for (vff::Plane p : {vff::Plane::kDistance, vff::Plane::kNormal}) {
+    if (!file->plane(p).present) continue;
+    std::vector<uint8_t>& out = p == vff::Plane::kDistance ? q->baked.distance : q->baked.normals;
+    out.reserve(file->plane(p).rawBytes);
+    for (uint32_t b = 0; b < file->plane(p).blocks.size(); ++b) {
+      auto bytes = file->blockData(p, b);
+      if (!bytes) return std::move(bytes).error();
+      out.insert(out.end(), bytes->begin(), bytes->end());
+    }
+  }
+  q->config.n = fd.positionScheme == vff::PositionScheme::kOctaHemi2 ? fd.positionParam : 0;
+  q->config.mapSize = fd.mapResolution;
+  const size_t slash = path.find_last_of('/');
+  const std::string base = slash == std::string::npos ? path : path.substr(slash + 1);
+  q->name = base.size() > 4 && base.ends_with(".vff") ? base.substr(0, base.size() - 4) : base;
+  q->description = base + " (" + std::to_string(fd.mapCount) + "x" + std::to_string(fd.mapResolution) + "x" +
+                   std::to_string(fd.mapResolution) + " " + vff::distanceEncodingName(fd.distanceEncoding) + ")";
   auto query = vff::FieldQuery::fromMaps(q->baked.field, q->baked.distance, q->baked.normals);
   if (!query) return std::move(query).error();
   q->query = std::move(*query);

@@ -5,6 +5,7 @@
 //   vff-experiments shadows                soft shadows from three spherical lights
 //   vff-experiments reflections            glossy reflection using the normal field
 //   vff-experiments bench                  Embree vs FieldQuery throughput on the same rays
+//   vff-experiments ao --field lod.vff     also (or only) evaluate field files of the same mesh
 //
 // Images (PNG, EXR, error heat maps) and OUT/NAME-table.md go to --out (default out/experiments);
 // the table is printed on stdout, progress on stderr. Fields are baked in memory, never written.
@@ -39,6 +40,9 @@ int main(int argc, char** argv) {
   app.add_option("--config", o.configs,
                  "field configuration(s) MAPSxMxM, octa-hemi2 maps (4226 = n 32, 16642 = n 64); "
                  "default per experiment (bench: 4226x64x64)");
+  app.add_option("--field", o.fields,
+                 "image experiments: also evaluate this .vff of the same mesh (repeatable; e.g. one made by "
+                 "vff-convert); its sphere and source mesh must match. With --field and no --config, only the files");
   app.add_option("--ao-distance", o.aoDistance, "AO ray range in multiples of the bounding radius R")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
@@ -47,6 +51,10 @@ int main(int argc, char** argv) {
   app.add_option("--repeat", o.repeat, "bench: repetitions (best is reported)")->capture_default_str()
       ->check(CLI::Range(1, 100));
   if (auto rc = vff::cli::parse(app, kProg, argc, argv)) return *rc;
+  if (o.experiment == "bench" && !o.fields.empty()) {
+    vff::cli::usageError(kProg, "--field applies to the image experiments, not to bench");
+    return vff::cli::kExitUsage;
+  }
   try {
     return experiments.at(o.experiment)(o);
   } catch (const std::bad_alloc&) {

@@ -3,13 +3,16 @@
 //   vff-bake mesh.obj -o field.vff          the paper's configuration: 4226 maps of 64x64, 8 bits, 2R
 //   vff-bake mesh.glb -o f.vff --normals --encoding unorm16-diameter --codec zstd
 //   vff-bake mesh.obj --benchmark           Embree's raw throughput on the bake's rays vs the bake
+//   vff-bake shape.vdb -o f.vff [--grid NAME]   from an OpenVDB level set (vff/bake/levelset.h)
 #include <sys/resource.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <optional>
 #include <thread>
 #include <chrono>
@@ -20,6 +23,7 @@
 
 #include "cli.h"
 #include "vff/bake/baker.h"
+#include "vff/bake/levelset.h"
 #include "vff/bake/mesh.h"
 #include "vff/vff.h"
 
@@ -32,6 +36,7 @@ const char* kProg = "vff-bake";
 struct Options {
   std::string mesh;
   std::string output;
+  std::string grid;  // .vdb input: the level set grid to bake (empty: the first)
   std::string positions = "octa-hemi2";
   uint32_t count = 0;  // 0: the scheme's default
   uint32_t mapSize = 64;
@@ -114,16 +119,120 @@ class Progress {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now(), last_{};
 };
 
+bool isVdbPath(const std::string& p) {
+  if (p.size() < 4) return false;
+  std::string ext = p.substr(p.size() - 4);
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext == ".vdb";
+}
+
+// Bakes from an OpenVDB level set (vff/bake/levelset.h): the field, layout, output and checks of a
+// mesh bake; the metadata and the summary describe the grid instead of triangles.
+int bakeFromLevelSet(const Options& o, BakeOptions bo, vff::WriteOptions wo) {
+  auto t0 = std::chrono::steady_clock::now();
+  auto ls = vff::bake::LevelSet::load(o.mesh, {.grid = o.grid});
+  if (!ls && ls.error().code == vff::Code::kInvalidArgument) {  // --grid names no grid of the file
+    vff::cli::usageError(kProg, ls.error().message);
+    return vff::cli::kExitUsage;
+  }
+  if (!ls) return vff::cli::reportError(kProg, o.mesh, ls.error());
+  const double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const vff::bake::LevelSetInfo& info = ls->info();
+  auto field = vff::bake::describeLevelSetBake(*ls, bo);
+  if (!field) {
+    vff::cli::usageError(kProg, field.error().message);
+    return vff::cli::kExitUsage;
+  }
+  if (auto layout = vff::computeLayout(*field, wo.layout); !layout) {
+    vff::cli::usageError(kProg, layout.error().message);
+    return vff::cli::kExitUsage;
+  }
+  const uint64_t payload = field->mapCount * (vff::distanceMapBytes(field->distanceEncoding, field->mapResolution) +
+                                              vff::normalMapBytes(field->normalEncoding, field->mapResolution));
+  if (payload > (uint64_t{16} << 30)) {
+    vff::cli::usageError(kProg, "the field would hold " + std::to_string(payload) +
+                                    " bytes, above the baker's 16 GiB limit: fewer maps or a smaller --map-size");
+    return vff::cli::kExitUsage;
+  }
+  // vff.source.xxh3 of a level set is the XXH3-64 of the .vdb file's bytes (a mesh's hashes its
+  // positions and indices); the sphere is the user's or the one around the active voxels' bounds.
+  nlohmann::json meta = {
+      {"vff.generator", "vff-bake"},
+      {"vff.generatorVersion", vff::kLibraryVersion},
+      {"vff.source", {{"name", baseName(o.mesh)}, {"format", "vdb"}, {"grid", info.grid},
+                      {"activeVoxels", info.activeVoxels}, {"xxh3", vff::cli::hexDigits64(info.fileXxh3)}}},
+      {"vff.bake", {{"rayOrigin", "texel centre"}, {"sphere", bo.sphere ? "user" : "active-voxel-bounds"},
+                    {"surface", "level set zero crossing"}, {"twoSided", true},
+                    {"normals", o.normals ? "gradient" : "none"}}}};
+  wo.metadataJson = meta.dump();
+  // The writer creates its temporary file now, so an unwritable destination fails before baking.
+  auto writer = vff::Writer::create(o.output, *field, wo);
+  if (!writer) return vff::cli::reportError(kProg, o.output, writer.error());
+
+  Progress progress(!o.quiet && !o.json && isatty(2), uint64_t(o.mapSize) * o.mapSize);
+  bo.progress = [&](uint64_t d, uint64_t t) { progress.update(d, t); };
+  auto baked = vff::bake::bakeLevelSet(*ls, bo);
+  if (!baked) return vff::cli::reportError(kProg, o.mesh, baked.error());
+  t0 = std::chrono::steady_clock::now();
+  vff::Status st = writer->writeMaps(vff::Plane::kDistance, baked->distance);
+  if (st && o.normals) st = writer->writeMaps(vff::Plane::kNormal, baked->normals);
+  if (st) st = writer->finish();
+  if (!st) return vff::cli::reportError(kProg, o.output, st.error());
+  const double writeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  uint64_t fileBytes = 0;
+  if (auto f = vff::File::open(o.output, {.checksums = vff::ChecksumPolicy::kNone})) fileBytes = f->info().fileSize;
+
+  const vff::bake::BakeStats& s = baked->stats;
+  const double rays = double(s.rays);
+  if (o.json) {
+    nlohmann::json summary = {
+        {"input", o.mesh},
+        {"grid", info.grid},
+        {"activeVoxels", info.activeVoxels},
+        {"voxelSize", info.voxelSize},
+        {"sphere", {{"center", {field->sphere.center[0], field->sphere.center[1], field->sphere.center[2]}},
+                    {"radius", field->sphere.radius}}},
+        {"positions", o.positions},
+        {"positionParam", bo.positionParam},
+        {"maps", field->mapCount},
+        {"mapResolution", field->mapResolution},
+        {"encoding", o.encoding},
+        {"normals", o.normals},
+        {"rays", s.rays},
+        {"hits", s.hits},
+        {"hitRatio", rays > 0 ? double(s.hits) / rays : 0.0},
+        {"payloadBytes", payload},
+        {"seconds", {{"load", loadSeconds}, {"bake", s.seconds}, {"write", writeSeconds}}},
+        {"raysPerSecond", s.seconds > 0 ? rays / s.seconds : 0.0},
+        {"peakRssMiB", peakRssMiB()},
+        {"output", o.output},
+        {"fileBytes", fileBytes}};
+    std::printf("%s\n", summary.dump(2).c_str());
+  } else if (!o.quiet) {
+    std::fprintf(stderr,
+                 "%s: %s: grid \"%s\" (%" PRIu64 " active voxels of %g): %u maps of %ux%u (%.0f rays, %.1f%% hits) "
+                 "in %.2f s (%.1f Mrays/s), %.3f MiB payload -> %s\n",
+                 kProg, o.mesh.c_str(), info.grid.c_str(), info.activeVoxels, info.voxelSize, field->mapCount,
+                 field->mapResolution, field->mapResolution, rays, 100.0 * double(s.hits) / rays, s.seconds,
+                 rays / s.seconds / 1e6, double(payload) / 1048576.0, o.output.c_str());
+  }
+  return vff::cli::kExitSuccess;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   Options o;
-  CLI::App app{"Bakes a precomputed 4D visibility field (.vff) from a triangle mesh with Embree.\n"
-               "Inputs: .obj .ply .off .stl (OpenMesh), .gltf .glb (tinygltf).\n" +
+  CLI::App app{"Bakes a precomputed 4D visibility field (.vff) from a triangle mesh with Embree, or from an\n"
+               "OpenVDB level set (rays intersected with its zero crossing, normals from its gradient).\n"
+               "Inputs: .obj .ply .off .stl (OpenMesh), .gltf .glb (tinygltf), .vdb (OpenVDB: the first float\n"
+               "grid of class level set by name, as vdb_print lists them, or --grid NAME; default sphere: the\n"
+               "one around the active voxels' bounding box).\n" +
                vff::cli::exitCodeHelp()};
   vff::cli::addVersionFlag(app, kProg);
-  app.add_option("mesh", o.mesh, "input mesh")->required();
+  app.add_option("mesh", o.mesh, "input mesh, or OpenVDB level set (.vdb)")->required();
   app.add_option("-o,--output", o.output, "output .vff file (written atomically)");
+  app.add_option("--grid", o.grid, ".vdb input: name of the level set grid to bake (default: the first level set by name)");
   app.add_option("--positions", o.positions, "positional-sample scheme")
       ->check(CLI::IsMember({"octa-hemi2", "ea-octa-grid", "fibonacci"}))->capture_default_str();
   app.add_option("-n,--count", o.count,
@@ -186,6 +295,18 @@ int main(int argc, char** argv) {
   wo.layout.maxTextureSize = o.maxTextureSize;
   wo.layout.maxLayers = o.maxLayers;
   wo.layout.gutter = o.gutter;
+
+  if (isVdbPath(o.mesh)) {
+    if (o.benchmark) {
+      vff::cli::usageError(kProg, "--benchmark measures Embree on a mesh; it does not apply to a .vdb level set");
+      return vff::cli::kExitUsage;
+    }
+    return bakeFromLevelSet(o, bo, wo);
+  }
+  if (!o.grid.empty()) {
+    vff::cli::usageError(kProg, "--grid applies to a .vdb level set input only");
+    return vff::cli::kExitUsage;
+  }
 
   // Load and check the mesh, then the parameters, before any output exists.
   vff::bake::MeshInfo info;

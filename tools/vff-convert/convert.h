@@ -1,6 +1,8 @@
 // convert.h - what vff-convert's parts share: a whole field held in memory, and the EXR side.
 #pragma once
 
+#include <nlohmann/json.hpp>
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -46,5 +48,23 @@ Result<FieldData> readExr(const std::string& path, ExrReadReport* report);
 
 // True when the file starts with the OpenEXR magic number.
 bool looksLikeExr(const std::string& path);
+
+// ---- Shared by the EXR and OpenVDB sides (interchange.cpp) ----------------------------------------
+// The "vff.field" JSON: {"format": formatName, "field", "layout", "metadata", "codec", "mapsPerBlock"}.
+nlohmann::json fieldJson(const FieldData& data, const char* formatName);
+// Parses it into `data` (everything but the planes) and checks it with libvff; errors
+// (kMetadataJson, or libvff's) start with `where`, e.g. "attribute vff.field".
+Status parseFieldJson(const std::string& text, const char* formatName, const std::string& where, FieldData* data);
+// cos(alpha) of every texel centre of a map (row-major), for unorm8-chord.
+std::vector<float> texelCosines(const FieldDesc& field);
+// v clamped to [0, m - 1]: the map texel a gutter texel replicates.
+uint32_t clampToMap(int64_t v, uint32_t m);
+// v rounded to HALF when `half` (to nearest even, as Imath::half and the EXR export do), else v.
+float roundToType(float v, bool half);
+// v, rounded to HALF when `half`, is exactly `stored` (the sign of a zero included).
+bool sameValue(float v, float stored, bool half);
+// encodeNormal, then, when its code does not decode to exactly `n` (rounded to HALF when `half`),
+// the codes mirrored across the octahedron's seams; returns whether the stored code decodes to `n`.
+bool encodeNormalExact(Vec3 n, bool half, uint8_t out[4]);
 
 }  // namespace vff::convert
