@@ -390,8 +390,4 @@ test_preview_no_partial_output() {
 
 # ---- Dispatch --------------------------------------------------------------------------------------
 [[ $# -eq 1 ]] || fail "usage: cli_tests.sh test_NAME"
-declare -F "$1" >/dev/null || fail "no test named $1"
-rm -rf "$WORK"
-mkdir -p "$WORK"
-"$1"
-echo "PASS: $1"
+run_test "$1"

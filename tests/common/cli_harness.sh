@@ -24,3 +24,12 @@ expect_err() { grep -q -F -e "$1" "$WORK/err" || { show; fail "stderr lacks: $1"
 expect_err_re() { grep -q -E -e "$1" "$WORK/err" || { show; fail "stderr matches no line: $1"; }; }
 expect_no_out() { [[ ! -s $WORK/out ]] || { show; fail "stdout is not empty"; }; }
 expect_no_err() { [[ ! -s $WORK/err ]] || { show; fail "stderr is not empty"; }; }
+# run_test NAME: the last line of every suite (`run_test "$1"`): runs the test function NAME in an
+# emptied $WORK and prints "PASS: NAME" when it returns. tests/CMakeLists.txt checks for that line.
+run_test() {
+  declare -F "$1" >/dev/null || { echo "no such test: $1" >&2; exit 2; }
+  rm -rf "$WORK"
+  mkdir -p "$WORK"
+  "$1"
+  echo "PASS: $1"
+}

@@ -178,8 +178,4 @@ test_benchmark_candidates() {
   done
 }
 
-declare -F "$1" >/dev/null || { echo "no such test: $1" >&2; exit 2; }
-rm -rf "$WORK"
-mkdir -p "$WORK"
-"$1"
-echo "PASS: $1"
+run_test "$1"

@@ -724,8 +724,4 @@ test_lod_ao_field_option() {
 
 # ---- Runner --------------------------------------------------------------------------------------------
 [[ $# -eq 1 && $1 == test_* ]] || { echo "usage: $0 test_NAME" >&2; exit 2; }
-declare -F "$1" >/dev/null || { echo "no such test: $1" >&2; exit 2; }
-rm -rf "$WORK"
-mkdir -p "$WORK"
-"$1"
-echo "PASS: $1"
+run_test "$1"
