@@ -1,6 +1,8 @@
 #include "parser.h"
 
+#define ZSTD_STATIC_LINKING_ONLY  // ZSTD_getFrameHeader (exported by libzstd since 1.3)
 #include <nlohmann/json.hpp>
+#include <zstd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -260,6 +262,12 @@ class Parser {
     const SectionInfo& s = out_->info.sections[size_t(idx)];
     if (!sectionUsable_[size_t(idx)]) return false;
     auto stored = b_.subspan(s.offset, s.storedSize);
+    if (s.codec == Codec::kZstd) {  // before allocating rawSize bytes
+      if (Status st = checkZstdFrame(stored, s.rawSize, Code::kSectionDecode); !st) {
+        report(Code::kSectionDecode, s.tag, s.offset, st.error().message);
+        return false;
+      }
+    }
     raw->resize(s.rawSize);
     Status st = decompress(s.codec, stored, *raw, Code::kSectionDecode);
     if (!st) {
@@ -598,6 +606,34 @@ class Parser {
 };
 
 }  // namespace
+
+Status checkZstdFrame(std::span<const uint8_t> stored, uint64_t rawSize, Code failCode) {
+  ZSTD_frameHeader h{};
+  const size_t r = ZSTD_getFrameHeader(&h, stored.data(), stored.size());
+  if (ZSTD_isError(r) || r != 0 || h.frameType != ZSTD_frame) return makeError(failCode, "not a zstd frame");
+  if (h.frameContentSize == ZSTD_CONTENTSIZE_UNKNOWN)
+    return makeError(failCode, "zstd frame does not declare its content size");
+  if (h.frameContentSize != rawSize)
+    return makeError(failCode, "zstd frame declares " + num(h.frameContentSize) + " bytes, expected " + num(rawSize));
+  uint64_t pos = h.headerSize, most = 0;
+  for (bool last = false; !last;) {
+    if (stored.size() - pos < 3) return makeError(failCode, "zstd frame ends inside a block header");
+    const uint32_t bh = uint32_t(stored[pos]) | uint32_t(stored[pos + 1]) << 8 | uint32_t(stored[pos + 2]) << 16;
+    pos += 3;
+    last = (bh & 1) != 0;
+    const uint32_t type = (bh >> 1) & 3, size = bh >> 3;  // 0 raw, 1 RLE, 2 compressed, 3 reserved
+    if (type == 3 || size > h.blockSizeMax) return makeError(failCode, "zstd frame holds a malformed block");
+    const uint64_t body = type == 1 ? 1 : size;
+    if (stored.size() - pos < body) return makeError(failCode, "zstd frame ends inside a block");
+    pos += body;
+    most += type == 2 ? h.blockSizeMax : size;
+  }
+  if (h.checksumFlag) pos += 4;
+  if (pos != stored.size()) return makeError(failCode, "stored bytes are not exactly one zstd frame");
+  if (most < rawSize)
+    return makeError(failCode, "zstd frame declares " + num(rawSize) + " bytes but its blocks hold at most " + num(most));
+  return {};
+}
 
 bool parseFile(std::span<const uint8_t> bytes, const ParseOptions& options, IssueSink& sink, ParsedFile* out) {
   Parser p(bytes, options, sink, out);

@@ -44,6 +44,12 @@ struct ParsedFile {
 // one the caller chose to continue past, and the field, layout and distance plane were read).
 bool parseFile(std::span<const uint8_t> bytes, const ParseOptions& options, IssueSink& sink, ParsedFile* out);
 
+// Checks, from its header and block headers alone, that `stored` is exactly one zstd frame that
+// declares `rawSize` bytes and whose blocks can hold that many (raw and RLE blocks count exactly,
+// compressed ones at the frame's maximum block size). A reader calls it before allocating
+// `rawSize` bytes, so a frame that lies about its size costs nothing. Fails with `failCode`.
+Status checkZstdFrame(std::span<const uint8_t> stored, uint64_t rawSize, Code failCode);
+
 // Index of the block holding `map` in a plane; maps are grouped by mapsPerBlock.
 inline uint32_t blockOfMap(const PlaneInfo& p, uint32_t map) noexcept { return map / p.mapsPerBlock; }
 

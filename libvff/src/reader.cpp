@@ -27,9 +27,23 @@ class FirstErrorSink final : public detail::IssueSink {
   Error first;
 };
 
+// Leaves new elements uninitialised: a decode buffer then takes memory only where the decoder
+// writes, so a block whose frame fails early costs next to nothing whatever its rawSize.
+template <class T>
+struct UninitAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = UninitAllocator<U>;
+  };
+  template <class U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+};
+
 struct BlockCache {
   std::once_flag once;
-  std::vector<uint8_t> data;  // decoded bytes (compressed blocks only)
+  std::vector<uint8_t, UninitAllocator<uint8_t>> data;  // decoded bytes (compressed blocks only)
   Error error;
 };
 
@@ -60,6 +74,12 @@ struct File::Impl {
         return;
       }
       if (b.codec == Codec::kStored) return;
+      if (b.filter == Filter::kNone) {  // a frame that cannot hold rawSize bytes fails before the allocation
+        if (Status st = detail::checkZstdFrame(stored, b.rawSize, Code::kBlockDecode); !st) {
+          c.error = makeError(Code::kBlockDecode, "block " + std::to_string(bi) + ": " + st.error().message, tag, b.offset);
+          return;
+        }
+      }
       try {
         c.data.resize(b.rawSize);
       } catch (const std::bad_alloc&) {
@@ -69,7 +89,7 @@ struct File::Impl {
       Status st = detail::decodeBlock(b.codec, b.filter, {parsed.field.mapResolution}, stored, c.data, Code::kBlockDecode);
       if (!st) {
         c.error = makeError(Code::kBlockDecode, "block " + std::to_string(bi) + ": " + st.error().message, tag, b.offset);
-        std::vector<uint8_t>().swap(c.data);
+        decltype(c.data)().swap(c.data);
       }
     });
     if (c.error.code != Code::kOk) return c.error;
@@ -155,6 +175,9 @@ Status File::decodeBlock(Plane p, uint32_t block, std::span<uint8_t> out) const 
   auto stored = impl_->bytes.subspan(b.offset, b.storedSize);
   if (impl_->options.checksums == ChecksumPolicy::kLazy && detail::xxh3(stored) != b.checksum)
     return makeError(Code::kBlockChecksum, "block checksum does not match", p == Plane::kDistance ? kTagDistance : kTagNormal, b.offset);
+  if (b.codec == Codec::kZstd && b.filter == Filter::kNone)
+    if (Status st = detail::checkZstdFrame(stored, b.rawSize, Code::kBlockDecode); !st)
+      return makeError(Code::kBlockDecode, st.error().message, p == Plane::kDistance ? kTagDistance : kTagNormal, b.offset);
   Status st = detail::decodeBlock(b.codec, b.filter, {field().mapResolution}, stored, out, Code::kBlockDecode);
   if (!st) return makeError(Code::kBlockDecode, st.error().message, p == Plane::kDistance ? kTagDistance : kTagNormal, b.offset);
   return {};

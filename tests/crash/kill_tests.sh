@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # Crash safety: a writer killed with SIGKILL at any moment leaves the destination holding either the
 # old file, byte for byte, or (when there was none) nothing; never a truncated file under the real
-# name. Usage: kill_tests.sh TOOL BAKE CONVERT INSPECT MESHGEN
-#   TOOL  bake | convert_exr | convert_repack
+# name. Usage: kill_tests.sh TOOL BAKE CONVERT INSPECT MESHGEN COMPRESS
+#   TOOL  bake | convert_exr | convert_repack | compress
 set -uo pipefail
-tool="$1"; bake="$2"; convert="$3"; inspect="$4"; meshgen="$5"
+tool="$1"; bake="$2"; convert="$3"; inspect="$4"; meshgen="$5"; compress="$6"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 cd "$work"
@@ -16,6 +16,7 @@ case "$tool" in
   bake) dest=out.vff; cmd=("$bake" knot.obj -o out.vff -n 32 -m 64 --normals -q) ;;
   convert_exr) dest=out.exr; cmd=("$convert" big.vff --to exr out.exr) ;;
   convert_repack) dest=out.vff; cmd=("$convert" big.vff --to vff out.vff --codec zstd --max-texture-size 1024) ;;
+  compress) dest=out.vff; cmd=("$compress" big.vff out.vff -q) ;;
   *) fail "unknown tool $tool" ;;
 esac
 echo "old content, not a field" > old.bin

@@ -7,6 +7,7 @@
 
 #include <cerrno>
 #include <cinttypes>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 
@@ -95,6 +96,10 @@ void addCommonOptions(CLI::App& app, std::string_view prog, CommonOptions& optio
 }
 
 std::optional<int> parse(CLI::App& app, std::string_view prog, int argc, char** argv) {
+  // A write beyond RLIMIT_FSIZE (ulimit -f) raises SIGXFSZ, whose default action kills the process
+  // and leaves its temporary file behind. Ignored, the write fails with EFBIG instead and the tool
+  // reports it like a full disk: exit 2, the temporary removed, the destination untouched.
+  (void)std::signal(SIGXFSZ, SIG_IGN);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -85,6 +85,8 @@ void addCommonOptions(CLI::App& app, std::string_view prog, CommonOptions& optio
 // Parses the command line. Returns nothing when the tool should go on; otherwise the exit code to
 // return at once: kExitSuccess after --help or --version (printed to stdout), kExitUsage after a
 // parse error (printed to stderr as a diagnostic, with a hint to run --help).
+// It also ignores SIGXFSZ, so that a file growing past RLIMIT_FSIZE (ulimit -f) makes write() fail
+// with EFBIG, reported like a full disk (exit 2, no partial file), instead of killing the tool.
 std::optional<int> parse(CLI::App& app, std::string_view prog, int argc, char** argv);
 
 // ---- Formatting ---------------------------------------------------------------------------------

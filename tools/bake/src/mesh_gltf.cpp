@@ -171,12 +171,17 @@ class Importer {
       return makeError(Code::kMeshIndex, what + ": bufferView references a missing buffer");
     const tinygltf::Buffer& buf = model_.buffers[size_t(bv.buffer)];
     *stride = bv.byteStride ? bv.byteStride : elemSize;
-    const uint64_t begin = uint64_t(bv.byteOffset) + a.byteOffset;
-    const uint64_t need = a.count == 0 ? 0 : uint64_t(*stride) * (a.count - 1) + elemSize;
-    if (uint64_t(bv.byteOffset) + bv.byteLength > buf.data.size() || a.byteOffset + need > bv.byteLength ||
-        begin + need > buf.data.size())
-      return makeError(Code::kMeshIndex, what + ": accessor reaches outside its buffer");
-    *data = buf.data.data() + begin;
+    // Every sum and product is checked for overflow: the counts and offsets are the file's claims
+    // (a count of 2^62 + 1 would otherwise wrap to a small byte size).
+    uint64_t need = 0;
+    const bool huge = a.count != 0 && (__builtin_mul_overflow(uint64_t(*stride), uint64_t(a.count - 1), &need) ||
+                                       __builtin_add_overflow(need, uint64_t(elemSize), &need));
+    const auto fits = [](uint64_t off, uint64_t size, uint64_t limit) { return off <= limit && size <= limit - off; };
+    if (huge || !fits(bv.byteOffset, bv.byteLength, buf.data.size()) || !fits(a.byteOffset, need, bv.byteLength))
+      return makeError(Code::kMeshIndex, what + ": accessor of " + std::to_string(a.count) + " elements (stride " +
+                                             std::to_string(*stride) + ") reaches outside its " +
+                                             std::to_string(buf.data.size()) + "-byte buffer");
+    *data = buf.data.data() + bv.byteOffset + a.byteOffset;
     return {};
   }
 

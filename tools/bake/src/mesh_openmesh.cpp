@@ -3,6 +3,8 @@
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <OpenMesh/Core/System/omstream.hh>
 
+#include <cctype>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <set>
@@ -310,6 +312,33 @@ Status checkOff(const std::string& path) {
   return {};
 }
 
+// A binary STL is an 80-byte header, a u32 triangle count N and N records of 50 bytes; OpenMesh
+// takes a file whose size is not 84 + 50 N for ASCII and reads no triangle from it, so a header
+// that claims 10^9 triangles over a short body would end as "no triangles". A file that does not
+// start with "solid" (ASCII) must have the size its count gives.
+Status checkStl(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return makeError(Code::kIoOpen, path + ": cannot open");
+  unsigned char head[84] = {};
+  in.read(reinterpret_cast<char*>(head), sizeof head);
+  const uint64_t got = uint64_t(in.gcount());
+  size_t first = 0;
+  while (first < got && std::isspace(head[first])) ++first;
+  if (got - first >= 5 && std::memcmp(head + first, "solid", 5) == 0) return {};  // ASCII (or binary named so)
+  if (got < 84)
+    return makeError(Code::kMeshParse, path + ": " + std::to_string(got) +
+                                           " bytes: not an ASCII STL (no 'solid') and shorter than a binary STL header");
+  in.clear();
+  in.seekg(0, std::ios::end);
+  const uint64_t size = uint64_t(in.tellg());
+  const uint64_t n = uint64_t(head[80]) | uint64_t(head[81]) << 8 | uint64_t(head[82]) << 16 | uint64_t(head[83]) << 24;
+  if (size != 84 + 50 * n)
+    return makeError(Code::kMeshParse, path + ": binary STL header claims " + std::to_string(n) + " triangles (" +
+                                           std::to_string(84 + 50 * n) + " bytes), the file has " +
+                                           std::to_string(size) + " bytes");
+  return {};
+}
+
 }  // namespace
 
 Result<Mesh> loadWithOpenMesh(const std::string& path, const std::string& ext) {
@@ -324,6 +353,8 @@ Result<Mesh> loadWithOpenMesh(const std::string& path, const std::string& ext) {
     if (Status s = checkObjFaces(path); !s) return s.error();
   } else if (ext == "off") {
     if (Status s = checkOff(path); !s) return s.error();
+  } else if (ext == "stl") {
+    if (Status s = checkStl(path); !s) return s.error();
   }
   TriMesh tm;
   tm.request_vertex_normals();
