@@ -25,8 +25,6 @@ source "$(dirname "${BASH_SOURCE[0]}")/../common/cli_harness.sh"
 # Tool runs that are known to exceed the bound, with the reason; skipped (not run: each takes
 # gigabytes and tens of seconds) unless VFF_LIMITS_ALL=1. Delete a line once its cause is fixed.
 declare -A KNOWN=(
-  ["vff-inspect vff-block-raw-4gib.vff"]="tools/vff-inspect/statistics.cpp zero-fills a block's rawSize (4 GiB) before File::decodeBlock can reject the block"
-  ["vff-inspect vff-block-frame-4gib.vff"]="tools/vff-inspect/statistics.cpp zero-fills a block's rawSize (4 GiB) before File::decodeBlock can reject the block"
   ["vff-convert exr-slice-16k.exr"]="tools/vff-convert/exr.cpp allocates the claimed field and slice buffers (2.3 GiB) before OpenEXR finds that the part holds no pixels"
 )
 

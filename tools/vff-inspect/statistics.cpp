@@ -9,6 +9,8 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <memory>
+#include <new>
 
 #include "inspect.h"
 #include "vff/direction.h"
@@ -52,7 +54,10 @@ Result<DistanceStats> distanceStats(const File& file, uint32_t bins, bool skipBa
   }
   const uint32_t miss = missCode(enc);
 
-  std::vector<uint8_t> scratch;
+  // Not zero-filled: File::decodeBlock rejects a frame that cannot hold rawSize bytes before writing,
+  // so a block that claims gigabytes costs address space, not memory.
+  std::unique_ptr<uint8_t[]> scratch;
+  uint64_t scratchSize = 0;
   for (uint32_t b = 0; b < plane.blocks.size(); ++b) {
     const BlockInfo& blk = plane.blocks[b];
     std::span<const uint8_t> data;
@@ -65,14 +70,18 @@ Result<DistanceStats> distanceStats(const File& file, uint32_t bins, bool skipBa
       }
       data = *view;
     } else {
-      scratch.resize(blk.rawSize);
-      Status s = file.decodeBlock(Plane::kDistance, b, scratch);
+      if (blk.rawSize > scratchSize) {
+        scratch.reset(new (std::nothrow) uint8_t[blk.rawSize]);
+        scratchSize = scratch ? blk.rawSize : 0;
+        if (!scratch) return makeError(Code::kOutOfMemory, "cannot allocate a decoded block", kTagDistance, blk.offset);
+      }
+      Status s = file.decodeBlock(Plane::kDistance, b, std::span<uint8_t>(scratch.get(), blk.rawSize));
       if (!s) {
         if (!skipBadBlocks) return std::move(s).error();
         ++st.unreadableBlocks;
         continue;
       }
-      data = scratch;
+      data = std::span<const uint8_t>(scratch.get(), blk.rawSize);
     }
     const uint64_t blockTexels = texelsPerMap * blk.mapCount;
     st.texels += blockTexels;
