@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -57,6 +58,8 @@ nlohmann::json fieldJson(const FieldData& data, const char* formatName);
 Status parseFieldJson(const std::string& text, const char* formatName, const std::string& where, FieldData* data);
 // cos(alpha) of every texel centre of a map (row-major), for unorm8-chord.
 std::vector<float> texelCosines(const FieldDesc& field);
+// True when the file at `path` starts with `magic` (at most 16 bytes); false when it cannot be read.
+bool startsWithBytes(const std::string& path, std::span<const unsigned char> magic);
 // v clamped to [0, m - 1]: the map texel a gutter texel replicates.
 uint32_t clampToMap(int64_t v, uint32_t m);
 // v rounded to HALF when `half` (to nearest even, as Imath::half and the EXR export do), else v.

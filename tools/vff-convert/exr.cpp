@@ -78,12 +78,8 @@ class TempFile {
 }  // namespace
 
 bool looksLikeExr(const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return false;
-  unsigned char b[4] = {};
-  const size_t n = std::fread(b, 1, 4, f);
-  std::fclose(f);
-  return n == 4 && b[0] == 0x76 && b[1] == 0x2f && b[2] == 0x31 && b[3] == 0x01;
+  static constexpr unsigned char kExrMagic[4] = {0x76, 0x2f, 0x31, 0x01};
+  return startsWithBytes(path, kExrMagic);
 }
 
 Status writeExr(const std::string& path, const FieldData& d, const ExrWriteOptions& options) {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <exception>
 #include <utility>
@@ -134,6 +135,16 @@ std::vector<float> texelCosines(const FieldDesc& f) {
   for (uint32_t j = 0; j < m; ++j)
     for (uint32_t i = 0; i < m; ++i) c[uint64_t{j} * m + i] = texelDirection(f.directionScheme, m, i, j).z;
   return c;
+}
+
+bool startsWithBytes(const std::string& path, std::span<const unsigned char> magic) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return false;
+  unsigned char b[16] = {};
+  const size_t want = std::min(magic.size(), sizeof b);
+  const size_t n = std::fread(b, 1, want, f);
+  std::fclose(f);
+  return n == want && std::memcmp(b, magic.data(), want) == 0;
 }
 
 uint32_t clampToMap(int64_t v, uint32_t m) {

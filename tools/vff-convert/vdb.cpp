@@ -129,14 +129,7 @@ Status fixUuid(std::string* bytes) {
 
 }  // namespace
 
-bool looksLikeVdb(const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return false;
-  unsigned char b[8] = {};
-  const size_t n = std::fread(b, 1, 8, f);
-  std::fclose(f);
-  return n == 8 && std::memcmp(b, kVdbMagic, 8) == 0;
-}
+bool looksLikeVdb(const std::string& path) { return startsWithBytes(path, kVdbMagic); }
 
 Status writeVdb(const std::string& path, const FieldData& d, const VdbWriteOptions& options,
                 VdbWriteReport* report) {
