@@ -119,6 +119,26 @@ class Progress {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now(), last_{};
 };
 
+// The --json keys every bake reports (the callers add their input's and timing keys).
+nlohmann::json bakeSummary(const Options& o, const BakeOptions& bo, const vff::FieldDesc& field,
+                           const vff::bake::BakeStats& s, uint64_t payload, double bakeSeconds) {
+  const double rays = double(s.rays);
+  return {{"sphere", {{"center", {field.sphere.center[0], field.sphere.center[1], field.sphere.center[2]}},
+                      {"radius", field.sphere.radius}}},
+          {"positions", o.positions},
+          {"positionParam", bo.positionParam},
+          {"maps", field.mapCount},
+          {"mapResolution", field.mapResolution},
+          {"encoding", o.encoding},
+          {"normals", o.normals},
+          {"rays", s.rays},
+          {"hits", s.hits},
+          {"hitRatio", rays > 0 ? double(s.hits) / rays : 0.0},
+          {"payloadBytes", payload},
+          {"raysPerSecond", bakeSeconds > 0 ? rays / bakeSeconds : 0.0},
+          {"peakRssMiB", peakRssMiB()}};
+}
+
 bool isVdbPath(const std::string& p) {
   if (p.size() < 4) return false;
   std::string ext = p.substr(p.size() - 4);
@@ -185,28 +205,14 @@ int bakeFromLevelSet(const Options& o, BakeOptions bo, vff::WriteOptions wo) {
   const vff::bake::BakeStats& s = baked->stats;
   const double rays = double(s.rays);
   if (o.json) {
-    nlohmann::json summary = {
-        {"input", o.mesh},
-        {"grid", info.grid},
-        {"activeVoxels", info.activeVoxels},
-        {"voxelSize", info.voxelSize},
-        {"sphere", {{"center", {field->sphere.center[0], field->sphere.center[1], field->sphere.center[2]}},
-                    {"radius", field->sphere.radius}}},
-        {"positions", o.positions},
-        {"positionParam", bo.positionParam},
-        {"maps", field->mapCount},
-        {"mapResolution", field->mapResolution},
-        {"encoding", o.encoding},
-        {"normals", o.normals},
-        {"rays", s.rays},
-        {"hits", s.hits},
-        {"hitRatio", rays > 0 ? double(s.hits) / rays : 0.0},
-        {"payloadBytes", payload},
-        {"seconds", {{"load", loadSeconds}, {"bake", s.seconds}, {"write", writeSeconds}}},
-        {"raysPerSecond", s.seconds > 0 ? rays / s.seconds : 0.0},
-        {"peakRssMiB", peakRssMiB()},
-        {"output", o.output},
-        {"fileBytes", fileBytes}};
+    nlohmann::json summary = bakeSummary(o, bo, *field, s, payload, s.seconds);
+    summary.update({{"input", o.mesh},
+                    {"grid", info.grid},
+                    {"activeVoxels", info.activeVoxels},
+                    {"voxelSize", info.voxelSize},
+                    {"seconds", {{"load", loadSeconds}, {"bake", s.seconds}, {"write", writeSeconds}}},
+                    {"output", o.output},
+                    {"fileBytes", fileBytes}});
     std::printf("%s\n", summary.dump(2).c_str());
   } else if (!o.quiet) {
     std::fprintf(stderr,
@@ -389,28 +395,14 @@ int main(int argc, char** argv) {
   const double meshMiB = double(mesh->positions.size() * 4 + mesh->normals.size() * 4 + mesh->indices.size() * 4) / 1048576.0;
   const double bvhMiB = double(scene->embreeBytes()) / 1048576.0;
   const double payloadMiB = double(payload) / 1048576.0;
-  nlohmann::json summary = {
-      {"mesh", o.mesh},
-      {"vertices", mesh->vertexCount()},
-      {"triangles", mesh->triangleCount()},
-      {"droppedDegenerate", mesh->droppedDegenerate},
-      {"sphere", {{"center", {field->sphere.center[0], field->sphere.center[1], field->sphere.center[2]}},
-                  {"radius", field->sphere.radius}}},
-      {"positions", o.positions},
-      {"positionParam", bo.positionParam},
-      {"maps", field->mapCount},
-      {"mapResolution", field->mapResolution},
-      {"encoding", o.encoding},
-      {"normals", o.normals},
-      {"rays", s.rays},
-      {"hits", s.hits},
-      {"hitRatio", rays > 0 ? double(s.hits) / rays : 0.0},
-      {"payloadBytes", payload},
-      {"seconds", {{"load", loadSeconds}, {"build", buildSeconds}, {"bake", bakeBest}, {"write", writeSeconds}}},
-      {"raysPerSecond", bakeBest > 0 ? rays / bakeBest : 0.0},
-      {"peakRssMiB", peakRssMiB()},
-      {"meshMiB", meshMiB},
-      {"bvhMiB", bvhMiB}};
+  nlohmann::json summary = bakeSummary(o, bo, *field, s, payload, bakeBest);
+  summary.update({{"mesh", o.mesh},
+                  {"vertices", mesh->vertexCount()},
+                  {"triangles", mesh->triangleCount()},
+                  {"droppedDegenerate", mesh->droppedDegenerate},
+                  {"seconds", {{"load", loadSeconds}, {"build", buildSeconds}, {"bake", bakeBest}, {"write", writeSeconds}}},
+                  {"meshMiB", meshMiB},
+                  {"bvhMiB", bvhMiB}});
   if (writer) {
     summary["output"] = o.output;
     summary["fileBytes"] = fileBytes;
