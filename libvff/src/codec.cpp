@@ -3,6 +3,7 @@
 #include <xxhash.h>
 #include <zstd.h>
 
+#include <memory>
 #include <new>
 #include <cstring>
 #include <string>
@@ -96,12 +97,10 @@ Status decodeBlock(Codec codec, Filter filter, const BlockShape& shape, std::spa
     return makeError(failCode, "zstd frame declares " + std::to_string(content) + " bytes, more than the " +
                                    std::to_string(bound) + " a " + filterName(filter) + " block of " +
                                    std::to_string(out.size()) + " bytes can hold");
-  std::vector<uint8_t> filtered;
-  try {
-    filtered.resize(size_t(content));
-  } catch (const std::bad_alloc&) {
-    return makeError(Code::kOutOfMemory, "cannot allocate a filtered block");
-  }
+  // Not zero-filled: zstd writes every byte before the filter reads it.
+  std::unique_ptr<uint8_t[]> buffer(new (std::nothrow) uint8_t[size_t(content)]);
+  if (!buffer && content) return makeError(Code::kOutOfMemory, "cannot allocate a filtered block");
+  const std::span<uint8_t> filtered(buffer.get(), size_t(content));
   if (Status st = decompress(codec, stored, filtered, failCode); !st) return st;
   return unapplyFilter(filter, shape, filtered, out, failCode);
 }
