@@ -10,7 +10,10 @@
 //   binding VFF_FIELD_BINDING      (default 0): uniform block VffFieldBlock (std140, vff::gl::FieldBlock)
 //   binding VFF_MAPS_BINDING       (default 1): the packed distance slices, usampler2DArray
 //                                               (usampler3D when VFF_MAPS_3D is defined);
-//                                               R8UI for unorm8-* and bit1, R16UI for unorm16-diameter
+//                                               R8UI for unorm8-* and bit1, R16UI for unorm16-diameter;
+//                                               for bc4-diameter define VFF_MAPS_BC4: a sampler2DArray
+//                                               of GL_COMPRESSED_RED_RGTC1 (vff::gl::shaderDefines
+//                                               gives the defines a field needs)
 //   binding VFF_POSITIONS_BINDING  (default 2): buffer VffPositionsBlock, the binary32 unit vectors
 //                                               of the samples (vff::PositionSet::position), one vec4
 //                                               each, then (unorm8-chord) the per-texel decode scales,
@@ -88,7 +91,13 @@ layout(std140, binding = VFF_FIELD_BINDING) uniform VffFieldBlock {
   uint reserved1;
 } vffField;
 
-#ifdef VFF_MAPS_3D
+#if defined(VFF_MAPS_BC4)
+// bc4-diameter: the texture unit decodes the BC4 blocks (spec/format.md 7.4); 2D arrays only.
+layout(binding = VFF_MAPS_BINDING) uniform highp sampler2DArray vffMaps;
+#ifndef VFF_NO_NORMALS
+layout(binding = VFF_NORMALS_BINDING) uniform highp isampler2DArray vffNormals;
+#endif
+#elif defined(VFF_MAPS_3D)
 layout(binding = VFF_MAPS_BINDING) uniform highp usampler3D vffMaps;
 #ifndef VFF_NO_NORMALS
 layout(binding = VFF_NORMALS_BINDING) uniform highp isampler3D vffNormals;
@@ -119,6 +128,7 @@ const uint VFF_ENCODING_UNORM8_DIAMETER = 1u;
 const uint VFF_ENCODING_UNORM8_CHORD = 2u;
 const uint VFF_ENCODING_UNORM16_DIAMETER = 3u;
 const uint VFF_ENCODING_BIT1 = 4u;
+const uint VFF_ENCODING_BC4_DIAMETER = 5u;
 
 // ---- Arithmetic ----------------------------------------------------------------------------------
 // a / b, correctly rounded (one Newton correction of the driver's quotient, with a fused residual).
@@ -338,9 +348,16 @@ uvec3 vffPlace(uint k, uvec2 ij) {
 // The stored code of texel (i, j) of map k: placeMap, then texelFetch in the packed slices.
 uint vffFetchCode(uint k, uvec2 ij) {
   uvec3 p = vffPlace(k, ij);
+#ifdef VFF_MAPS_BC4
+  // The palette entry as a normalised value: its code is round(value * 255). Texture units may round
+  // the interpolated entries differently from the CPU's integer rule (by under one code); 0 and 255
+  // (a miss) are exact.
+  return uint(round(texelFetch(vffMaps, ivec3(p), 0).r * 255.0));
+#else
   if (vffField.distanceEncoding == VFF_ENCODING_BIT1)
     return (texelFetch(vffMaps, ivec3(int(p.x >> 3u), int(p.y), int(p.z)), 0).r >> (p.x & 7u)) & 1u;
   return texelFetch(vffMaps, ivec3(p), 0).r;
+#endif
 }
 
 // oct-snorm16 (spec/format.md 7.3) as vff::decodeNormal: X / 32767 clamped to -1, the octahedral

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "le.h"
+#include "vff/bc4.h"
 
 namespace vff {
 namespace {
@@ -47,6 +48,8 @@ uint32_t loadCode(DistanceEncoding e, std::span<const uint8_t> map, uint32_t m, 
     case DistanceEncoding::kUnorm8Chord: return map[t];
     case DistanceEncoding::kUnorm16Diameter: return detail::loadU16(&map[2 * t]);
     case DistanceEncoding::kBit1: return (map[t / 8] >> (t % 8)) & 1u;
+    case DistanceEncoding::kBc4Diameter:
+      return bc4Texel(&map[(size_t(j / 4) * (m / 4) + i / 4) * kBc4BlockBytes], (j % 4) * 4 + i % 4);
     case DistanceEncoding::kInvalid: break;
   }
   return 0;
@@ -64,6 +67,7 @@ void storeCode(DistanceEncoding e, std::span<uint8_t> map, uint32_t m, uint32_t 
       map[t / 8] = code ? uint8_t(map[t / 8] | bit) : uint8_t(map[t / 8] & ~bit);
       break;
     }
+    case DistanceEncoding::kBc4Diameter:  // blocks are encoded whole (encodeBc4Map)
     case DistanceEncoding::kInvalid: break;
   }
 }

@@ -50,6 +50,7 @@ const char* distanceEncodingName(DistanceEncoding e) noexcept {
     case DistanceEncoding::kUnorm8Chord: return "unorm8-chord";
     case DistanceEncoding::kUnorm16Diameter: return "unorm16-diameter";
     case DistanceEncoding::kBit1: return "bit1";
+    case DistanceEncoding::kBc4Diameter: return "bc4-diameter";
     case DistanceEncoding::kInvalid: break;
   }
   return "invalid";
@@ -94,7 +95,8 @@ Result<uint32_t> positionCount(PositionScheme scheme, uint32_t n) {
 uint32_t missCode(DistanceEncoding e) noexcept {
   switch (e) {
     case DistanceEncoding::kUnorm8Diameter:
-    case DistanceEncoding::kUnorm8Chord: return 255;
+    case DistanceEncoding::kUnorm8Chord:
+    case DistanceEncoding::kBc4Diameter: return 255;
     case DistanceEncoding::kUnorm16Diameter: return 65535;
     case DistanceEncoding::kBit1:
     case DistanceEncoding::kInvalid: break;
@@ -105,7 +107,8 @@ uint32_t missCode(DistanceEncoding e) noexcept {
 uint32_t maxHitCode(DistanceEncoding e) noexcept {
   switch (e) {
     case DistanceEncoding::kUnorm8Diameter:
-    case DistanceEncoding::kUnorm8Chord: return 254;
+    case DistanceEncoding::kUnorm8Chord:
+    case DistanceEncoding::kBc4Diameter: return 254;
     case DistanceEncoding::kUnorm16Diameter: return 65534;
     case DistanceEncoding::kBit1: return 1;
     case DistanceEncoding::kInvalid: break;
@@ -120,6 +123,7 @@ uint64_t distanceMapBytes(DistanceEncoding e, uint32_t m) noexcept {
     case DistanceEncoding::kUnorm8Chord: return texels;
     case DistanceEncoding::kUnorm16Diameter: return texels * 2;
     case DistanceEncoding::kBit1: return (m % 8 == 0) ? texels / 8 : 0;
+    case DistanceEncoding::kBc4Diameter: return (m % 4 == 0) ? texels / 2 : 0;
     case DistanceEncoding::kInvalid: break;
   }
   return 0;
@@ -146,7 +150,7 @@ Status checkFieldDesc(const FieldDesc& d) {
     return makeError(Code::kDirectionScheme, "unknown direction scheme " + std::to_string(uint32_t(d.directionScheme)));
   if (d.frame != FrameConvention::kDuff2017)
     return makeError(Code::kFrameConvention, "unknown tangent-frame convention " + std::to_string(uint32_t(d.frame)));
-  if (d.distanceEncoding == DistanceEncoding::kInvalid || uint32_t(d.distanceEncoding) > 4)
+  if (d.distanceEncoding == DistanceEncoding::kInvalid || uint32_t(d.distanceEncoding) > 5)
     return makeError(Code::kDistanceEncoding, "unknown distance encoding " + std::to_string(uint32_t(d.distanceEncoding)));
   if (d.mapResolution < 1 || d.mapResolution > kMaxMapResolution)
     return makeError(Code::kMapResolution, "mapResolution must be in [1, " + std::to_string(kMaxMapResolution) +
@@ -154,6 +158,9 @@ Status checkFieldDesc(const FieldDesc& d) {
   if (d.distanceEncoding == DistanceEncoding::kBit1 && d.mapResolution % 8 != 0)
     return makeError(Code::kMapResolution, "bit1 maps need a mapResolution that is a multiple of 8, got " +
                                                std::to_string(d.mapResolution));
+  if (d.distanceEncoding == DistanceEncoding::kBc4Diameter && d.mapResolution % 4 != 0)
+    return makeError(Code::kMapResolution, "bc4-diameter maps need a mapResolution that is a multiple of 4 "
+                                           "(4x4 texel blocks), got " + std::to_string(d.mapResolution));
   if (d.normalEncoding != NormalEncoding::kNone && d.normalEncoding != NormalEncoding::kOctSnorm16)
     return makeError(Code::kNormalEncoding, "unknown normal encoding " + std::to_string(uint32_t(d.normalEncoding)));
   return {};

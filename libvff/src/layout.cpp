@@ -8,8 +8,12 @@ namespace vff {
 Result<LayoutDesc> computeLayout(const FieldDesc& field, const LayoutLimits& limits) {
   if (limits.target != LayoutTarget::kTexture2DArray && limits.target != LayoutTarget::kTexture3D)
     return makeError(Code::kLayoutTarget, "unknown texture target " + std::to_string(uint32_t(limits.target)));
+  if (field.distanceEncoding == DistanceEncoding::kBc4Diameter && limits.target != LayoutTarget::kTexture2DArray)
+    return makeError(Code::kLayoutTarget, "bc4-diameter fields need the 2d-array target (GL has no BC4 3D textures)");
   if (field.distanceEncoding == DistanceEncoding::kBit1 && limits.gutter != 0)
     return makeError(Code::kLayoutTile, "bit1 fields cannot have a gutter (8 texels share a byte)");
+  if (field.distanceEncoding == DistanceEncoding::kBc4Diameter && limits.gutter != 0)
+    return makeError(Code::kLayoutTile, "bc4-diameter fields cannot have a gutter (tiles start on 4x4 blocks)");
   if (limits.gutter > 64) return makeError(Code::kLayoutTile, "gutter must be at most 64 texels");
   const uint64_t tile = uint64_t(field.mapResolution) + 2ull * limits.gutter;
   if (field.mapCount == 0 || tile == 0) return makeError(Code::kLayoutGeometry, "field has no maps");
@@ -51,8 +55,12 @@ Result<LayoutDesc> computeLayout(const FieldDesc& field, const LayoutLimits& lim
 Status checkLayout(const LayoutDesc& l, const FieldDesc& field) {
   if (l.target != LayoutTarget::kTexture2DArray && l.target != LayoutTarget::kTexture3D)
     return makeError(Code::kLayoutTarget, "unknown texture target " + std::to_string(uint32_t(l.target)));
+  if (field.distanceEncoding == DistanceEncoding::kBc4Diameter && l.target != LayoutTarget::kTexture2DArray)
+    return makeError(Code::kLayoutTarget, "bc4-diameter fields need the 2d-array target");
   if (field.distanceEncoding == DistanceEncoding::kBit1 && l.gutter != 0)
     return makeError(Code::kLayoutTile, "bit1 fields cannot have a gutter");
+  if (field.distanceEncoding == DistanceEncoding::kBc4Diameter && l.gutter != 0)
+    return makeError(Code::kLayoutTile, "bc4-diameter fields cannot have a gutter");
   if (l.gutter > 64) return makeError(Code::kLayoutTile, "gutter " + std::to_string(l.gutter) + " exceeds 64 texels");
   if (uint64_t(l.tileSize) != uint64_t(field.mapResolution) + 2ull * l.gutter)
     return makeError(Code::kLayoutTile, "tileSize " + std::to_string(l.tileSize) +

@@ -328,6 +328,12 @@ class Parser {
                       num(missCode(f.distanceEncoding))))
         return false;
     }
+    if (ok && f.distanceEncoding == DistanceEncoding::kBc4Diameter && !(out_->info.incompatFeatures & kFeatureBc4)) {
+      // The file is still readable; a reader that does not know bc4 would only fail later (rule 5007).
+      if (!report(Code::kFeatureBit, 0, 24,
+                  "the distance encoding is bc4-diameter but the bc4 feature bit (incompatFeatures bit 2) is clear"))
+        return false;
+    }
     if (ok) {
       const ReadOptions& lim = opt_.limits;
       uint64_t payload = 0;

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "vff/bc4.h"
 #include "vff/encoding.h"
 #include "vff/reader.h"
 
@@ -62,6 +63,11 @@ struct FieldQuery::Impl {
   std::vector<float> chordScale;     // unorm8-chord: 2R cos(alpha) / 254 per texel (M * M)
   uint64_t payload = 0;
 
+  // bc4-diameter: the byte offset of the block that holds texel (i, j) of a map.
+  size_t bc4Block(uint32_t i, uint32_t j) const noexcept {
+    return (size_t(j >> 2) * (m >> 2) + (i >> 2)) * kBc4BlockBytes;
+  }
+
   Sample texel(uint32_t k, uint32_t i, uint32_t j) const noexcept {
     const uint8_t* map = dist[k];
     const size_t t = size_t(j) * m + i;
@@ -80,6 +86,10 @@ struct FieldQuery::Impl {
       }
       case DistanceEncoding::kBit1:
         return {((map[t / 8] >> (t % 8)) & 1u) != 0, 0.0f};
+      case DistanceEncoding::kBc4Diameter: {
+        const uint32_t c = bc4Texel(map + bc4Block(i, j), (j & 3u) * 4 + (i & 3u));
+        return {c != 255u, float(c) * (2.0f * radius / 254.0f)};
+      }
       case DistanceEncoding::kInvalid: break;
     }
     return {};
@@ -130,6 +140,7 @@ struct FieldQuery::Impl {
     switch (field.distanceEncoding) {
       case DistanceEncoding::kUnorm16Diameter: return dist[l.k0] + 2 * t;
       case DistanceEncoding::kBit1: return dist[l.k0] + t / 8;
+      case DistanceEncoding::kBc4Diameter: return dist[l.k0] + bc4Block(l.i, l.j);
       default: return dist[l.k0] + t;
     }
   }

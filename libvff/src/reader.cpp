@@ -192,6 +192,7 @@ uint64_t File::sliceBytes(Plane p) const noexcept {
     case DistanceEncoding::kUnorm8Chord: return texels;
     case DistanceEncoding::kUnorm16Diameter: return texels * 2;
     case DistanceEncoding::kBit1: return texels / 8;
+    case DistanceEncoding::kBc4Diameter: return texels / 2;
     case DistanceEncoding::kInvalid: break;
   }
   return 0;
@@ -204,12 +205,16 @@ Status File::readSlice(Plane p, uint32_t slice, std::span<uint8_t> out) const {
   if (slice >= l.sliceCount) return makeError(Code::kOutOfRange, "slice " + std::to_string(slice) + " out of range");
   if (out.size() != sliceBytes(p)) return makeError(Code::kInvalidArgument, "output size differs from sliceBytes()");
   const bool bit1 = p == Plane::kDistance && f.distanceEncoding == DistanceEncoding::kBit1;
+  // bc4: the rows below are rows of 4x4 blocks (8 bytes each); such fields have no gutter.
+  const bool bc4 = p == Plane::kDistance && f.distanceEncoding == DistanceEncoding::kBc4Diameter;
   // Bytes per texel (bit1: a texel column of 8 map texels is one byte).
   const uint32_t tb = p == Plane::kNormal ? 4 : f.distanceEncoding == DistanceEncoding::kUnorm16Diameter ? 2 : 1;
   const uint32_t m = f.mapResolution;
-  const uint64_t rowBytes = bit1 ? l.sliceWidth / 8 : uint64_t(l.sliceWidth) * tb;
-  const uint64_t mapRowBytes = bit1 ? m / 8 : uint64_t(m) * tb;
-  // Empty tiles: the miss code (all ones for unorm encodings, zero bits for bit1) or zero normals.
+  const uint64_t rowBytes = bit1 ? l.sliceWidth / 8 : bc4 ? uint64_t(l.sliceWidth) * 2 : uint64_t(l.sliceWidth) * tb;
+  const uint64_t mapRowBytes = bit1 ? m / 8 : bc4 ? uint64_t(m) * 2 : uint64_t(m) * tb;
+  const uint32_t mapRows = bc4 ? m / 4 : m;
+  // Empty tiles: the miss code (all ones for unorm encodings, and a block of all-ones bytes is all
+  // misses in bc4; zero bits for bit1) or zero normals.
   const uint8_t fill = (p == Plane::kDistance && !bit1) ? 0xFF : 0x00;
   std::fill(out.begin(), out.end(), fill);
   const uint64_t perSlice = uint64_t(l.tilesPerRow) * l.tilesPerColumn;
@@ -220,9 +225,10 @@ Status File::readSlice(Plane p, uint32_t slice, std::span<uint8_t> out) const {
     auto data = mapData(p, map);
     if (!data) return std::move(data).error();
     const TilePlacement tp = placeMap(l, map);
-    const uint64_t x0 = bit1 ? tp.x / 8 : uint64_t(tp.x) * tb;
-    for (uint32_t j = 0; j < m; ++j)
-      std::memcpy(&out[(tp.y + j) * rowBytes + x0], data->data() + j * mapRowBytes, mapRowBytes);
+    const uint64_t x0 = bit1 ? tp.x / 8 : bc4 ? uint64_t(tp.x) * 2 : uint64_t(tp.x) * tb;
+    const uint64_t y0 = bc4 ? tp.y / 4 : tp.y;
+    for (uint32_t j = 0; j < mapRows; ++j)
+      std::memcpy(&out[(y0 + j) * rowBytes + x0], data->data() + j * mapRowBytes, mapRowBytes);
     if (g == 0) continue;
     // Gutters: replicate the edge texels outwards, first along rows, then whole rows.
     for (uint32_t j = 0; j < m; ++j) {

@@ -382,13 +382,15 @@ struct Writer::Impl {
       if (s.codec == Codec::kZstd) incompat |= kFeatureZstd;
     if (planes[0].anyZstd || planes[1].anyZstd) incompat |= kFeatureZstd;
     if (planes[0].anyFilter || planes[1].anyFilter) incompat |= kFeatureFilters;
+    if (field.distanceEncoding == DistanceEncoding::kBc4Diameter) incompat |= kFeatureBc4;
     const SectionRecord& last = sections.back();
     const uint64_t fileSize = last.offset + last.storedSize;
     std::vector<uint8_t> head(kHeaderSize + sections.size() * kSectionEntrySize, 0);
     std::copy(std::begin(kMagic), std::end(kMagic), head.begin());
     store<uint16_t>(&head[8], kVersionMajor);
-    // The lowest version that holds the file: 1.0 unless a 1.1 feature (a filter) is used.
-    store<uint16_t>(&head[10], uint16_t((incompat & kFeatureFilters) ? 1 : 0));
+    // The lowest version that holds the file: 1.2 with a 1.2 feature (bc4-diameter), else 1.1 with a
+    // 1.1 feature (a filter), else 1.0.
+    store<uint16_t>(&head[10], uint16_t((incompat & kFeatureBc4) ? 2 : (incompat & kFeatureFilters) ? 1 : 0));
     store<uint32_t>(&head[12], kHeaderSize);
     store<uint64_t>(&head[16], fileSize);
     store<uint64_t>(&head[24], incompat);

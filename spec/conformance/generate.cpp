@@ -308,6 +308,7 @@ D3 localDirection(DirectionScheme scheme, uint32_t m, uint32_t i, uint32_t j) {
 
 struct Content {
   Bytes distance;  // mapCount maps, in file order
+  Bytes codes;     // bc4-diameter: the unorm8-diameter codes the blocks were made from (M*M per map)
   Bytes normals;   // empty without a normal encoding
   uint64_t hits = 0, misses = 0;
 };
@@ -333,6 +334,8 @@ Content makeContent(const FieldDesc& f) {
     if (frameErr > 1e-5) fail("libvff's frameFromNormal disagrees with the Duff et al. 2017 basis");
     const D3 origin = centre + p * r;
     auto map = std::span<uint8_t>(c.distance).subspan(k * mapBytes, mapBytes);
+    const bool bc4 = f.distanceEncoding == DistanceEncoding::kBc4Diameter;
+    if (bc4 && k == 0) c.codes.assign(uint64_t(m) * m * f.mapCount, 255);
     for (uint32_t j = 0; j < m; ++j)
       for (uint32_t i = 0; i < m; ++i) {
         const D3 l = localDirection(f.directionScheme, m, i, j);
@@ -346,7 +349,8 @@ Content makeContent(const FieldDesc& f) {
         const bool hit = disc >= 0;
         const double t = hit ? -bq - std::sqrt(disc) : 0.0;
         const uint32_t code = encodeDistance(f.distanceEncoding, hit, float(t), f.sphere.radius, ll.z);
-        storeCode(f.distanceEncoding, map, m, i, j, code);
+        if (bc4) c.codes[(uint64_t(k) * m + j) * m + i] = uint8_t(code);
+        else storeCode(f.distanceEncoding, map, m, i, j, code);
         (hit ? c.hits : c.misses)++;
         if (hit && withNormals) {
           const D3 nn = normalize(origin + w * t - inner);
@@ -354,8 +358,27 @@ Content makeContent(const FieldDesc& f) {
                        &c.normals[(uint64_t(k) * m * m + uint64_t(j) * m + i) * 4]);
         }
       }
+    // bc4-diameter: the blocks come from libvff's encoder; the checks decode them with the reference
+    // decoder below, written from spec/format.md 7.4.
+    if (bc4) encodeBc4Map(std::span<const uint8_t>(c.codes).subspan(uint64_t(k) * m * m, uint64_t(m) * m), m, map);
   }
   return c;
+}
+
+// ---- bc4-diameter, decoded from spec/format.md 7.4 independently of libvff ------------------------
+// The code of texel (i, j) of a map of (M/4)^2 blocks.
+uint32_t referenceBc4Code(std::span<const uint8_t> map, uint32_t m, uint32_t i, uint32_t j) {
+  const uint8_t* b = &map[8 * (uint64_t(j / 4) * (m / 4) + i / 4)];
+  uint64_t w = 0;
+  for (int k = 0; k < 6; ++k) w |= uint64_t(b[2 + k]) << (8 * k);
+  const uint32_t u = 4 * (j % 4) + i % 4;
+  const uint32_t k = uint32_t(w >> (3 * u)) & 7u, r0 = b[0], r1 = b[1];
+  if (k == 0) return r0;
+  if (k == 1) return r1;
+  if (r0 > r1) return ((8 - k) * r0 + (k - 1) * r1 + 3) / 7;
+  if (k == 6) return 0;
+  if (k == 7) return 255;
+  return ((6 - k) * r0 + (k - 1) * r1 + 2) / 5;
 }
 
 // ---- Filter 1 (hits-med), written from spec/format.md independently of libvff --------------------
@@ -432,6 +455,23 @@ std::vector<Bytes> composeSlices(const FieldDesc& f, const LayoutDesc& l, const 
   const Bytes& src = p == Plane::kNormal ? c.normals : c.distance;
   const uint32_t perSlice = l.tilesPerRow * l.tilesPerColumn;
   std::vector<Bytes> out;
+  if (p == Plane::kDistance && f.distanceEncoding == DistanceEncoding::kBc4Diameter) {
+    // Slices of 4x4 blocks, row-major; block (bx, by) of map k at slice block (x0/4 + bx, y0/4 + by);
+    // all-miss blocks (FF bytes) in the unused tiles. No gutters.
+    const uint32_t bw = l.sliceWidth / 4, bh = l.sliceHeight / 4, mb = m / 4;
+    for (uint32_t s = 0; s < l.sliceCount; ++s) {
+      Bytes slice(uint64_t(bw) * bh * 8, 0xFF);
+      for (uint32_t by = 0; by < bh; ++by)
+        for (uint32_t bx = 0; bx < bw; ++bx) {
+          const uint64_t map = uint64_t(s) * perSlice + (by * 4 / l.tileSize) * l.tilesPerRow + bx * 4 / l.tileSize;
+          if (map >= f.mapCount) continue;
+          const uint64_t from = map * mapBytes + 8 * (uint64_t((by * 4 % l.tileSize) / 4) * mb + (bx * 4 % l.tileSize) / 4);
+          std::copy_n(&src[from], 8, &slice[8 * (uint64_t(by) * bw + bx)]);
+        }
+      out.push_back(std::move(slice));
+    }
+    return out;
+  }
   for (uint32_t s = 0; s < l.sliceCount; ++s) {
     Bytes slice(rowBytes * l.sliceHeight, 0);
     for (uint32_t y = 0; y < l.sliceHeight; ++y)
@@ -603,6 +643,11 @@ std::vector<ValidCase> validCases() {
                makeField(DE::kUnorm8Diameter, NE::kNone, PS::kOctaHemi2, 2, DS::kConcentricEqualArea, 16, unitish),
                makeOptions(Codec::kZstd, LT::kTexture2DArray, 0, 2048, 26)});
   v.back().options.filter = Filter::kHitsMed;
+  v.push_back({"bc4-zstd-normals-slices",
+               "format 1.2: bc4-diameter, zstd, normals, octa-hemi2 n=2 (26 maps of 16x16), maxTextureSize 64 "
+               "(4x4 tiles, 2 slices, the second with 6 unused tiles)",
+               makeField(DE::kBc4Diameter, NE::kOctSnorm16, PS::kOctaHemi2, 2, DS::kConcentricEqualArea, 16, unitish),
+               makeOptions(Codec::kZstd, LT::kTexture2DArray, 0, 64, 0)});
   ValidCase unknownOptional = v[0];
   unknownOptional.name = "unknown-section-optional";
   unknownOptional.description = "u8d-stored plus an unknown section 'XTST' with flags 0 (a reader skips it)";
@@ -770,7 +815,8 @@ std::string expectedJson(const BuiltValid& v) {
     std::string normals;
     for (uint32_t t = 0; t < m * m; ++t) {
       const uint32_t i = t % m, j = t / m;
-      const uint32_t code = loadCode(f.distanceEncoding, dmap, m, i, j);
+      const uint32_t code = f.distanceEncoding == DistanceEncoding::kBc4Diameter ? referenceBc4Code(dmap, m, i, j)
+                                                                                : loadCode(f.distanceEncoding, dmap, m, i, j);
       const Texel tx =
           decodeDistance(f.distanceEncoding, code, f.sphere.radius, texelDirection(f.directionScheme, m, i, j).z);
       if (t % m == 0) s += t ? "\n                  " : "";
@@ -875,8 +921,29 @@ void checkValid(const BuiltValid& v) {
     }
     if (ld16(v.bytes, 10) != 1 || ld64(v.bytes, 24) != (kFeatureZstd | kFeatureFilters))
       fail(n + ": a filtered file must be version 1.1 with incompatFeatures zstd | filters");
+  } else if (v.c.field.distanceEncoding == DistanceEncoding::kBc4Diameter) {
+    if (ld16(v.bytes, 10) != 2 || !(ld64(v.bytes, 24) & kFeatureBc4))
+      fail(n + ": a bc4-diameter file must be version 1.2 with incompatFeatures bit 2");
+    // spec/format.md 7.4's writer rules, checked with the reference decoder: a miss decodes to 255,
+    // a hit to a code <= 254 near the code it was made from; libvff's loadCode agrees texel for texel.
+    const uint32_t m = v.c.field.mapResolution;
+    const uint64_t mb = distanceMapBytes(v.c.field.distanceEncoding, m);
+    uint32_t worst = 0;
+    for (uint32_t k = 0; k < v.c.field.mapCount; ++k) {
+      const auto map = std::span<const uint8_t>(v.content.distance).subspan(k * mb, mb);
+      for (uint32_t j = 0; j < m; ++j)
+        for (uint32_t i = 0; i < m; ++i) {
+          const uint32_t want = v.content.codes[(uint64_t(k) * m + j) * m + i];
+          const uint32_t got = referenceBc4Code(map, m, i, j);
+          if (got != loadCode(v.c.field.distanceEncoding, map, m, i, j))
+            fail(n + ": libvff's loadCode differs from the reference BC4 decoder");
+          if ((want == 255) != (got == 255)) fail(n + ": a BC4 block turned a miss into a hit or a hit into a miss");
+          if (want != 255) worst = std::max(worst, uint32_t(std::abs(int(got) - int(want))));
+        }
+    }
+    if (worst > 8) fail(n + ": a BC4 texel is " + std::to_string(worst) + " codes from the code it was made from");
   } else if (ld16(v.bytes, 10) != 0) {
-    fail(n + ": a file without 1.1 features must be version 1.0");
+    fail(n + ": a file without 1.1 or 1.2 features must be version 1.0");
   }
   if (v.content.hits == 0 || v.content.misses == 0) fail(n + ": the content needs both hits and misses");
 }
@@ -921,8 +988,8 @@ std::vector<InvalidCase> invalidCases(const std::map<std::string, BuiltValid>& v
     st16(v.b, 8, 2);
     v.sealHeader();
   });
-  add(2004, "incompat-bit2", A, "incompatFeatures bit 2 (unknown) set (header re-sealed)", [](Vff& v) {
-    st64(v.b, 24, 4);
+  add(2004, "incompat-bit3", A, "incompatFeatures bit 3 (unknown) set (header re-sealed)", [](Vff& v) {
+    st64(v.b, 24, 8);
     v.sealHeader();
   });
   // 3xxx: header
@@ -1038,7 +1105,11 @@ std::vector<InvalidCase> invalidCases(const std::map<std::string, BuiltValid>& v
       5005, "bit1-resolution-12", "bit1 with mapResolution 12 (not a multiple of 8)",
       [](Vff& v, uint64_t p) { st32(v.b, p + kFdscResolution, 12); }, B);
   fdsc(5006, "frame-2", "frame convention 2 (unknown)", [](Vff& v, uint64_t p) { st32(v.b, p + kFdscFrame, 2); });
-  fdsc(5007, "encoding-5", "distanceEncoding 5 (unknown)", [](Vff& v, uint64_t p) { st32(v.b, p + kFdscEncoding, 5); });
+  fdsc(5007, "encoding-6", "distanceEncoding 6 (unknown)", [](Vff& v, uint64_t p) { st32(v.b, p + kFdscEncoding, 6); });
+  const std::string C = "bc4-zstd-normals-slices";  // FDSC, LAYT, DIST, NORM (bc4-diameter, zstd blocks)
+  fdsc(
+      5005, "bc4-resolution-18", "bc4-diameter with mapResolution 18 (not a multiple of 4)",
+      [](Vff& v, uint64_t p) { st32(v.b, p + kFdscResolution, 18); }, C);
   fdsc(5008, "miss-code-0", "unorm8-diameter with missCode 0 (255 is reserved)",
        [](Vff& v, uint64_t p) { st32(v.b, p + kFdscMiss, 0); });
   fdsc(5009, "normal-encoding-2", "normalEncoding 2 (unknown)",
@@ -1150,6 +1221,14 @@ std::vector<InvalidCase> invalidCases(const std::map<std::string, BuiltValid>& v
        [&](Vff& v) { v.b[v.blockEntry(D, 0) + 22] = 1; });
   edit(6012, "zstd-without-feature-bit", Z, "zstd sections and blocks, incompatFeatures zstd bit clear",
        [&](Vff& v) { st64(v.b, 24, 0); });
+  edit(6012, "bc4-without-feature-bit", C, "bc4-diameter field, incompatFeatures bit 2 (bc4) clear",
+       [&](Vff& v) { st64(v.b, 24, ld64(v.b, 24) & ~kFeatureBc4); });
+  edit(6008, "filter-on-bc4", C, "bc4-diameter DIST block 0 (zstd) with filter 1 hits-med, filters bit set",
+       [&](Vff& v) {
+         if (v.b[v.blockEntry(D, 0) + 20] != 1) die("filter-on-bc4: DIST block 0 is not zstd");
+         v.b[v.blockEntry(D, 0) + 21] = 1;
+         st64(v.b, 24, ld64(v.b, 24) | kFeatureFilters);
+       });
   edit(6013, "normal-of-miss", S, "a nonzero normal at a texel whose distance is a miss", [&](Vff& v) {
     const uint64_t dist = v.block(D, 0), norm = v.block(NM, 0);
     for (uint32_t t = 0; t < 64; ++t)
@@ -1168,6 +1247,11 @@ std::vector<InvalidCase> invalidCases(const std::map<std::string, BuiltValid>& v
   layt(7002, "tile-size", "LAYT tileSize 9 for 8x8 maps without gutter", kLaytTileSize, 9);
   layt(7003, "slice-count", "LAYT sliceCount 2 where 1 holds every map", kLaytSliceCount, 2);
   layt(7004, "reserved-40", "LAYT reserved u32 at 40 is 1", 40, 1);
+  layt(7001, "bc4-target-3d", "bc4-diameter field with LAYT target 2 (3d)", kLaytTarget, 2, C);
+  edit(7002, "bc4-gutter-1", C, "bc4-diameter field with LAYT gutter 1 and tileSize 18", [&](Vff& f) {
+    st32(f.b, f.sec(kTagLayout) + 4, 1);
+    st32(f.b, f.sec(kTagLayout) + kLaytTileSize, 18);
+  });
   // 8xxx: metadata (stored META rewritten)
   auto meta = [&](uint32_t id, std::string name, std::string what, std::string text) {
     add(id, std::move(name), M, std::move(what), [text](Vff& v) { v.replaceStored(kTagMetadata, text); });

@@ -50,7 +50,7 @@ test_help() {
 test_version() {
   inspect --version
   expect_rc 0
-  expect_out_re '^vff-inspect [0-9]+\.[0-9]+\.[0-9]+ \(libvff [0-9.]+, \.vff format 1\.1\)$'
+  expect_out_re '^vff-inspect [0-9]+\.[0-9]+\.[0-9]+ \(libvff [0-9.]+, \.vff format 1\.2\)$'
 }
 
 test_unknown_option() {

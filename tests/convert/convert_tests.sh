@@ -518,6 +518,48 @@ test_reencode_bit1_keeps_hit_and_miss() {
   no_leftovers a.vff b.vff m12.vff
 }
 
+# bc4-diameter: lossy, but hits and misses are kept, the tool's RMS error is small on a bake, the
+# layout becomes a gutterless 2D array, converting back to unorm8-diameter gives the bc4 distances
+# exactly, and an EXR of a bc4 field cannot come back (its blocks cannot be rebuilt exactly).
+test_reencode_to_bc4_and_back() {
+  needs_bake || return 0
+  "$MESHGEN" torus-knot "$WORK/knot.obj" >/dev/null || fail "mesh generator"
+  "$VFF_BAKE" "$WORK/knot.obj" -o "$WORK/a.vff" -n 3 -m 32 --normals --gutter 1 -q || fail "bake"
+  convert "$WORK/a.vff" --to vff "$WORK/b.vff" --encoding bc4-diameter
+  expect_rc 0
+  expect_out "encoding: unorm8-diameter -> bc4-diameter: max error"
+  expect_out "(2d-array, gutter 0)"
+  local rms
+  rms=$(sed -n 's/.*RMS \([0-9.]*\) steps.*/\1/p' "$WORK/out")
+  # Measured 1.93 steps on this 32x32 knot (0.85 on the bunny at 64x64).
+  awk -v r="$rms" 'BEGIN { exit !(r > 0 && r < 2.5) }' || { show; fail "RMS $rms steps is not in (0, 2.5)"; }
+  run "$CHECK" texels "$WORK/a.vff" "$WORK/b.vff" --max-flips 0
+  [[ $RC -eq 0 ]] || { show; fail "bc4 changed a hit or a miss"; }
+  expect_out "hit->miss 0, miss->hit 0"
+  expect_out "hit texels with other normal bytes: 0"
+  valid "$WORK/b.vff"
+  run "$VFF_INSPECT" "$WORK/b.vff"
+  expect_out "vff 1.2"
+  expect_out "bc4-diameter"
+  convert "$WORK/b.vff" --to vff "$WORK/c.vff" --encoding unorm8-diameter
+  expect_rc 0
+  run "$CHECK" texels "$WORK/b.vff" "$WORK/c.vff" --max-steps 0 --max-flips 0
+  [[ $RC -eq 0 ]] || { show; fail "bc4 -> unorm8-diameter did not keep the decoded codes"; }
+  # Maps of 30 texels cannot hold 4x4 blocks.
+  "$VFF_BAKE" "$WORK/knot.obj" -o "$WORK/m30.vff" -n 1 -m 30 -q || fail "bake"
+  convert "$WORK/m30.vff" --to vff "$WORK/d.vff" --encoding bc4-diameter
+  expect_rc 1
+  expect_err "multiple of 4"
+  # EXR: out yes (decoded distances), back no.
+  convert "$WORK/b.vff" --to exr "$WORK/b.exr"
+  expect_rc 0
+  convert "$WORK/b.exr" --to vff "$WORK/e.vff"
+  expect_rc 5
+  expect_err "b.exr"
+  expect_err "bc4-diameter"
+  no_leftovers knot.obj a.vff b.vff c.vff m30.vff b.exr
+}
+
 # Every rule, even and odd factors, an encoding change on top: each new texel is recomputed by
 # convert_check from the source texels (the rules as README.md states them) and must match exactly,
 # normals included.

@@ -20,9 +20,20 @@ case "$tool" in
   *) fail "unknown tool $tool" ;;
 esac
 echo "old content, not a field" > old.bin
+# One uninterrupted run gives the job's duration T on this machine now; the kills land at fixed
+# fractions of T (so a loaded machine, where everything is slower, still sees kills spread over the
+# whole write), and the last delays, 1.5 T and 3 T + 1 s, let the job finish.
+t0=$(date +%s%N)
+"${cmd[@]}" >/dev/null 2>&1 || fail "an uninterrupted run failed: ${cmd[*]}"
+T=$(( ($(date +%s%N) - t0) / 1000000 ))  # milliseconds
+echo "uninterrupted run: $T ms"
+delays=()
+for f in 0 2 5 10 15 20 30 40 50 60 70 80 90 100 120 150; do
+  delays+=("$(awk -v t="$T" -v f="$f" 'BEGIN { printf "%.3f", t * f / 100000 }')")
+done
+delays+=("$(awk -v t="$T" 'BEGIN { printf "%.3f", 3 * t / 1000 + 1 }')")
 killed=0 finished=0
-# Delays spread over the run (deterministic): 0 to ~1.5 s.
-for delay in 0 0.02 0.05 0.1 0.15 0.2 0.3 0.4 0.5 0.6 0.7 0.8 0.9 1.0 1.2 1.5 2 3; do
+for delay in "${delays[@]}"; do
   for start in old none; do
     rm -f "$dest"
     if [ "$start" = old ]; then cp old.bin "$dest"; fi

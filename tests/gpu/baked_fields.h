@@ -27,6 +27,7 @@ inline std::string caseName(const FieldCase& c) {
     case DistanceEncoding::kUnorm8Diameter: s += "_Unorm8Diameter"; break;
     case DistanceEncoding::kUnorm8Chord: s += "_Unorm8Chord"; break;
     case DistanceEncoding::kUnorm16Diameter: s += "_Unorm16Diameter"; break;
+    case DistanceEncoding::kBc4Diameter: s += "_Bc4Diameter"; break;
     default: s += "_Bit1"; break;
   }
   if (c.target == LayoutTarget::kTexture3D) s += "_3D";
@@ -51,7 +52,8 @@ inline Result<File> bakeFile(const FieldCase& c, bool normals) {
   WriteOptions w;
   w.layout.target = c.target;
   w.layout.maxTextureSize = 256;
-  w.layout.gutter = c.encoding == DistanceEncoding::kBit1 ? 0 : 1;
+  // bit1 and bc4-diameter allow no gutter (rule 7002).
+  w.layout.gutter = c.encoding == DistanceEncoding::kBit1 || c.encoding == DistanceEncoding::kBc4Diameter ? 0 : 1;
   auto bytes = writeMemory(baked->field, baked->distance, baked->normals, w);
   if (!bytes) return bytes.error();
   return File::openBuffer(std::move(*bytes));

@@ -41,9 +41,9 @@ constexpr double kInterpVis = 1e-4;
     if (!gl_.ok) GTEST_SKIP() << "no headless OpenGL 4.3 context: " << gl_.error; \
   } while (0)
 
-GLuint buildProgram(bool maps3D, const std::string& body) {
+GLuint buildProgram(const char* defines, const std::string& body) {
   std::string log;
-  const GLuint prog = test::buildQueryProgram(maps3D ? "#define VFF_MAPS_3D\n" : "", body, &log);
+  const GLuint prog = test::buildQueryProgram(defines, body, &log);
   EXPECT_NE(prog, 0u) << log;
   return prog;
 }
@@ -147,7 +147,7 @@ TEST_P(GpuField, NormalsAndInterpolatedMatchCpu) {
   auto gpu = gl::loadField(*file);
   ASSERT_TRUE(gpu.ok()) << gpu.error().toString();
   ASSERT_NE(gpu->normalsTexture(), 0u);
-  const GLuint prog = buildProgram(file->layout().target == LayoutTarget::kTexture3D, kMain);
+  const GLuint prog = buildProgram(gl::shaderDefines(file->field(), file->layout()), kMain);
   ASSERT_NE(prog, 0u);
   auto cpu = FieldQuery::fromFile(*file);
   ASSERT_TRUE(cpu.ok()) << cpu.error().toString();
@@ -304,7 +304,7 @@ TEST(GpuAo, GroundAoMatchesCpu) {
   ASSERT_TRUE(gpu.ok()) << gpu.error().toString();
   auto cpu = FieldQuery::fromFile(*file);
   ASSERT_TRUE(cpu.ok());
-  const GLuint prog = buildProgram(false, gpubench::kAoShader);
+  const GLuint prog = buildProgram("", gpubench::kAoShader);
   ASSERT_NE(prog, 0u);
   GLuint bufs[3];
   glGenBuffers(3, bufs);

@@ -112,8 +112,9 @@ TEST_P(RoundTrip, SlicesPlaceEveryTexel) {
   for (uint32_t s = 0; s < l.sliceCount; ++s) {
     ASSERT_TRUE(file->readSlice(Plane::kDistance, s, slice).ok());
     const bool bit1 = f.distanceEncoding == DistanceEncoding::kBit1;
+    const bool bc4 = f.distanceEncoding == DistanceEncoding::kBc4Diameter;
     const uint32_t tb = f.distanceEncoding == DistanceEncoding::kUnorm16Diameter ? 2 : 1;
-    const uint64_t rowBytes = bit1 ? l.sliceWidth / 8 : uint64_t(l.sliceWidth) * tb;
+    const uint64_t rowBytes = bit1 ? l.sliceWidth / 8 : bc4 ? uint64_t(l.sliceWidth) * 2 : uint64_t(l.sliceWidth) * tb;
     for (uint32_t k = 0; k < f.mapCount; ++k) {
       TilePlacement p = placeMap(l, k);
       if (p.slice != s) continue;
@@ -128,6 +129,7 @@ TEST_P(RoundTrip, SlicesPlaceEveryTexel) {
           const uint64_t x = uint64_t(int64_t(p.x) + i), y = uint64_t(int64_t(p.y) + j);
           uint32_t got;
           if (bit1) got = (slice[y * rowBytes + x / 8] >> (x % 8)) & 1u;
+          else if (bc4) got = bc4Texel(&slice[(y / 4) * rowBytes + (x / 4) * 8], uint32_t((y % 4) * 4 + x % 4));
           else if (tb == 2) got = uint32_t(slice[y * rowBytes + 2 * x]) | uint32_t(slice[y * rowBytes + 2 * x + 1]) << 8;
           else got = slice[y * rowBytes + x];
           ASSERT_EQ(got, want) << "map " << k << " texel " << i << "," << j;
@@ -139,6 +141,9 @@ TEST_P(RoundTrip, SlicesPlaceEveryTexel) {
   const uint32_t perSlice = l.tilesPerRow * l.tilesPerColumn;
   if (f.mapCount % perSlice != 0 && f.distanceEncoding == DistanceEncoding::kUnorm8Diameter) {
     EXPECT_EQ(slice.back(), 255);
+  }
+  if (f.mapCount % perSlice != 0 && f.distanceEncoding == DistanceEncoding::kBc4Diameter) {
+    EXPECT_EQ(bc4Texel(&slice[slice.size() - 8], 15), 255u);
   }
 }
 
@@ -152,6 +157,11 @@ std::vector<Case> allCases() {
       if (enc != DistanceEncoding::kBit1)
         v.push_back({enc, NormalEncoding::kNone, codec, 1, LayoutTarget::kTexture2DArray, 1});
     }
+  // bc4-diameter: 2d-array and no gutter only (rules 7001, 7002).
+  for (auto codec : {Codec::kStored, Codec::kZstd}) {
+    v.push_back({DistanceEncoding::kBc4Diameter, NormalEncoding::kNone, codec, 0, LayoutTarget::kTexture2DArray, 0});
+    v.push_back({DistanceEncoding::kBc4Diameter, NormalEncoding::kOctSnorm16, codec, 0, LayoutTarget::kTexture2DArray, 5});
+  }
   return v;
 }
 

@@ -33,6 +33,17 @@ inline uint32_t hashMix(uint32_t x) {
 }
 
 inline std::vector<uint8_t> syntheticDistance(const FieldDesc& f) {
+  if (f.distanceEncoding == DistanceEncoding::kBc4Diameter) {  // unorm8-diameter codes, then BC4 blocks
+    FieldDesc u8 = f;
+    u8.distanceEncoding = DistanceEncoding::kUnorm8Diameter;
+    const std::vector<uint8_t> codes = syntheticDistance(u8);
+    const uint64_t texels = uint64_t(f.mapResolution) * f.mapResolution;
+    std::vector<uint8_t> d(texels / 2 * f.mapCount);
+    for (uint32_t k = 0; k < f.mapCount; ++k)
+      encodeBc4Map(std::span<const uint8_t>(codes).subspan(k * texels, texels), f.mapResolution,
+                   std::span<uint8_t>(d).subspan(k * texels / 2, texels / 2));
+    return d;
+  }
   std::vector<uint8_t> d(distanceMapBytes(f.distanceEncoding, f.mapResolution) * f.mapCount, 0);
   const uint32_t m = f.mapResolution;
   const uint64_t mb = distanceMapBytes(f.distanceEncoding, m);

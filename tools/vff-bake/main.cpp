@@ -69,7 +69,8 @@ const std::map<std::string, vff::DistanceEncoding> kEncodings = {
     {"unorm8-diameter", vff::DistanceEncoding::kUnorm8Diameter},
     {"unorm8-chord", vff::DistanceEncoding::kUnorm8Chord},
     {"unorm16-diameter", vff::DistanceEncoding::kUnorm16Diameter},
-    {"bit1", vff::DistanceEncoding::kBit1}};
+    {"bit1", vff::DistanceEncoding::kBit1},
+    {"bc4-diameter", vff::DistanceEncoding::kBc4Diameter}};
 const std::map<std::string, vff::Codec> kCodecs = {{"stored", vff::Codec::kStored}, {"zstd", vff::Codec::kZstd}};
 const std::map<std::string, vff::LayoutTarget> kTargets = {{"2d-array", vff::LayoutTarget::kTexture2DArray},
                                                            {"3d", vff::LayoutTarget::kTexture3D}};
@@ -250,7 +251,7 @@ int main(int argc, char** argv) {
   app.add_option("--directions", o.directions, "hemisphere-to-square map")
       ->check(CLI::IsMember({"concentric", "hemi-oct"}))->capture_default_str();
   app.add_option("--encoding", o.encoding, "distance encoding")
-      ->check(CLI::IsMember({"unorm8-diameter", "unorm8-chord", "unorm16-diameter", "bit1"}))->capture_default_str();
+      ->check(CLI::IsMember({"unorm8-diameter", "unorm8-chord", "unorm16-diameter", "bit1", "bc4-diameter"}))->capture_default_str();
   app.add_flag("--normals", o.normals, "also store the surface normal at each hit (4 bytes per ray)");
   app.add_option("-j,--threads", o.threads, "baking threads (0: all cores); the output does not depend on it")
       ->capture_default_str();

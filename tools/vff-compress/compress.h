@@ -19,16 +19,30 @@ struct PlaneReport {
   uint32_t zstd = 0;                  // blocks with codec zstd
 };
 
+// --bc4: what re-encoding the distance plane as bc4-diameter changed, over every hit texel, in codes
+// (steps of 2R / 254). Misses and hits are kept exactly (the encoder's guarantee, checked here).
+struct Bc4Report {
+  bool done = false;
+  uint64_t hits = 0;
+  uint64_t changed = 0;     // hits whose code changed
+  uint32_t maxError = 0;    // largest |new code - old code|
+  double sumSquared = 0;    // sum of (new - old)^2, for the RMS
+};
+
 struct Report {
   PlaneReport planes[2];
+  Bc4Report bc4;
   uint64_t fileBytes = 0;
   double seconds = 0;
 };
 
 // Re-writes `in` to `out` with `options` (codec, level, filter, G; the layout limits and metadata
 // are taken from `in`), streaming one source block at a time so memory stays at a few blocks.
-// Then reads `out` back and fills `report`.
-Status rewrite(const File& in, const std::string& out, const WriteOptions& options, Report* report);
+// With `bc4`, the distance plane of an unorm8-diameter field is re-encoded as bc4-diameter (the
+// field, its layout (2d-array, no gutter) and `options` must already say so). Then reads `out`
+// back and fills `report`.
+Status rewrite(const File& in, const std::string& out, const FieldDesc& field, const WriteOptions& options,
+               bool bc4, Report* report);
 
 // The benchmark: for each field file, the distance payload through our lossless codec, zstd -19 and
 // xz -9 on the raw payload, and OpenEXR ZIP, PIZ and DWAA on the EXR export; prints the table.

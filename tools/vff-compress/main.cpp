@@ -8,12 +8,14 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>
 
 #include "cli.h"
 #include "compress.h"
+#include "resample.h"
 #include "vff/vff.h"
 
 namespace {
@@ -27,6 +29,7 @@ struct Options {
   bool blocks = false;
   bool candidates = false;
   bool quiet = false;
+  bool bc4 = false;
   int level = 19;
   std::string filter = "auto";
   uint32_t mapsPerBlock = 0;
@@ -56,6 +59,13 @@ void printPlane(const char* name, const vff::compress::PlaneReport& r, bool bloc
   if (blocks)
     for (size_t b = 0; b < r.blockStored.size(); ++b)
       std::printf("    block %zu: %llu bytes\n", b, static_cast<unsigned long long>(r.blockStored[b]));
+}
+
+nlohmann::json bc4Json(const vff::compress::Bc4Report& b) {
+  return {{"hits", b.hits},
+          {"changedHits", b.changed},
+          {"maxErrorCodes", b.maxError},
+          {"rmsErrorCodes", b.hits ? std::sqrt(b.sumSquared / double(b.hits)) : 0.0}};
 }
 
 }  // namespace
@@ -88,6 +98,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--candidates", o.candidates,
                "benchmark: also measure the filters hits-med was chosen over (left, up, gradient, MED on raw bytes)");
+  app.add_flag("--bc4", o.bc4,
+               "lossy, GPU-native: re-encode an unorm8-diameter distance plane as bc4-diameter (BC4 blocks the "
+               "texture unit decodes, half the GPU memory; format 1.2), then compress; prints the code error");
   app.add_flag("--blocks", o.blocks, "also list every block's stored size");
   app.add_option("--repeat", o.repeat, "benchmark repetitions (the best time is reported)")
       ->check(CLI::Range(1, 100))
@@ -110,8 +123,8 @@ int main(int argc, char** argv) {
   }
   const std::string& input = o.files[0];
   const std::string& output = o.files[1];
-  if (o.decompress && (o.filter != "auto" || app.count("--level"))) {
-    vff::cli::usageError(kProg, "--filter and --level apply to compression only");
+  if (o.decompress && (o.filter != "auto" || app.count("--level") || o.bc4)) {
+    vff::cli::usageError(kProg, "--filter, --level and --bc4 apply to compression only");
     return vff::cli::kExitUsage;
   }
 
@@ -127,7 +140,21 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "%s: warning: %s: unknown section '%s' is not copied\n", kProg, input.c_str(),
                    vff::sectionTagName(s.tag).c_str());
 
-  const vff::FieldDesc& field = in->field();
+  vff::FieldDesc field = in->field();
+  const bool reencode = o.bc4 && field.distanceEncoding != vff::DistanceEncoding::kBc4Diameter;
+  if (reencode && field.distanceEncoding != vff::DistanceEncoding::kUnorm8Diameter) {
+    vff::cli::printError(kProg, input + ": --bc4 re-encodes unorm8-diameter codes; this field is " +
+                                    vff::distanceEncodingName(field.distanceEncoding) +
+                                    " (vff-convert --encoding bc4-diameter converts from any encoding with distances)");
+    return vff::cli::kExitUnsupported;
+  }
+  if (reencode && field.mapResolution % 4 != 0) {
+    vff::cli::printError(kProg, input + ": --bc4 needs maps whose size is a multiple of 4 (4x4 blocks); this "
+                                        "field's are " + std::to_string(field.mapResolution) +
+                                        " (vff-convert --map-size makes smaller maps)");
+    return vff::cli::kExitUnsupported;
+  }
+  if (reencode) field.distanceEncoding = vff::DistanceEncoding::kBc4Diameter;
   const bool eightBit = field.distanceEncoding == vff::DistanceEncoding::kUnorm8Diameter ||
                         field.distanceEncoding == vff::DistanceEncoding::kUnorm8Chord;
   if (o.filter == "hits-med" && !eightBit) {
@@ -146,9 +173,24 @@ int main(int argc, char** argv) {
   w.layout.maxLayers = in->layout().maxLayers;
   w.layout.gutter = in->layout().gutter;
   w.metadataJson = std::string(in->metadata());
+  if (reencode) {
+    // bc4-diameter slices are a 2D array without gutters (spec rules 7001, 7002).
+    w.layout.target = vff::LayoutTarget::kTexture2DArray;
+    w.layout.gutter = 0;
+    auto hash = vff::convert::fileXxh3(input);
+    if (!hash) return vff::cli::reportError(kProg, input, hash.error());
+    const size_t slash = input.find_last_of('/');
+    vff::convert::ResampleOptions r;
+    r.encoding = vff::DistanceEncoding::kBc4Diameter;
+    auto meta = vff::convert::appendProvenance(w.metadataJson, in->field(), field, r,
+                                               slash == std::string::npos ? input : input.substr(slash + 1), *hash,
+                                               kProg);
+    if (!meta) return vff::cli::reportError(kProg, input, meta.error());
+    w.metadataJson = std::move(*meta);
+  }
 
   vff::compress::Report report;
-  if (vff::Status st = vff::compress::rewrite(*in, output, w, &report); !st)
+  if (vff::Status st = vff::compress::rewrite(*in, output, field, w, reencode, &report); !st)
     return vff::cli::reportError(kProg, st.error().code == vff::Code::kIoWrite ? output : input, st.error());
   if (o.common.format == vff::cli::OutputFormat::kJson) {
     nlohmann::json j = {{"input", input},
@@ -160,6 +202,7 @@ int main(int argc, char** argv) {
                         {"seconds", report.seconds},
                         {"distance", planeJson(report.planes[0])}};
     if (report.planes[1].present) j["normal"] = planeJson(report.planes[1]);
+    if (report.bc4.done) j["bc4"] = bc4Json(report.bc4);
     std::printf("%s\n", j.dump(2).c_str());
   } else if (!o.quiet) {
     std::printf("%s: %s -> %s (%s, filter %s, %.2f s)\n", output.c_str(), vff::cli::formatBytes(in->bytes().size()).c_str(),
@@ -167,6 +210,13 @@ int main(int argc, char** argv) {
                 w.filter == vff::Filter::kNone ? "none" : "hits-med where smaller", report.seconds);
     printPlane("distance", report.planes[0], o.blocks);
     if (report.planes[1].present) printPlane("normal", report.planes[1], o.blocks);
+    if (report.bc4.done) {
+      const auto& b = report.bc4;
+      std::printf("  bc4      unorm8-diameter -> bc4-diameter: %llu of %llu hits changed, max error %u codes, RMS "
+                  "%.3f codes (a code is 2R/254); every hit and miss kept\n",
+                  static_cast<unsigned long long>(b.changed), static_cast<unsigned long long>(b.hits), b.maxError,
+                  b.hits ? std::sqrt(b.sumSquared / double(b.hits)) : 0.0);
+    }
   }
   return vff::cli::kExitSuccess;
 }

@@ -88,6 +88,11 @@ Status parseFieldJson(const std::string& text, const char* formatName, const std
       return badField("unknown frame");
     if (!parseEnum(f.at("distanceEncoding").get<std::string>(), distanceEncodingName, &d->field.distanceEncoding))
       return badField("unknown distanceEncoding");
+    if (d->field.distanceEncoding == DistanceEncoding::kBc4Diameter)
+      return makeError(Code::kUnsupported,
+                       where + ": the field is bc4-diameter, whose BC4 blocks cannot be rebuilt exactly from the "
+                               "decoded distances; export an unorm8-diameter field instead (vff-convert --encoding "
+                               "unorm8-diameter gives the bc4 field's distances exactly)");
     if (!parseEnum(f.at("normalEncoding").get<std::string>(), normalEncodingName, &d->field.normalEncoding))
       return badField("unknown normalEncoding");
     const json& l = j.at("layout");

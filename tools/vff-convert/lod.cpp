@@ -214,6 +214,11 @@ Result<FieldData> resampleField(const FieldData& src, const ResampleOptions& o, 
   out.field = nf;
   out.layout = src.layout;
   if (nf.distanceEncoding == DistanceEncoding::kBit1) out.layout.gutter = 0;  // bit1 tiles have no gutters
+  if (nf.distanceEncoding == DistanceEncoding::kBc4Diameter) {  // nor bc4 tiles, which only 2D arrays hold
+    out.layout.gutter = 0;
+    out.layout.target = LayoutTarget::kTexture2DArray;
+  }
+  const bool bc4 = nf.distanceEncoding == DistanceEncoding::kBc4Diameter;
   out.metadata = src.metadata;
   out.codec = src.codec;
   // The source's G fits the source's maps; new maps get the writer's automatic G.
@@ -251,7 +256,10 @@ Result<FieldData> resampleField(const FieldData& src, const ResampleOptions& o, 
   const bool distances = sf.distanceEncoding != DistanceEncoding::kBit1;
 
   // One new map: stage 1 for each of its f x f sub-texels per new texel, stage 2, stage 3.
-  auto doMap = [&](uint32_t k, std::vector<Value>& plane, EncodeStats& stats) {
+  // bc4: each map is quantised to unorm8-diameter codes in `codes`, then fitted to BC4 blocks, and the
+  // error is that of the decoded blocks against the distance before encoding.
+  auto doMap = [&](uint32_t k, std::vector<Value>& plane, std::vector<uint8_t>& codes, std::vector<float>& exact,
+                   EncodeStats& stats) {
     Vec3 u{}, uk{};
     Frame frame{}, frameK{};
     uint32_t ks = k;  // the source map answering this map (nearest sample)
@@ -299,10 +307,32 @@ Result<FieldData> resampleField(const FieldData& src, const ResampleOptions& o, 
       for (uint32_t i = 0; i < nm; ++i) {
         const Value v = combine(plane, m, f, i, j, o.downsample);
         const size_t t = size_t(j) * nm + i;
-        const uint32_t code = encodeTexel(nf.distanceEncoding, v.hit, v.distance, radius, newDirs[t].z, &stats);
-        storeCode(nf.distanceEncoding, {map, nBytes}, nm, i, j, code);
+        if (bc4) {
+          codes[t] = uint8_t(encodeDistance(nf.distanceEncoding, v.hit, v.distance, radius, 1.0f));
+          exact[t] = v.hit ? v.distance : -1.0f;
+        } else {
+          const uint32_t code = encodeTexel(nf.distanceEncoding, v.hit, v.distance, radius, newDirs[t].z, &stats);
+          storeCode(nf.distanceEncoding, {map, nBytes}, nm, i, j, code);
+        }
         if (normals && v.hit)
           std::copy(v.normal.begin(), v.normal.end(), out.normals.data() + size_t(k) * nNormBytes + 4 * t);
+      }
+    if (!bc4) return;
+    encodeBc4Map(codes, nm, {map, nBytes});
+    const float step = quantizationStep(nf.distanceEncoding, radius, 1.0f);
+    for (uint32_t j = 0; j < nm; ++j)
+      for (uint32_t i = 0; i < nm; ++i) {
+        const float want = exact[size_t(j) * nm + i];
+        if (want < 0) continue;  // a miss, and the blocks keep it one
+        ++stats.hits;
+        const Texel x = decodeDistance(nf.distanceEncoding, loadCode(nf.distanceEncoding, {map, nBytes}, nm, i, j), radius, 1.0f);
+        const float scale = 2.0f * radius;
+        if (want > scale) {  // beyond the sphere's diameter: the largest code
+          ++stats.clamped;
+          stats.maxClampRadii = std::max(stats.maxClampRadii, std::fabs(double(x.distance) - want) / double(radius));
+          continue;
+        }
+        accountError(&stats, std::fabs(double(x.distance) - double(want)), step, radius);
       }
   };
 
@@ -312,7 +342,9 @@ Result<FieldData> resampleField(const FieldData& src, const ResampleOptions& o, 
   std::vector<EncodeStats> stats(threads);
   auto worker = [&](unsigned w) {
     std::vector<Value> plane(size_t(m) * m);  // stage 1 of one map, at the source resolution
-    for (uint32_t k; (k = next.fetch_add(1)) < nf.mapCount;) doMap(k, plane, stats[w]);
+    std::vector<uint8_t> codes(bc4 ? size_t(nm) * nm : 0);
+    std::vector<float> exact(codes.size());
+    for (uint32_t k; (k = next.fetch_add(1)) < nf.mapCount;) doMap(k, plane, codes, exact, stats[w]);
   };
   std::vector<std::thread> pool;
   for (unsigned w = 1; w < threads; ++w) pool.emplace_back(worker, w);
@@ -326,6 +358,7 @@ Result<FieldData> resampleField(const FieldData& src, const ResampleOptions& o, 
   r.hits = all.hits;
   r.maxErrorSteps = all.maxErrorSteps;
   r.maxErrorRadii = all.maxErrorRadii;
+  r.rmsErrorSteps = all.hits > all.clamped ? std::sqrt(all.sumSquaredSteps / double(all.hits - all.clamped)) : 0.0;
   r.clamped = all.clamped;
   r.maxClampRadii = all.maxClampRadii;
   for (uint32_t k = 0; k < sf.mapCount; ++k)

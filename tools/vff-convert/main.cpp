@@ -50,7 +50,8 @@ const std::map<std::string, vff::DistanceEncoding> kEncodings = {
     {"unorm8-diameter", vff::DistanceEncoding::kUnorm8Diameter},
     {"unorm8-chord", vff::DistanceEncoding::kUnorm8Chord},
     {"unorm16-diameter", vff::DistanceEncoding::kUnorm16Diameter},
-    {"bit1", vff::DistanceEncoding::kBit1}};
+    {"bit1", vff::DistanceEncoding::kBit1},
+    {"bc4-diameter", vff::DistanceEncoding::kBc4Diameter}};
 const std::map<std::string, vff::PositionScheme> kPositions = {
     {"octa-hemi2", vff::PositionScheme::kOctaHemi2},
     {"ea-octa-grid", vff::PositionScheme::kEqualAreaOctaGrid},
@@ -90,11 +91,13 @@ vff::Result<FieldData> loadVff(const std::string& path) {
   for (vff::Plane p : {vff::Plane::kDistance, vff::Plane::kNormal}) {
     if (!f->plane(p).present) continue;
     std::vector<uint8_t>& out = p == vff::Plane::kDistance ? d.distance : d.normals;
+    // Decoded straight into the field (File::decodeBlock, not the File's block cache): one copy of
+    // the payload, however well it compresses; memory is touched block by block as blocks decode.
     out.reserve(f->plane(p).rawBytes);
     for (uint32_t b = 0; b < f->plane(p).blocks.size(); ++b) {
-      auto bytes = f->blockData(p, b);
-      if (!bytes) return std::move(bytes).error();
-      out.insert(out.end(), bytes->begin(), bytes->end());
+      const uint64_t at = out.size();
+      out.resize(at + f->plane(p).blocks[b].rawSize);
+      if (vff::Status s = f->decodeBlock(p, b, std::span<uint8_t>(out).subspan(at)); !s) return std::move(s).error();
     }
   }
   return d;
@@ -244,9 +247,10 @@ int main(int argc, char** argv) {
                  "depend on it")
       ->capture_default_str();
   app.add_option("--encoding", o.encoding,
-                 "vff: re-encode the distances (prints the largest error in steps of the new encoding; "
+                 "vff: re-encode the distances (prints the largest and RMS error in steps of the new encoding; "
+                 "bc4-diameter: lossy GPU block compression, half the size of unorm8; "
                  "from bit1: exit 5)")
-      ->check(CLI::IsMember({"unorm8-diameter", "unorm8-chord", "unorm16-diameter", "bit1"}));
+      ->check(CLI::IsMember({"unorm8-diameter", "unorm8-chord", "unorm16-diameter", "bit1", "bc4-diameter"}));
   app.add_option("--map-size", o.mapSize, "vff: smaller maps M' (must divide the source's M; bit1: a multiple of 8)")
       ->check(CLI::PositiveNumber);
   app.add_option("--downsample", o.downsample,

@@ -37,6 +37,7 @@ const char* positionResampleName(PositionResample r) noexcept {
 void EncodeStats::merge(const EncodeStats& o) noexcept {
   maxErrorSteps = std::max(maxErrorSteps, o.maxErrorSteps);
   maxErrorRadii = std::max(maxErrorRadii, o.maxErrorRadii);
+  sumSquaredSteps += o.sumSquaredSteps;
   maxClampRadii = std::max(maxClampRadii, o.maxClampRadii);
   hits += o.hits;
   clamped += o.clamped;
@@ -59,14 +60,19 @@ uint32_t encodeTexel(DistanceEncoding to, bool hit, float distance, float radius
     stats->maxClampRadii = std::max(stats->maxClampRadii, error / double(radius));
     return code;
   }
+  accountError(stats, error, step, radius);
+  return code;
+}
+
+void accountError(EncodeStats* stats, double error, float step, float radius) noexcept {
   stats->maxErrorSteps = std::max(stats->maxErrorSteps, error / double(step));
   stats->maxErrorRadii = std::max(stats->maxErrorRadii, error / double(radius));
-  return code;
+  stats->sumSquaredSteps += (error / double(step)) * (error / double(step));
 }
 
 Result<std::string> appendProvenance(const std::string& metadata, const FieldDesc& source, const FieldDesc& result,
                                      const ResampleOptions& options, const std::string& sourceName,
-                                     uint64_t sourceXxh3) {
+                                     uint64_t sourceXxh3, const char* tool) {
   nlohmann::json meta = nlohmann::json::object();
   if (!metadata.empty()) {
     meta = nlohmann::json::parse(metadata, nullptr, /*allow_exceptions=*/false);
@@ -94,7 +100,7 @@ Result<std::string> appendProvenance(const std::string& metadata, const FieldDes
     ops.push_back("encoding");
     opts["encoding"] = distanceEncodingName(result.distanceEncoding);
   }
-  list.push_back({{"tool", "vff-convert"},
+  list.push_back({{"tool", tool},
                   {"version", kLibraryVersion},
                   {"operations", ops},
                   {"options", opts},
@@ -133,11 +139,11 @@ std::string describeResample(const FieldDesc& from, const FieldDesc& to, const R
                   distanceEncodingName(from.distanceEncoding));
     s += buf;
   } else {
-    std::snprintf(buf, sizeof buf, "%s%s%s%s: max error %.3f steps of %s (%.6f R) over %llu hits\n",
+    std::snprintf(buf, sizeof buf, "%s%s%s%s: max error %.3f steps of %s (%.6f R), RMS %.3f steps, over %llu hits\n",
                   r.encodingChanged ? "encoding: " : "quantisation (",
                   r.encodingChanged ? distanceEncodingName(from.distanceEncoding) : enc,
                   r.encodingChanged ? " -> " : ")", r.encodingChanged ? enc : "", r.maxErrorSteps, enc, r.maxErrorRadii,
-                  static_cast<unsigned long long>(r.hits));
+                  r.rmsErrorSteps, static_cast<unsigned long long>(r.hits));
     s += buf;
     if (r.reverseChecked && r.notReversible == 0) {
       std::snprintf(buf, sizeof buf, "reversible: converting back to %s gives every code back\n",

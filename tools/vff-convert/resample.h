@@ -81,7 +81,9 @@ struct ResampleReport {
   // Stage 3, over every hit within the new encoding's scale: |decoded new distance - distance
   // before encoding|, in quantisation steps of the new encoding at that texel (0 for bit1, which
   // keeps no distance).
+  // bc4-diameter: the error after the BC4 blocks (the 8-bit quantisation and the block fit).
   double maxErrorSteps = 0;
+  double rmsErrorSteps = 0;        // root mean square of the same error over those hits
   double maxErrorRadii = 0;        // the same error in units of the radius R
   uint64_t clamped = 0;            // hits beyond the new encoding's scale, stored as its largest code
   double maxClampRadii = 0;        // how far beyond, at most, in units of R (not in maxErrorSteps)
@@ -113,14 +115,14 @@ Result<FieldDesc> planResample(const FieldDesc& source, const ResampleOptions& o
 Result<FieldData> resampleField(const FieldData& source, const ResampleOptions& options, ResampleReport* report);
 
 // The provenance entry of one conversion, appended to the array under "vff.provenance" in the
-// metadata (created when absent; the other keys stay as they are): {"tool":"vff-convert",
+// metadata (created when absent; the other keys stay as they are): {"tool":TOOL,
 // "version":VERSION,"operations":[...],"options":{...},"source":{"name":NAME,"xxh3":HEX,
 // "positionScheme":..,"positionParam":..,"mapResolution":..,"distanceEncoding":..}}
 // (spec/format.md, META). Errors: kMetadataJson when the metadata is not JSON, or when
 // "vff.provenance" exists but is not an array.
 Result<std::string> appendProvenance(const std::string& metadata, const FieldDesc& source, const FieldDesc& result,
                                      const ResampleOptions& options, const std::string& sourceName,
-                                     uint64_t sourceXxh3);
+                                     uint64_t sourceXxh3, const char* tool = "vff-convert");
 
 // The tool's summary of a conversion: one line per stage that changed something (or one saying
 // that nothing did), the quantisation error of the new encoding and the hit counts.
@@ -133,6 +135,7 @@ Result<uint64_t> fileXxh3(const std::string& path);
 // Stage 3 (reencode.cpp): what encoding the texels of one thread found; merged into the report.
 struct EncodeStats {
   double maxErrorSteps = 0, maxErrorRadii = 0;  // over the hits within the new scale
+  double sumSquaredSteps = 0;                    // the same errors squared and summed (for the RMS)
   double maxClampRadii = 0;                      // over the clamped hits: distance - scale, in R
   uint64_t hits = 0, clamped = 0;
   void merge(const EncodeStats& o) noexcept;
@@ -142,5 +145,7 @@ struct EncodeStats {
 // quantisation error accounted in `stats`. cosAlpha: z of the new texel-centre direction.
 uint32_t encodeTexel(DistanceEncoding to, bool hit, float distance, float radius, float cosAlpha,
                      EncodeStats* stats) noexcept;
+// Accounts the error of one hit (object-space units) in `stats`, in steps and radii.
+void accountError(EncodeStats* stats, double error, float step, float radius) noexcept;
 
 }  // namespace vff::convert

@@ -13,6 +13,7 @@
 #include <new>
 
 #include "inspect.h"
+#include "vff/bc4.h"
 #include "vff/direction.h"
 #include "vff/encoding.h"
 
@@ -43,7 +44,7 @@ Result<DistanceStats> distanceStats(const File& file, uint32_t bins, bool skipBa
 
   // unorm8 / unorm16 diameter: counts per code.
   std::vector<uint64_t> codeCounts;
-  if (enc == DistanceEncoding::kUnorm8Diameter) codeCounts.assign(256, 0);
+  if (enc == DistanceEncoding::kUnorm8Diameter || enc == DistanceEncoding::kBc4Diameter) codeCounts.assign(256, 0);
   if (enc == DistanceEncoding::kUnorm16Diameter) codeCounts.assign(65536, 0);
   // unorm8 chord: cos(alpha) per texel.
   std::vector<float> cosAlpha;
@@ -104,6 +105,14 @@ Result<DistanceStats> distanceStats(const File& file, uint32_t bins, bool skipBa
       case DistanceEncoding::kUnorm16Diameter:
         for (size_t k = 0; k + 1 < data.size(); k += 2) ++codeCounts[data[k] | (uint32_t{data[k + 1]} << 8)];
         break;
+      case DistanceEncoding::kBc4Diameter: {  // the codes the blocks decode to
+        uint8_t codes[16];
+        for (size_t k = 0; k + kBc4BlockBytes <= data.size(); k += kBc4BlockBytes) {
+          decodeBc4Block(&data[k], codes);
+          for (uint8_t c : codes) ++codeCounts[c];
+        }
+        break;
+      }
       case DistanceEncoding::kUnorm8Chord:
         for (uint64_t k = 0; k < data.size(); ++k) {
           const uint32_t code = data[k];

@@ -37,6 +37,8 @@ json featureJson(uint64_t bits, bool incompat) {
       names.push_back("zstd");
     else if (incompat && bit == kFeatureFilters)
       names.push_back("filters");
+    else if (incompat && bit == kFeatureBc4)
+      names.push_back("bc4");
     else
       names.push_back("bit " + std::to_string(b));
   }

@@ -127,7 +127,8 @@ Result<FieldBlock> makeFieldBlock(const FieldDesc& field, const LayoutDesc& layo
   // The same float expressions as the CPU query's decode (libvff/src/query.cpp), so that the
   // shader's decoded distances are bit-identical.
   switch (field.distanceEncoding) {
-    case DistanceEncoding::kUnorm8Diameter: b.distanceScale = 2.0f * radius / 254.0f; break;
+    case DistanceEncoding::kUnorm8Diameter:
+    case DistanceEncoding::kBc4Diameter: b.distanceScale = 2.0f * radius / 254.0f; break;
     case DistanceEncoding::kUnorm16Diameter: b.distanceScale = 2.0f * radius / 65534.0f; break;
     default: b.distanceScale = 0.0f; break;
   }
@@ -191,6 +192,11 @@ void GpuField::bind(const Bindings& b) const noexcept {
   glBindTexture(mapsTarget_ ? mapsTarget_ : GL_TEXTURE_2D_ARRAY, mapsTexture_);
 }
 
+const char* shaderDefines(const FieldDesc& field, const LayoutDesc& layout) noexcept {
+  if (field.distanceEncoding == DistanceEncoding::kBc4Diameter) return "#define VFF_MAPS_BC4\n";
+  return layout.target == LayoutTarget::kTexture3D ? "#define VFF_MAPS_3D\n" : "";
+}
+
 Result<GpuField> loadField(const File& file, const LoadOptions& options) {
   const FieldDesc& field = file.field();
   const LayoutDesc& layout = file.layout();
@@ -231,11 +237,15 @@ Result<GpuField> loadField(const File& file, const LoadOptions& options) {
     case DistanceEncoding::kUnorm8Chord:
     case DistanceEncoding::kBit1: break;
     case DistanceEncoding::kUnorm16Diameter: internalFormat = GL_R16UI; type = GL_UNSIGNED_SHORT; break;
+    case DistanceEncoding::kBc4Diameter: internalFormat = GL_COMPRESSED_RED_RGTC1; break;
     default: return makeError(Code::kUnsupported, "vff_gl cannot upload this distance encoding");
   }
+  const bool bc4 = field.distanceEncoding == DistanceEncoding::kBc4Diameter;
+  if (bc4 && (is3D || layout.gutter != 0))  // the file's rules 7001 and 7002
+    return makeError(Code::kUnsupported, "bc4-diameter slices must be a 2D array without gutters");
   const uint64_t sliceBytes = file.sliceBytes(Plane::kDistance);
   const uint64_t texelBytes = type == GL_UNSIGNED_SHORT ? 2 : 1;
-  if (sliceBytes != uint64_t(width) * layout.sliceHeight * texelBytes)
+  if (sliceBytes != (bc4 ? uint64_t(width) * layout.sliceHeight / 2 : uint64_t(width) * layout.sliceHeight * texelBytes))
     return makeError(Code::kUnsupported, "unexpected slice size " + std::to_string(sliceBytes) + " bytes");
 
   SavedState saved;
@@ -260,7 +270,20 @@ Result<GpuField> loadField(const File& file, const LoadOptions& options) {
   glPixelStorei(GL_UNPACK_SKIP_PIXELS, 0);
   glPixelStorei(GL_UNPACK_SKIP_ROWS, 0);
   glPixelStorei(GL_UNPACK_SKIP_IMAGES, 0);
-  if (layout.gutter == 0 && !bit1) {
+  if (bc4) {
+    // Each map's blocks are its compressed M x M image: upload them as stored. Unused tiles stay
+    // undefined; no lookup reads them.
+    const GLsizei m = GLsizei(field.mapResolution);
+    for (uint32_t k = 0; k < field.mapCount; ++k) {
+      auto map = file.mapData(Plane::kDistance, k);
+      if (!map) return map.error();
+      const TilePlacement at = placeMap(layout, k);
+      glCompressedTexSubImage3D(out.mapsTarget_, 0, GLint(at.x), GLint(at.y), GLint(at.slice), m, m, 1,
+                                GL_COMPRESSED_RED_RGTC1, GLsizei(map->size()), map->data());
+    }
+    if (Status st = checkGl("glCompressedTexSubImage3D (maps)"); !st) return st.error();
+    out.textureBytes_ += sliceBytes * layout.sliceCount;
+  } else if (layout.gutter == 0 && !bit1) {
     // Without gutters every map is one rectangle of its slice: upload it straight from the file's
     // bytes (the mapped file itself for stored blocks), with no slice composed on the CPU. Tiles
     // past the last map stay undefined; no lookup reads them.

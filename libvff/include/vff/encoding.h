@@ -33,6 +33,8 @@ float quantizationStep(DistanceEncoding e, float radius, float cosAlpha) noexcep
 
 // Reads / writes the code of texel (i, j) in one distance map of `mapResolution` squared texels.
 // The span must hold distanceMapBytes(e, mapResolution) bytes; no bounds checks beyond that.
+// kBc4Diameter: loadCode decodes the texel's block (vff/bc4.h); storeCode does nothing, since a
+// block is encoded from all its 16 codes at once: write unorm8-diameter codes, then encodeBc4Map.
 uint32_t loadCode(DistanceEncoding e, std::span<const uint8_t> map, uint32_t mapResolution,
                   uint32_t i, uint32_t j) noexcept;
 void storeCode(DistanceEncoding e, std::span<uint8_t> map, uint32_t mapResolution, uint32_t i,

@@ -16,7 +16,7 @@ namespace vff {
 
 // ---- Versions and fixed sizes -----------------------------------------------------------------
 inline constexpr uint16_t kVersionMajor = 1;
-inline constexpr uint16_t kVersionMinor = 1;  // the newest minor version this library reads and writes
+inline constexpr uint16_t kVersionMinor = 2;  // the newest minor version this library reads and writes
 inline constexpr uint8_t kMagic[8] = {0x89, 'V', 'F', 'F', 0x0D, 0x0A, 0x1A, 0x0A};
 inline constexpr uint32_t kHeaderSize = 64;
 inline constexpr uint32_t kSectionEntrySize = 64;
@@ -32,7 +32,8 @@ inline constexpr uint32_t kMaxMapResolution = 16384;  // so a map's bytes fit th
 // incompatFeatures: a reader that does not implement a set bit must reject the file.
 inline constexpr uint64_t kFeatureZstd = 1u << 0;     // some block or section uses codec zstd
 inline constexpr uint64_t kFeatureFilters = 1u << 1;  // some block uses a filter (format 1.1)
-inline constexpr uint64_t kKnownIncompatFeatures = kFeatureZstd | kFeatureFilters;
+inline constexpr uint64_t kFeatureBc4 = 1u << 2;      // the distance encoding is bc4-diameter (format 1.2)
+inline constexpr uint64_t kKnownIncompatFeatures = kFeatureZstd | kFeatureFilters | kFeatureBc4;
 // roCompatFeatures: none are defined in 1.0.
 inline constexpr uint64_t kKnownRoCompatFeatures = 0;
 
@@ -91,6 +92,8 @@ enum class DistanceEncoding : uint32_t {
   kUnorm8Chord = 2,      // u8: round(254 d / chord), chord = 2R cos(alpha) of the texel centre; 255 = miss
   kUnorm16Diameter = 3,  // u16 LE: round(65534 d / 2R), 65535 = miss
   kBit1 = 4,             // 1 bit: 1 = hit, 0 = miss, 8 texels per byte, LSB first
+  kBc4Diameter = 5,      // 1.2: unorm8-diameter codes in BC4/RGTC1 blocks of 4x4 texels (8 bytes), lossy;
+                         // 255 = miss, exactly; M a multiple of 4; layout 2d-array without gutter
 };
 // How a texel of the normal plane stores the object-space surface normal at the hit.
 enum class NormalEncoding : uint32_t {
@@ -110,10 +113,12 @@ const char* normalEncodingName(NormalEncoding e) noexcept;     // "none", "oct-s
 Result<uint32_t> positionCount(PositionScheme scheme, uint32_t param);
 
 // The reserved miss code of an encoding (255, 65535, or 0 for kBit1), and the largest hit code.
+// kBc4Diameter's codes are those of kUnorm8Diameter (see vff/bc4.h for the blocks).
 uint32_t missCode(DistanceEncoding e) noexcept;
 uint32_t maxHitCode(DistanceEncoding e) noexcept;
 
-// Bytes per map of the distance plane (kBit1: M*M/8) and of the normal plane; 0 if invalid.
+// Bytes per map of the distance plane (kBit1: M*M/8, kBc4Diameter: M*M/2) and of the normal plane;
+// 0 if invalid.
 uint64_t distanceMapBytes(DistanceEncoding e, uint32_t mapResolution) noexcept;
 uint64_t normalMapBytes(NormalEncoding e, uint32_t mapResolution) noexcept;
 

@@ -121,7 +121,8 @@ class File {
 
   // Bytes of one packed slice of a plane: sliceWidth * sliceHeight * texel size, where the texel
   // size is 1 (kUnorm8*), 2 (kUnorm16Diameter), 4 (normals); for kBit1 a row holds sliceWidth/8
-  // bytes. The slice's rows are tightly packed, top row first.
+  // bytes; kBc4Diameter: sliceWidth/4 x sliceHeight/4 blocks of 8 bytes, row-major (the layout
+  // glCompressedTexSubImage3D takes). The slice's rows are tightly packed, top row first.
   uint64_t sliceBytes(Plane p) const noexcept;
   // Composes slice `slice` into `out` (size sliceBytes(p)): each map at its placement, gutters
   // replicate the nearest edge texel, unused tiles hold the miss code (distance) or zero (normals).

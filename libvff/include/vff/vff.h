@@ -1,6 +1,7 @@
 // vff/vff.h - everything in libvff. See README.md for an overview and spec/ for the format.
 #pragma once
 
+#include "vff/bc4.h"
 #include "vff/direction.h"
 #include "vff/encoding.h"
 #include "vff/error.h"

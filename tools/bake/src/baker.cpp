@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "vff/bake/sphere.h"
+#include "vff/bc4.h"
 #include "vff/direction.h"
 #include "vff/encoding.h"
 #include "vff/positions.h"
@@ -152,6 +153,10 @@ uint64_t traceMap(const Scene::Impl& s, const Plan& plan, uint32_t map, uint8_t*
   const size_t texels = size_t(m) * m;
   const bool withNormals = kKeep && norm != nullptr;
   const bool smooth = !s.mesh.normals.empty();
+  // bc4-diameter: the map's unorm8-diameter codes first, then its BC4 blocks (vff/bc4.h).
+  const bool bc4 = kKeep && f.distanceEncoding == DistanceEncoding::kBc4Diameter;
+  thread_local std::vector<uint8_t> codes;
+  if (bc4) codes.assign(texels, 255);
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
@@ -188,7 +193,8 @@ uint64_t traceMap(const Scene::Impl& s, const Plan& plan, uint32_t map, uint8_t*
         const size_t t = t0 + k;
         const float d = std::max(0.0f, rh.ray.tfar[k] - backOff);
         const uint32_t code = encodeDistance(f.distanceEncoding, hit, d, R, plan.cosAlpha[t]);
-        storeCode(f.distanceEncoding, std::span<uint8_t>(dist, plan.distBytes), m, uint32_t(t % m), uint32_t(t / m), code);
+        if (bc4) codes[t] = uint8_t(code);
+        else storeCode(f.distanceEncoding, std::span<uint8_t>(dist, plan.distBytes), m, uint32_t(t % m), uint32_t(t / m), code);
         if (withNormals && hit) {
           Vec3 nv{rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]};
           if (smooth) {
@@ -206,6 +212,7 @@ uint64_t traceMap(const Scene::Impl& s, const Plan& plan, uint32_t map, uint8_t*
       }
     }
   }
+  if (bc4) encodeBc4Map(codes, m, std::span<uint8_t>(dist, plan.distBytes));
   return hits;
 }
 

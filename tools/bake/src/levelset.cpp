@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "vff/bake/sphere.h"
+#include "vff/bc4.h"
 #include "vff/direction.h"
 #include "vff/encoding.h"
 #include "vff/positions.h"
@@ -284,6 +285,10 @@ Result<BakedField> bakeLevelSet(const LevelSet& levelSet, const BakeOptions& opt
     const std::span<uint8_t> dmap(out.distance.data() + k * distBytes, distBytes);
     uint8_t* nmap = options.normals ? out.normals.data() + k * normBytes : nullptr;
     uint64_t hits = 0;
+    // bc4-diameter: the map's unorm8-diameter codes first, then its BC4 blocks (vff/bc4.h).
+    const bool bc4 = f.distanceEncoding == DistanceEncoding::kBc4Diameter;
+    thread_local std::vector<uint8_t> codes;
+    if (bc4) codes.assign(texels, 255);
     for (size_t t = 0; t < texels; ++t) {
       const Vec3 d = toWorld(frame, local[t]);
       openvdb::Vec3d dir(d.x, d.y, d.z);
@@ -296,8 +301,9 @@ Result<BakedField> bakeLevelSet(const LevelSet& levelSet, const BakeOptions& opt
       const bool hit = isect.intersectsWS(ray, world, normal, time);
       hits += hit;
       const float distance = hit ? std::max(0.0f, static_cast<float>(time)) : 0.0f;
-      storeCode(f.distanceEncoding, dmap, m, uint32_t(t % m), uint32_t(t / m),
-                encodeDistance(f.distanceEncoding, hit, distance, R, cosAlpha[t]));
+      const uint32_t code = encodeDistance(f.distanceEncoding, hit, distance, R, cosAlpha[t]);
+      if (bc4) codes[t] = uint8_t(code);
+      else storeCode(f.distanceEncoding, dmap, m, uint32_t(t % m), uint32_t(t / m), code);
       if (nmap && hit) {
         // The intersector's normal is the gradient of the trilinear interpolant, already taken to
         // world space by the inverse transpose of the grid's Jacobian (BoxStencil::gradient), and
@@ -307,6 +313,7 @@ Result<BakedField> bakeLevelSet(const LevelSet& levelSet, const BakeOptions& opt
           encodeNormal({float(normal.x() / len), float(normal.y() / len), float(normal.z() / len)}, nmap + 4 * t);
       }
     }
+    if (bc4) encodeBc4Map(codes, m, dmap);
     return hits;
   };
 

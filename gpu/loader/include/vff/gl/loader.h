@@ -11,7 +11,9 @@
 //   slice at a time and uploaded with glTexSubImage3D into immutable storage of internal format
 //   GL_R8UI (unorm8-diameter, unorm8-chord, bit1: width sliceWidth / 8) or GL_R16UI
 //   (unorm16-diameter), target GL_TEXTURE_2D_ARRAY (LAYT target 1) or GL_TEXTURE_3D (target 2),
-//   nearest filtering, one level;
+//   nearest filtering, one level; bc4-diameter: GL_COMPRESSED_RED_RGTC1 (2D array), each map's
+//   blocks uploaded as they are stored with glCompressedTexSubImage3D (the texture unit decodes them;
+//   the shader needs shaderDefines(field, layout));
 // * a uniform buffer holding a FieldBlock (std140, the shader's VffFieldBlock);
 // * a shader storage buffer with the binary32 unit vector of every positional sample
 //   (vff::PositionSet::position), one vec4 each; for unorm8-chord followed by the decode scale
@@ -138,5 +140,10 @@ class GpuField {
 
 // Uploads the file's distance plane, field block and sample positions (see the top of this file).
 Result<GpuField> loadField(const File& file, const LoadOptions& options = {});
+
+// The #define lines vff_query.glsl needs for a field, to put between `#version 430` and the
+// shader's text: "#define VFF_MAPS_3D\n" for the 3d target, "#define VFF_MAPS_BC4\n" for
+// bc4-diameter (a float sampler of the compressed slices), else "".
+const char* shaderDefines(const FieldDesc& field, const LayoutDesc& layout) noexcept;
 
 }  // namespace vff::gl
