@@ -467,6 +467,7 @@ class Parser {
     pi.rawBytes = uint64_t(mapCount) * mapBytes;
     pi.blocks.resize(blockCount);
     uint64_t expected = alignUp(indexEnd, kBlockAlignment);
+    bool blockLimitReported = false;
     for (uint32_t bi = 0; bi < blockCount; ++bi) {
       const uint64_t at = kPlaneHeaderSize + uint64_t(bi) * kBlockEntrySize;
       const uint8_t* e = &sec[at];
@@ -504,6 +505,14 @@ class Parser {
         ok = false;
         if (!report(Code::kBlockRawSize, tag, where + 16,
                     "block " + num(bi) + " rawSize " + num(blk.rawSize) + " should be " + num(uint64_t(blk.mapCount) * mapBytes)))
+          return false;
+      } else if (blk.rawSize > opt_.limits.maxBlockBytes && !blockLimitReported) {
+        // Before anything is decoded: a valid zstd frame of a few KiB can really expand to 4 GiB.
+        blockLimitReported = true;  // once per plane: every block but the last has the same rawSize
+        if (!report(Code::kDecodedLimit, tag, where + 16,
+                    "block " + num(bi) + " of " + num(blockCount) + " decodes to " + num(blk.rawSize) +
+                        " bytes, above the reader's limit of " + num(opt_.limits.maxBlockBytes) +
+                        " bytes per block (ReadOptions::maxBlockBytes)"))
           return false;
       }
       if (blk.codec != Codec::kStored && blk.codec != Codec::kZstd) {

@@ -1,6 +1,10 @@
 #include "vff/validate.h"
 
 #include <algorithm>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
 
 #include "codec.h"
 #include "mapped_file.h"
@@ -56,28 +60,40 @@ void checkPadding(std::span<const uint8_t> bytes, std::vector<std::pair<uint64_t
   if (pos < end) gap(pos, end);
 }
 
-// Decodes every block of a plane; checks that normal texels of misses are zero.
+// Decodes every block of a plane; checks that normal texels of misses are zero. Block by block into
+// one buffer (File::decodeBlock, not the File's cache): memory stays one block (at most
+// ReadOptions::maxBlockBytes) however large the field, even a few KiB of zstd that decode to GiBs.
 void checkPlane(const File& f, Plane p, Report* r) {
   const PlaneInfo& pi = f.plane(p);
   const uint32_t tag = p == Plane::kDistance ? kTagDistance : kTagNormal;
   const FieldDesc& fd = f.field();
   bool missReported = false;  // rule 6013 is reported once per plane; decoding goes on
+  std::vector<uint8_t> block, distBlock;  // the block checked; for normals, the distance block of its maps
+  uint32_t distIndex = UINT32_MAX;
   for (uint32_t bi = 0; bi < pi.blocks.size(); ++bi) {
-    auto data = f.blockData(p, bi);
-    if (!data) {
-      const Error& e = data.error();
-      r->issues.push_back({e.code, Severity::kError, tag, e.offset, e.message});
+    block.resize(pi.blocks[bi].rawSize);
+    if (Status st = f.decodeBlock(p, bi, block); !st) {
+      const Error& e = st.error();
+      r->issues.push_back({e.code, Severity::kError, tag, e.offset, "block " + std::to_string(bi) + ": " + e.message});
       continue;
     }
     if (p != Plane::kNormal || missReported) continue;
     const BlockInfo& b = pi.blocks[bi];
     for (uint32_t k = 0; k < b.mapCount; ++k) {
-      auto dist = f.mapData(Plane::kDistance, b.firstMap + k);
-      if (!dist) break;  // reported with the distance plane
-      const uint8_t* nm = data->data() + uint64_t(k) * pi.mapBytes;
+      const PlaneInfo& di = f.plane(Plane::kDistance);
+      const uint32_t map = b.firstMap + k, db = map / di.mapsPerBlock;
+      if (db != distIndex) {
+        distIndex = UINT32_MAX;
+        distBlock.resize(di.blocks[db].rawSize);
+        if (!f.decodeBlock(Plane::kDistance, db, distBlock)) break;  // reported with the distance plane
+        distIndex = db;
+      }
+      const std::span<const uint8_t> dist =
+          std::span<const uint8_t>(distBlock).subspan(uint64_t(map - di.blocks[db].firstMap) * di.mapBytes, di.mapBytes);
+      const uint8_t* nm = block.data() + uint64_t(k) * pi.mapBytes;
       const uint32_t m = fd.mapResolution;
       for (uint32_t t = 0; t < m * m; ++t) {
-        const uint32_t code = loadCode(fd.distanceEncoding, *dist, m, t % m, t / m);
+        const uint32_t code = loadCode(fd.distanceEncoding, dist, m, t % m, t / m);
         const bool hit = decodeDistance(fd.distanceEncoding, code, 1.0f, 1.0f).hit;
         if (!hit && (nm[4 * t] | nm[4 * t + 1] | nm[4 * t + 2] | nm[4 * t + 3]) != 0) {
           r->issues.push_back({Code::kValueRange, Severity::kError, tag, kNoOffset,

@@ -19,6 +19,7 @@
 #include <xxhash.h>
 #include <zstd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -183,6 +184,23 @@ Bytes zstdFrameClaiming(uint64_t content, uint32_t rle) {
   return f;
 }
 
+// A real zstd frame of `content` bytes equal to `byte`: the frame header (8-byte content size,
+// single segment) and RLE blocks of 128 KiB (the largest a frame allows), 4 bytes each, the last
+// one marked. It decodes without error: 4 GiB from 128 KiB, what zstd itself writes for such data.
+Bytes zstdRleFrame(uint64_t content, uint8_t byte) {
+  Bytes f = {0x28, 0xB5, 0x2F, 0xFD, 0xE0};
+  for (int k = 0; k < 8; ++k) f.push_back(uint8_t(content >> (8 * k)));
+  for (uint64_t left = content; left > 0;) {
+    const uint32_t n = uint32_t(std::min<uint64_t>(left, 128u << 10));
+    left -= n;
+    const uint32_t header = (left == 0 ? 1u : 0u) | (1u << 1) | (n << 3);  // last?, RLE, size
+    f.insert(f.end(), {uint8_t(header), uint8_t(header >> 8), uint8_t(header >> 16), byte});
+  }
+  if (ZSTD_getFrameContentSize(f.data(), f.size()) != content || ZSTD_findFrameCompressedSize(f.data(), f.size()) != f.size())
+    die("zstdRleFrame: zstd does not read the frame back");
+  return f;
+}
+
 Bytes zstdOf(const Bytes& raw) {
   Bytes out(ZSTD_compressBound(raw.size()));
   const size_t n = ZSTD_compress(out.data(), out.size(), raw.data(), raw.size(), 19);
@@ -192,6 +210,37 @@ Bytes zstdOf(const Bytes& raw) {
 }
 
 Bytes text(const std::string& s) { return Bytes(s.begin(), s.end()); }
+
+// Replaces the DIST section (the file's last) with `blockCount` blocks of `g` maps, every one the
+// real zstd frame of its maps all at `byte` (the first frame stands for every full block), at the
+// canonical offsets. Makes a valid file once sealed.
+void setBlocks(Vff& v, uint32_t g, uint8_t byte) {
+  const uint64_t e = v.entry(kTagDistance), off = v.sec(kTagDistance);
+  const uint32_t mapCount = ld32(v.b, off), mapBytes = ld32(v.b, off + 4);
+  const uint32_t blockCount = (mapCount + g - 1) / g;
+  const Bytes full = zstdOf(Bytes(uint64_t{g} * mapBytes, byte));
+  const Bytes last = zstdOf(Bytes(uint64_t{mapCount - (blockCount - 1) * g} * mapBytes, byte));
+  Bytes sec(kPlaneHeaderSize + uint64_t{blockCount} * kBlockEntrySize, 0);
+  st32(sec, 0, mapCount);
+  st32(sec, 4, mapBytes);
+  st32(sec, 8, g);
+  st32(sec, 12, blockCount);
+  for (uint32_t i = 0; i < blockCount; ++i) {
+    const Bytes& frame = i + 1 < blockCount ? full : last;
+    sec.resize((sec.size() + kBlockAlignment - 1) / kBlockAlignment * kBlockAlignment, 0);
+    const uint64_t be = kPlaneHeaderSize + uint64_t{i} * kBlockEntrySize;
+    st64(sec, be, sec.size());
+    st64(sec, be + 8, frame.size());
+    st32(sec, be + 16, uint32_t(std::min(g, mapCount - i * g)) * mapBytes);
+    sec[be + 20] = 1;  // zstd
+    sec.insert(sec.end(), frame.begin(), frame.end());
+  }
+  v.b.resize(off);
+  v.b.insert(v.b.end(), sec.begin(), sec.end());
+  st64(v.b, e + 16, sec.size());
+  st64(v.b, e + 24, sec.size());
+  st64(v.b, 16, v.b.size());
+}
 
 // A .glb holding `json` and a binary chunk of `bin` bytes.
 Bytes glb(std::string json, const Bytes& bin) {
@@ -370,6 +419,21 @@ const std::map<std::string, std::function<Bytes()>> kInputs = {
        Vff v = base(false);
        claimField(v, fibonacci(kBigMaps, 64));
        v.setLastBlock(kTagDistance, 0, zstdFrameClaiming(kBigRaw, 16), kBigRaw);
+       v.seal();
+       return v.b;
+     }},
+    // ---- .vff: real zstd bombs (valid checksums, frames that decode without error) ----------------
+    {"vff-bomb-block-4gib.vff", [] {  // one block of 2^20-1 maps of 64x64, a 128 KiB frame of 4294963200 0xFF
+       Vff v = base(false);
+       claimField(v, fibonacci(kBigMaps, 64));
+       v.setLastBlock(kTagDistance, 0, zstdRleFrame(kBigRaw, 0xFF), kBigRaw);
+       v.seal();
+       return v.b;
+     }},
+    {"vff-bomb-blocks-4gib.vff", [] {  // the same field in 16384 blocks of 64 maps (256 KiB, the writer's
+       Vff v = base(false);             // own G), each a 40-byte frame: a valid all-miss field of 4 GiB
+       claimField(v, fibonacci(kBigMaps, 64));
+       setBlocks(v, 64, 0xFF);
        v.seal();
        return v.b;
      }},

@@ -25,7 +25,7 @@ source "$(dirname "${BASH_SOURCE[0]}")/../common/cli_harness.sh"
 # Tool runs that are known to exceed the bound, with the reason; skipped (not run: each takes
 # gigabytes and tens of seconds) unless VFF_LIMITS_ALL=1. Delete a line once its cause is fixed.
 declare -A KNOWN=(
-  ["vff-convert exr-slice-16k.exr"]="tools/vff-convert/exr.cpp allocates the claimed field and slice buffers (2.3 GiB) before OpenEXR finds that the part holds no pixels"
+  ["vff-convert vff-bomb-blocks-4gib.vff"]="a valid field of 4 GiB: vff-convert holds the whole decoded field (one copy: 4 GiB; ReadOptions::maxPayloadBytes bounds it), and re-encodes it for minutes"
 )
 
 # measure EXPECTED_RC EXPECTED_TEXT INPUT CMD...: runs CMD under vff_peak_rss, appends a report row,
@@ -108,15 +108,38 @@ test_vff_payload_512tib() { vff_case vff-payload-512tib.vff "decoded-limit (5011
 test_vff_blocks_2e24() { vff_case vff-blocks-2e24.vff "block-bounds (6003)"; }
 test_vff_block_offset_2e64() { vff_case vff-block-offset-2e64.vff "block-bounds (6003)"; }
 test_vff_block_stored_2e63() { vff_case vff-block-stored-2e63.vff "block-bounds (6003)"; }
-test_vff_block_raw_4gib() { vff_case vff-block-raw-4gib.vff "block-decode (6010)"; }
-test_vff_block_frame_4gib() { vff_case vff-block-frame-4gib.vff "block-decode (6010)"; }
+# (The two 4 GiB blocks meet the block limit, ReadOptions::maxBlockBytes, before their frames are
+# looked at; vff-block-frame-stored still reaches the frame check.)
+test_vff_block_raw_4gib() { vff_case vff-block-raw-4gib.vff "decoded-limit (5011)"; }
+test_vff_block_frame_4gib() { vff_case vff-block-frame-4gib.vff "decoded-limit (5011)"; }
 test_vff_block_frame_stored() { vff_case vff-block-frame-stored.vff "block-decode (6010)"; }
+# ---- .vff: real zstd bombs (valid frames and checksums) -----------------------------------------------
+# One block whose 128 KiB frame really decodes to 4 GiB: refused at open by ReadOptions::maxBlockBytes
+# (64 MiB), before anything is decoded.
+test_vff_bomb_block_4gib() {
+  vff_case vff-bomb-block-4gib.vff "decoded-limit (5011)"
+  grep -q -F "block 0 of 1 decodes to 4294963200 bytes, above the reader's limit of 67108864 bytes per block" \
+    "$WORK/err" || { cat "$WORK/err" >&2; fail "the diagnostic does not name the block and the limit"; }
+}
+# A valid all-miss field of 4 GiB in 16384 blocks of 256 KiB (1.5 MiB of file): the readers that
+# stream decode one block at a time (the validator, the statistics of the summary), within the bound.
+test_vff_bomb_blocks_4gib() {
+  local input="$WORK/vff-bomb-blocks-4gib.vff"
+  "$GEN" vff-bomb-blocks-4gib.vff "$input" || fail "vff_limits_gen vff-bomb-blocks-4gib.vff"
+  mkdir -p "$WORK/o"
+  measure 0 "" "$input" "$VFF_INSPECT" "$input" --validate
+  measure 0 "" "$input" "$VFF_INSPECT" "$input" --format json
+  grep -q -E '"texels": 4294963200' "$WORK/out" || fail "the statistics did not count every texel"
+  measure 0 "" "$input" "$VFF_CONVERT" "$input" --to vff "$WORK/o/out.vff"
+}
 # ---- EXR (vff-convert's input) -------------------------------------------------------------------------
 test_exr_slice_16k() {
   local input="$WORK/exr-slice-16k.exr"
   "$GEN" exr-slice-16k.exr "$input" || fail "vff_limits_gen exr-slice-16k.exr"
   mkdir -p "$WORK/o"
   measure 3 "section-decode (4011)" "$input" "$VFF_CONVERT" "$input" --to vff "$WORK/o/out.vff"
+  # Read in bands of tile rows: the first band already meets the missing pixels.
+  grep -q -F "Scan line 0 is missing" "$WORK/err" || fail "the diagnostic does not say what is missing"
   nothing_written
 }
 # ---- Meshes ---------------------------------------------------------------------------------------------

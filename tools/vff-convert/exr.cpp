@@ -222,7 +222,6 @@ Result<FieldData> readExr(const std::string& path, ExrReadReport* report) {
     const uint64_t dBytes = distanceMapBytes(f.distanceEncoding, m);
     const uint64_t nBytes = normalMapBytes(f.normalEncoding, m);
     const uint32_t perSlice = l.tilesPerRow * l.tilesPerColumn;
-    const uint64_t texels = uint64_t{l.sliceWidth} * l.sliceHeight;
     const std::vector<float> cosines = texelCosines(f);
 
     // Check every part before allocating the planes.
@@ -258,65 +257,88 @@ Result<FieldData> readExr(const std::string& path, ExrReadReport* report) {
     }
     report->half = yType == Imf::HALF;
 
-    d.distance.assign(uint64_t{f.mapCount} * dBytes, 0);
-    if (normals) d.normals.assign(uint64_t{f.mapCount} * nBytes, 0);
-    std::vector<float> y(texels), miss(texels), rgb[3];
-    std::vector<bool> hitAt(uint64_t{m} * m);
+    // Each part is read in bands of whole tile rows (about 2^20 texels), and the maps of a band are
+    // appended to the planes as they are decoded: memory follows the pixel data actually read, not
+    // the field's claim (a header can claim 16k x 16k slices over a file holding no pixels), and the
+    // first missing or corrupt chunk ends the import.
+    const uint32_t tile = l.tileSize;
+    const uint64_t bandTiles = std::max<uint64_t>(1, (uint64_t{1} << 20) / (uint64_t{l.sliceWidth} * tile));
+    const uint64_t bandRowsMax = std::min<uint64_t>(bandTiles * tile, l.sliceHeight);
+    std::vector<float> y, miss, rgb[3];
     for (uint32_t s = 0; s < l.sliceCount; ++s) {
-      {
-        Imf::InputPart part(in, distParts[s]);
-        const Imath::Box2i dw = part.header().dataWindow();
-        const bool hasMiss = part.header().channels().findChannel("miss") != nullptr;
-        Imf::FrameBuffer fb;
-        fb.insert("Y", Imf::Slice::Make(Imf::FLOAT, y.data(), dw));
-        fb.insert("miss", Imf::Slice::Make(Imf::FLOAT, miss.data(), dw, 0, 0, 1, 1, 0.0));
-        part.setFrameBuffer(fb);
-        part.readPixels(dw.min.y, dw.max.y);
-        if (!hasMiss)  // without the miss channel, a miss is a non-finite Y
-          for (uint64_t t = 0; t < texels; ++t) miss[t] = std::isfinite(y[t]) ? 0.0f : 1.0f;
-      }
-      if (normals) {
-        for (auto& c : rgb) c.assign(texels, 0.0f);
-        Imf::InputPart part(in, normParts[s]);
-        const Imath::Box2i dw = part.header().dataWindow();
-        Imf::FrameBuffer fb;
-        const char* names[3] = {"R", "G", "B"};
-        for (int c = 0; c < 3; ++c) fb.insert(names[c], Imf::Slice::Make(Imf::FLOAT, rgb[c].data(), dw));
-        part.setFrameBuffer(fb);
-        part.readPixels(dw.min.y, dw.max.y);
-      }
       const uint32_t first = s * perSlice, last = std::min(f.mapCount, first + perSlice);
-      for (uint32_t k = first; k < last; ++k) {
-        const TilePlacement p = placeMap(l, k);
-        const std::span<uint8_t> dmap(d.distance.data() + k * dBytes, dBytes);
-        for (uint32_t j = 0; j < m; ++j) {
-          for (uint32_t i = 0; i < m; ++i) {
-            const uint64_t at = uint64_t{p.y + j} * l.sliceWidth + (p.x + i);
-            const float cosAlpha = cosines[uint64_t{j} * m + i];
-            const bool hit = !(miss[at] >= 0.5f);
-            const uint32_t code = encodeDistance(f.distanceEncoding, hit, y[at], f.sphere.radius, cosAlpha);
-            storeCode(f.distanceEncoding, dmap, m, i, j, code);
-            const Texel back = decodeDistance(f.distanceEncoding, code, f.sphere.radius, cosAlpha);
-            if (hit && roundToType(back.distance, report->half) != y[at]) {
-              ++report->inexactTexels;
-            } else if (hit && report->half && f.distanceEncoding != DistanceEncoding::kBit1) {
-              // A neighbouring code that HALF stores as the same value makes the texel ambiguous.
-              const auto same = [&](uint32_t c) {
-                return roundToType(decodeDistance(f.distanceEncoding, c, f.sphere.radius, cosAlpha).distance, true) ==
-                       y[at];
-              };
-              if ((code > 0 && same(code - 1)) || (code < maxHitCode(f.distanceEncoding) && same(code + 1)))
-                ++report->ambiguousTexels;
-            }
-            if (normals && hit) {
-              uint8_t* out = d.normals.data() + k * nBytes + 4 * (uint64_t{j} * m + i);
-              const Vec3 n{rgb[0][at], rgb[1][at], rgb[2][at]};
-              if (!encodeNormalExact(n, nType == Imf::HALF, out)) ++report->inexactNormals;
+      for (uint64_t y0 = 0; y0 < l.sliceHeight; y0 += bandRowsMax) {
+        const uint64_t rows = std::min<uint64_t>(bandRowsMax, l.sliceHeight - y0);
+        const uint64_t texels = rows * l.sliceWidth;
+        // The pixel rows of this band, as a window in the part's coordinates.
+        auto band = [&](const Imath::Box2i& dw) {
+          return Imath::Box2i(Imath::V2i(dw.min.x, dw.min.y + static_cast<int>(y0)),
+                              Imath::V2i(dw.max.x, dw.min.y + static_cast<int>(y0 + rows) - 1));
+        };
+        {
+          y.resize(texels);
+          miss.resize(texels);
+          Imf::InputPart part(in, distParts[s]);
+          const Imath::Box2i bw = band(part.header().dataWindow());
+          const bool hasMiss = part.header().channels().findChannel("miss") != nullptr;
+          Imf::FrameBuffer fb;
+          fb.insert("Y", Imf::Slice::Make(Imf::FLOAT, y.data(), bw));
+          fb.insert("miss", Imf::Slice::Make(Imf::FLOAT, miss.data(), bw, 0, 0, 1, 1, 0.0));
+          part.setFrameBuffer(fb);
+          part.readPixels(bw.min.y, bw.max.y);
+          if (!hasMiss)  // without the miss channel, a miss is a non-finite Y
+            for (uint64_t t = 0; t < texels; ++t) miss[t] = std::isfinite(y[t]) ? 0.0f : 1.0f;
+        }
+        if (normals) {
+          for (auto& c : rgb) c.assign(texels, 0.0f);
+          Imf::InputPart part(in, normParts[s]);
+          const Imath::Box2i bw = band(part.header().dataWindow());
+          Imf::FrameBuffer fb;
+          const char* names[3] = {"R", "G", "B"};
+          for (int c = 0; c < 3; ++c) fb.insert(names[c], Imf::Slice::Make(Imf::FLOAT, rgb[c].data(), bw));
+          part.setFrameBuffer(fb);
+          part.readPixels(bw.min.y, bw.max.y);
+        }
+        // The maps whose tiles lie in this band (tiles are placed row by row), appended in order.
+        const uint64_t bandFirst = std::min<uint64_t>(last, first + y0 / tile * l.tilesPerRow);
+        const uint64_t bandEnd = std::min<uint64_t>(last, first + (y0 + rows) / tile * l.tilesPerRow);
+        if (bandFirst >= bandEnd) continue;
+        d.distance.resize(bandEnd * dBytes, 0);
+        if (normals) d.normals.resize(bandEnd * nBytes, 0);
+        for (uint32_t k = static_cast<uint32_t>(bandFirst); k < bandEnd; ++k) {
+          const TilePlacement p = placeMap(l, k);
+          const std::span<uint8_t> dmap(d.distance.data() + k * dBytes, dBytes);
+          for (uint32_t j = 0; j < m; ++j) {
+            for (uint32_t i = 0; i < m; ++i) {
+              const uint64_t at = (uint64_t{p.y + j} - y0) * l.sliceWidth + (p.x + i);
+              const float cosAlpha = cosines[uint64_t{j} * m + i];
+              const bool hit = !(miss[at] >= 0.5f);
+              const uint32_t code = encodeDistance(f.distanceEncoding, hit, y[at], f.sphere.radius, cosAlpha);
+              storeCode(f.distanceEncoding, dmap, m, i, j, code);
+              const Texel back = decodeDistance(f.distanceEncoding, code, f.sphere.radius, cosAlpha);
+              if (hit && roundToType(back.distance, report->half) != y[at]) {
+                ++report->inexactTexels;
+              } else if (hit && report->half && f.distanceEncoding != DistanceEncoding::kBit1) {
+                // A neighbouring code that HALF stores as the same value makes the texel ambiguous.
+                const auto same = [&](uint32_t c) {
+                  return roundToType(decodeDistance(f.distanceEncoding, c, f.sphere.radius, cosAlpha).distance, true) ==
+                         y[at];
+                };
+                if ((code > 0 && same(code - 1)) || (code < maxHitCode(f.distanceEncoding) && same(code + 1)))
+                  ++report->ambiguousTexels;
+              }
+              if (normals && hit) {
+                uint8_t* out = d.normals.data() + k * nBytes + 4 * (uint64_t{j} * m + i);
+                const Vec3 n{rgb[0][at], rgb[1][at], rgb[2][at]};
+                if (!encodeNormalExact(n, nType == Imf::HALF, out)) ++report->inexactNormals;
+              }
             }
           }
         }
       }
     }
+    if (d.distance.size() != uint64_t{f.mapCount} * dBytes)  // the layout places every map (checked by its parser)
+      return makeError(Code::kLayoutGeometry, "the layout's slices do not hold all " + std::to_string(f.mapCount) + " maps");
   } catch (const std::exception& e) {
     // The file opened (checked above), so a failure here is a corrupt or truncated EXR.
     return makeError(Code::kSectionDecode, "cannot read " + path + " as OpenEXR: " + e.what());

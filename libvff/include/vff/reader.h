@@ -41,6 +41,15 @@ struct ReadOptions {
   uint32_t maxMapResolution = 4096;             // M
   uint64_t maxPayloadBytes = uint64_t{1} << 36;  // raw bytes of all planes together (64 GiB)
   uint64_t maxSectionBytes = uint64_t{64} << 20;  // raw size of a non-plane section
+  // Raw (decoded) size of one block of a plane (64 MiB): the most a decode allocates at once. A
+  // zstd frame of a few KiB can really expand to a block's whole rawSize (up to 4 GiB, and every
+  // check on the claim passes), so the limit is enforced at open, before anything is decoded
+  // (decoded-limit, 5011, naming the block). The default holds the largest block the writer makes
+  // on its own (256 KiB, or one map when a map is larger: at most 4096^2 normals = 64 MiB); a file
+  // written with a larger WriteOptions::mapsPerBlock needs a larger limit. Readers that stream
+  // block by block (File::decodeBlock into one buffer) then use at most this much for the decoded
+  // data; those that keep every block (blockData, mapData, the query) use up to maxPayloadBytes.
+  uint64_t maxBlockBytes = uint64_t{64} << 20;
   ChecksumPolicy checksums = ChecksumPolicy::kVerifyAll;
 };
 
