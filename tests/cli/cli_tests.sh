@@ -135,7 +135,7 @@ test_stdout_write_error() {
   RC=$?
   set -e
   expect_rc 2
-  expect_err "io-write (1003): cannot write standard output"
+  expect_err "vff-inspect: error: stdout: No space left on device"
 }
 
 # ---- Summary ---------------------------------------------------------------------------------------

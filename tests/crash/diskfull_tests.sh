@@ -13,7 +13,8 @@
 # the cause on stderr, leave the old file byte for byte, and leave no temporary next to it. With
 # room for the whole output the same command must succeed and write the same bytes as without a
 # limit. Every function named test_* is one ctest case (tests/crash/CMakeLists.txt); environment:
-#   VFF_BAKE VFF_CONVERT VFF_COMPRESS VFF_INSPECT MESHGEN  the executables; WORK a scratch folder of this test.
+#   VFF_BAKE VFF_CONVERT VFF_COMPRESS VFF_INSPECT MESHGEN  the executables; WORK a scratch folder of this test;
+#   VFF_EXPERIMENTS  optional: vff-experiments (the stdout_full_* cases also run it).
 set -euo pipefail
 
 # ---- Inside the namespace (called by in_tmpfs below) ------------------------------------------------
@@ -160,17 +161,79 @@ test_fsize_convert_from_exr() { sweep fsize from_exr; }
 test_fsize_inspect_preview() { sweep fsize preview; }
 test_fsize_compress() { sweep fsize compress; }
 
-# Standard output that cannot be written (/dev/full) is an I/O error too, for the report's writer.
-test_stdout_full_inspect() {
-  inputs inspect
-  run "$VFF_INSPECT" "$WORK/in.vff" --format json
+# ---- Standard output that cannot be written ----------------------------------------------------------
+# A report on stdout that cannot be written (/dev/full: ENOSPC) is an I/O error for every tool: the
+# check cli::parse() installs (tools/common/cli.cpp) flushes stdout at exit and turns a failed
+# write into "PROG: error: stdout: No space left on device" and exit 2. An output file the tool
+# writes is complete by then (written through a temporary and a rename); only the report is lost.
+
+# stdout_full NAME CMD...: CMD prints something to stdout (checked on a pipe first: exit 0), and with
+# stdout on /dev/full exits 2 with the diagnostic.
+stdout_full() {
+  local name=$1
+  shift
+  [[ -w /dev/full ]] || skip "no writable /dev/full here"
+  run "$@"
   expect_rc 0
+  [[ -s $WORK/out ]] || { show; fail "$name prints nothing on stdout: the test proves nothing"; }
   set +e
-  "$VFF_INSPECT" "$WORK/in.vff" --format json >/dev/full 2>"$WORK/err"
+  "$@" >/dev/full 2>"$WORK/err"
   RC=$?
   set -e
+  : >"$WORK/out"
   expect_rc 2
-  expect_err "No space left on device"
+  expect_err "$name: error: stdout: No space left on device"
+  echo "$name $(printf '%q ' "${@:2}")> /dev/full: exit 2, $(head -n 1 "$WORK/err")"
+}
+
+# valid_vff FILE: the output the tool wrote although its report could not be.
+valid_vff() {
+  "$VFF_INSPECT" "$1" --validate >/dev/null 2>"$WORK/validate.err" || {
+    cat "$WORK/validate.err" >&2
+    fail "$1 is not a valid field"
+  }
+}
+
+test_stdout_full_inspect() {
+  inputs inspect
+  stdout_full vff-inspect "$VFF_INSPECT" "$WORK/in.vff" --format json
+  stdout_full vff-inspect "$VFF_INSPECT" "$WORK/in.vff"
+  stdout_full vff-inspect "$VFF_INSPECT" "$WORK/in.vff" --validate
+}
+
+test_stdout_full_bake() {
+  inputs bake
+  stdout_full vff-bake "$VFF_BAKE" "$WORK/knot.obj" -o "$WORK/baked.vff" -n 6 -m 32 --json
+  valid_vff "$WORK/baked.vff"
+}
+
+test_stdout_full_convert() {
+  inputs inspect
+  stdout_full vff-convert "$VFF_CONVERT" "$WORK/in.vff" --to vff "$WORK/repacked.vff" --codec zstd
+  valid_vff "$WORK/repacked.vff"
+  stdout_full vff-convert "$VFF_CONVERT" "$WORK/in.vff" --to exr "$WORK/in.exr"
+  [[ -s $WORK/in.exr ]] || fail "no EXR written"
+}
+
+test_stdout_full_compress() {
+  inputs inspect
+  stdout_full vff-compress "$VFF_COMPRESS" "$WORK/in.vff" "$WORK/small.vff" --level 3
+  valid_vff "$WORK/small.vff"
+}
+
+# --help and --version print to stdout before any work: the check covers them too.
+test_stdout_full_help_version() {
+  local tool
+  for tool in "$VFF_BAKE" "$VFF_INSPECT" "$VFF_CONVERT" "$VFF_COMPRESS" ${VFF_EXPERIMENTS:+"$VFF_EXPERIMENTS"}; do
+    stdout_full "${tool##*/}" "$tool" --help
+    stdout_full "${tool##*/}" "$tool" --version
+  done
+}
+
+test_stdout_full_experiments() {
+  [[ -n ${VFF_EXPERIMENTS:-} ]] || skip "vff-experiments is not built"
+  "$MESHGEN" torus-knot "$WORK/knot.obj" >/dev/null || fail "mesh generator"
+  stdout_full vff-experiments "$VFF_EXPERIMENTS" bench --mesh "$WORK/knot.obj" --config 1090x16x16 --bench-rays 2000 --repeat 1 -j 2
 }
 
 # ---- Runner --------------------------------------------------------------------------------------

@@ -9,7 +9,9 @@
 #include <cinttypes>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <iostream>
 
 #include "vff/format.h"
 #include "vff/version.h"
@@ -95,7 +97,43 @@ void addCommonOptions(CLI::App& app, std::string_view prog, CommonOptions& optio
   addFormatOption(app, options.format);
 }
 
+namespace {
+
+std::string gStdoutProg;  // the tool named by the exit check's diagnostic
+
+void stdoutExitCheck() {
+  // std::cout shares stdout's buffer (sync_with_stdio), so flushing both sends every byte the tool
+  // wrote; ferror() also remembers a failure of an earlier, implicit flush.
+  errno = 0;
+  std::cout.flush();
+  int err = errno;
+  const bool flushed = std::fflush(stdout) == 0;
+  if (!flushed && errno != 0) err = errno;
+  if (flushed && !std::ferror(stdout) && !std::cout.fail()) return;
+  // The write failed earlier (an explicit flush: std::endl, CLI11's --help) and errno is gone: a
+  // write of nothing, which changes nothing, still reports the cause on a device such as /dev/full.
+  if (err == 0 && ::write(STDOUT_FILENO, "", 0) < 0) err = errno;
+  (void)std::fprintf(stderr, "%s: error: stdout: %s\n", gStdoutProg.c_str(),
+                     err != 0 ? std::strerror(err) : "write error");
+  std::_Exit(kExitIo);  // not exit(): the handlers still to run could write to stdout again
+}
+
+}  // namespace
+
+void checkStdoutAtExit(std::string_view prog) {
+  static const bool registered = [] {
+    // A report that fits the buffer (64 KiB rather than stdio's 4 KiB; not on a terminal, which
+    // stays line-buffered) is written at exit, so the check still knows the cause (errno); a larger
+    // one that fails earlier is reported as "write error".
+    if (::isatty(STDOUT_FILENO) == 0) (void)std::setvbuf(stdout, nullptr, _IOFBF, std::size_t{1} << 16);
+    return std::atexit(stdoutExitCheck) == 0;
+  }();
+  (void)registered;
+  gStdoutProg = std::string(prog);
+}
+
 std::optional<int> parse(CLI::App& app, std::string_view prog, int argc, char** argv) {
+  checkStdoutAtExit(prog);
   // A write beyond RLIMIT_FSIZE (ulimit -f) raises SIGXFSZ, whose default action kills the process
   // and leaves its temporary file behind. Ignored, the write fails with EFBIG instead and the tool
   // reports it like a full disk: exit 2, the temporary removed, the destination untouched.

@@ -87,7 +87,21 @@ void addCommonOptions(CLI::App& app, std::string_view prog, CommonOptions& optio
 // parse error (printed to stderr as a diagnostic, with a hint to run --help).
 // It also ignores SIGXFSZ, so that a file growing past RLIMIT_FSIZE (ulimit -f) makes write() fail
 // with EFBIG, reported like a full disk (exit 2, no partial file), instead of killing the tool.
+// And it installs checkStdoutAtExit(prog) (once per process, before parsing, so --help and --version
+// are covered too).
 std::optional<int> parse(CLI::App& app, std::string_view prog, int argc, char** argv);
+
+// Registers (std::atexit, once per process; later calls only change `prog`) a check that runs when
+// the tool returns from main or calls std::exit: it flushes std::cout and stdout and, when either
+// could not be written at any point (a full disk, /dev/full, an I/O error), prints
+// "PROG: error: stdout: No space left on device" (the cause from errno, or "write error") to stderr
+// and ends the process with kExitIo, whatever main returned (the coreutils close_stdout rule: a
+// report that did not arrive is a failure). Output files written with writeFileAtomic are complete
+// by then; only the report on stdout was lost. A closed pipe still ends the tool with SIGPIPE, as
+// for any Unix filter. When stdout is not a terminal its buffer becomes 64 KiB, so that a report up
+// to that size fails at exit with its cause known. Called by parse() before anything is printed; a
+// tool that does not use parse() calls it itself, first.
+void checkStdoutAtExit(std::string_view prog);
 
 // ---- Formatting ---------------------------------------------------------------------------------
 // "17309696 bytes (16.508 MiB)": the exact count and MiB (2^20 bytes) with three decimals.
