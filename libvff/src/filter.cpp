@@ -101,37 +101,40 @@ std::vector<uint8_t> applyFilter(Filter filter, const BlockShape& shape, std::sp
   return out;
 }
 
-Status unapplyFilter(Filter filter, const BlockShape& shape, std::span<const uint8_t> filtered,
-                     std::span<uint8_t> raw, Code failCode) {
-  if (filter == Filter::kNone) {
-    if (filtered.size() != raw.size())
-      return makeError(failCode, "unfiltered size " + std::to_string(filtered.size()) + " differs from raw size " +
-                                     std::to_string(raw.size()));
-    if (!raw.empty()) std::memcpy(raw.data(), filtered.data(), raw.size());
-    return {};
-  }
-  if (filter != Filter::kHitsMed) return makeError(failCode, "unknown filter " + std::to_string(unsigned(filter)));
+namespace {
+
+// Checks what a hits-med stream must hold before any texel is decoded (spec/format.md, filter 1): the
+// whole mask, no mask bit past the last texel, and exactly one residual per hit. Sets *nMask.
+Status checkHitsMed(const BlockShape& shape, std::span<const uint8_t> filtered, uint64_t texels, Code failCode,
+                    uint64_t* nMask) {
   const uint32_t M = shape.mapResolution;
   const uint64_t mapTexels = uint64_t(M) * M;
-  const uint64_t texels = raw.size();
   if (M == 0 || texels % mapTexels != 0) return makeError(failCode, "block is not a whole number of maps");
-  const uint64_t nMask = maskBytes(texels);
-  if (filtered.size() < nMask)
+  *nMask = maskBytes(texels);
+  if (filtered.size() < *nMask)
     return makeError(failCode, "hits-med stream of " + std::to_string(filtered.size()) + " bytes is shorter than its " +
-                                   std::to_string(nMask) + "-byte hit mask");
+                                   std::to_string(*nMask) + "-byte hit mask");
   const uint8_t* mask = filtered.data();
   uint64_t hits = 0;
-  for (uint64_t i = 0; i < nMask; i += 8) hits += uint64_t(popcount64(loadBits(mask, nMask, i * 8, 64)));
-  if (texels % 8 != 0 && (mask[nMask - 1] >> (texels % 8)) != 0)
+  for (uint64_t i = 0; i < *nMask; i += 8) hits += uint64_t(popcount64(loadBits(mask, *nMask, i * 8, 64)));
+  if (texels % 8 != 0 && (mask[*nMask - 1] >> (texels % 8)) != 0)
     return makeError(failCode, "hits-med mask has bits set past the block's last texel");
-  if (filtered.size() != nMask + hits)
-    return makeError(failCode, "hits-med stream holds " + std::to_string(filtered.size() - nMask) +
+  if (filtered.size() != *nMask + hits)
+    return makeError(failCode, "hits-med stream holds " + std::to_string(filtered.size() - *nMask) +
                                    " residuals for " + std::to_string(hits) + " hits");
+  return {};
+}
+
+// Decodes the maps from `firstMap` on of a checked stream, texel by texel; `res` is the residual of
+// the first hit of map `firstMap`.
+Status unapplyHitsMedMaps(std::span<const uint8_t> filtered, uint64_t nMask, const uint8_t* res, uint32_t M,
+                          uint64_t firstMap, std::span<uint8_t> raw, Code failCode) {
+  const uint8_t* mask = filtered.data();
+  const uint64_t mapTexels = uint64_t(M) * M;
   // Row by row: the row is filled with the miss code, then only the hits (the set mask bits, found
   // 64 at a time) are predicted and written, so misses cost a memset.
-  const uint8_t* res = mask + nMask;
   const std::vector<uint8_t> missRow(M, kMiss8);  // the row above the first
-  for (uint64_t first = 0; first < texels; first += mapTexels) {
+  for (uint64_t first = firstMap * mapTexels; first < raw.size(); first += mapTexels) {
     uint8_t* m = raw.data() + first;
     uint8_t last = 0;
     for (uint32_t y = 0; y < M; ++y) {
@@ -158,6 +161,39 @@ Status unapplyFilter(Filter filter, const BlockShape& shape, std::span<const uin
     }
   }
   return {};
+}
+
+}  // namespace
+
+Status unapplyHitsMedScalar(const BlockShape& shape, std::span<const uint8_t> filtered, std::span<uint8_t> raw,
+                            Code failCode) {
+  uint64_t nMask = 0;
+  if (Status st = checkHitsMed(shape, filtered, raw.size(), failCode, &nMask); !st) return st;
+  return unapplyHitsMedMaps(filtered, nMask, filtered.data() + nMask, shape.mapResolution, 0, raw, failCode);
+}
+
+Status unapplyFilter(Filter filter, const BlockShape& shape, std::span<const uint8_t> filtered,
+                     std::span<uint8_t> raw, Code failCode) {
+  if (filter == Filter::kNone) {
+    if (filtered.size() != raw.size())
+      return makeError(failCode, "unfiltered size " + std::to_string(filtered.size()) + " differs from raw size " +
+                                     std::to_string(raw.size()));
+    if (!raw.empty()) std::memcpy(raw.data(), filtered.data(), raw.size());
+    return {};
+  }
+  if (filter != Filter::kHitsMed) return makeError(failCode, "unknown filter " + std::to_string(unsigned(filter)));
+  uint64_t nMask = 0;
+  if (Status st = checkHitsMed(shape, filtered, raw.size(), failCode, &nMask); !st) return st;
+  const uint32_t M = shape.mapResolution;
+  HitsMedProgress done{0, filtered.data() + nMask};
+#if VFF_HITS_MED_LANES
+  // The maps in whole groups of 16 go through the lanes; the rest, and any group holding a hit that
+  // decodes to the miss code, go through the scalar decoder, which names the bad texel.
+  if (M % kHitsMedLanes == 0)
+    done = unapplyHitsMedLanes(filtered, done.residuals, M, raw.size() / (uint64_t(M) * M), raw.data(),
+                               hitsMedLanesSsse3());
+#endif
+  return unapplyHitsMedMaps(filtered, nMask, done.residuals, M, done.maps, raw, failCode);
 }
 
 }  // namespace vff::detail

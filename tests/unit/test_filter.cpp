@@ -6,8 +6,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <vector>
 
+#include "../../libvff/src/filter.h"  // private: the decoder's fast path against its scalar reference
 #include "test_util.h"
 #include "vff/vff.h"
 
@@ -161,6 +163,180 @@ TEST(HitsMed, WriterRefusesMisuse) {
     ASSERT_FALSE(w) << distanceEncodingName(e);
     EXPECT_EQ(w.error().code, Code::kInvalidArgument);
     EXPECT_NE(w.error().message.find(distanceEncodingName(e)), std::string::npos) << w.error().message;
+  }
+}
+
+// A block of `maps` maps of m x m codes as the decoder meets them: maps with no hit, maps of hits only,
+// and maps of smooth codes (so that every case of the prediction occurs) in regions and speckles of
+// misses; now and then a code at the ends of the range, where the residual sums wrap.
+std::vector<uint8_t> randomBlock(std::mt19937& rng, uint32_t m, uint32_t maps) {
+  std::vector<uint8_t> raw(uint64_t(maps) * m * m);
+  for (uint32_t k = 0; k < maps; ++k) {
+    const uint32_t kind = uint32_t(rng()) % 6;  // 0: all misses, 1: all hits, else a mix
+    const double cx = double(uint32_t(rng()) % 100) / 100, cy = double(uint32_t(rng()) % 100) / 100,
+                 r2 = double(uint32_t(rng()) % 60) / 100;
+    const int base = int(uint32_t(rng()) % 200), slope = int(uint32_t(rng()) % 9) - 4;
+    const uint32_t speckle = uint32_t(rng()) % 4;
+    for (uint32_t y = 0; y < m; ++y)
+      for (uint32_t x = 0; x < m; ++x) {
+        const double u = (x + 0.5) / m - cx, v = (y + 0.5) / m - cy;
+        bool hit = kind == 1 || (kind != 0 && u * u + v * v < r2);
+        if (kind > 1 && speckle && uint32_t(rng()) % (8 * speckle) == 0) hit = !hit;
+        int code = base + slope * int(x) - slope * int(y) / 2 + int(uint32_t(rng()) % 3);
+        if (uint32_t(rng()) % 50 == 0) code = uint32_t(rng()) % 2 ? 0 : 254;
+        raw[(uint64_t(k) * m + y) * m + x] = hit ? uint8_t(std::clamp(code, 0, 254)) : uint8_t(255);
+      }
+  }
+  return raw;
+}
+
+Status decodeFast(uint32_t m, const std::vector<uint8_t>& stream, std::vector<uint8_t>& raw) {
+  return detail::unapplyFilter(Filter::kHitsMed, {m, 1}, stream, raw, Code::kBlockDecode);
+}
+
+Status decodeScalar(uint32_t m, const std::vector<uint8_t>& stream, std::vector<uint8_t>& raw) {
+  return detail::unapplyHitsMedScalar({m, 1}, stream, raw, Code::kBlockDecode);
+}
+
+// Both decoders agree: the same maps, or the same error (code and message).
+void expectSameDecode(uint32_t m, const std::vector<uint8_t>& stream, size_t rawSize, const std::string& what) {
+  std::vector<uint8_t> fast(rawSize, 0x5A), scalar(rawSize, 0xA5);
+  const Status a = decodeFast(m, stream, fast), b = decodeScalar(m, stream, scalar);
+  ASSERT_EQ(bool(a), bool(b)) << what << ": " << (a ? b.error().toString() : a.error().toString());
+  if (a) {
+    EXPECT_EQ(fast, scalar) << what;
+  } else {
+    EXPECT_EQ(a.error().code, b.error().code) << what;
+    EXPECT_EQ(a.error().message, b.error().message) << what;
+  }
+}
+
+const uint32_t kResolutions[] = {1, 3, 8, 16, 17, 32, 48, 64, 80, 128};
+
+TEST(HitsMed, FastDecoderMatchesTheScalarOneOnRandomBlocks) {
+  std::mt19937 rng(20240611);
+  for (int round = 0; round < 120; ++round) {
+    const uint32_t m = kResolutions[uint32_t(rng()) % std::size(kResolutions)];
+    const uint32_t maps = 1 + uint32_t(rng()) % (m >= 64 ? 40 : 70);  // often not a multiple of 16
+    const auto raw = randomBlock(rng, m, maps);
+    const auto stream = detail::applyFilter(Filter::kHitsMed, {m, 1}, raw);
+    const std::string what =
+        "M " + std::to_string(m) + ", " + std::to_string(maps) + " maps, round " + std::to_string(round);
+    std::vector<uint8_t> out(raw.size());
+    const Status st = decodeFast(m, stream, out);
+    ASSERT_TRUE(st) << what << ": " << st.error().toString();
+    EXPECT_EQ(out, raw) << what;
+    expectSameDecode(m, stream, raw.size(), what);
+  }
+}
+
+#if VFF_HITS_MED_LANES
+TEST(HitsMed, LanesDecodeWholeGroupsWithAndWithoutSsse3) {
+  // unapplyFilter uses one way on this processor; both are checked here, on the groups they decode.
+  std::mt19937 rng(5);
+  for (bool ssse3 : {false, true}) {
+    if (ssse3 && !detail::hitsMedLanesSsse3()) continue;
+    for (int round = 0; round < 40; ++round) {
+      const uint32_t m = 16 * (1 + uint32_t(rng()) % 8);
+      const uint32_t maps = 1 + uint32_t(rng()) % 50;
+      const auto raw = randomBlock(rng, m, maps);
+      const auto stream = detail::applyFilter(Filter::kHitsMed, {m, 1}, raw);
+      const uint64_t nMask = (raw.size() + 7) / 8;
+      std::vector<uint8_t> out(raw.size(), 0x5A);
+      const auto done = detail::unapplyHitsMedLanes(stream, stream.data() + nMask, m, maps, out.data(), ssse3);
+      const uint64_t whole = maps / 16 * 16, groupTexels = whole * m * m;
+      const std::string what =
+          std::string(ssse3 ? "SSSE3" : "SSE2") + ", M " + std::to_string(m) + ", " + std::to_string(maps) + " maps";
+      EXPECT_EQ(done.maps, whole) << what;
+      EXPECT_EQ(done.residuals - stream.data(),
+                ptrdiff_t(nMask + std::count_if(raw.begin(), raw.begin() + ptrdiff_t(groupTexels),
+                                                [](uint8_t v) { return v != 255; })))
+          << what;
+      EXPECT_TRUE(std::equal(out.begin(), out.begin() + ptrdiff_t(groupTexels), raw.begin())) << what;
+      EXPECT_TRUE(std::all_of(out.begin() + ptrdiff_t(groupTexels), out.end(), [](uint8_t v) { return v == 0x5A; }))
+          << what;
+      // A hit made to decode to the miss code: they stop before its group.
+      if (done.maps == 0 || stream.size() == nMask) continue;
+      auto bad = stream;
+      const uint64_t at = nMask + uint32_t(rng()) % (done.residuals - stream.data() - nMask);
+      std::vector<uint8_t> scalar(raw.size());
+      for (bad[at] = 0; detail::unapplyHitsMedScalar({m, 1}, bad, scalar, Code::kBlockDecode); ++bad[at]) {
+      }
+      const std::string message = detail::unapplyHitsMedScalar({m, 1}, bad, scalar, Code::kBlockDecode).error().message;
+      const uint64_t texel = std::stoull(message.substr(message.find("texel ") + 6));
+      const auto stopped = detail::unapplyHitsMedLanes(bad, bad.data() + nMask, m, maps, out.data(), ssse3);
+      EXPECT_EQ(stopped.maps, texel / (uint64_t(m) * m) / 16 * 16) << what << ": " << message;
+    }
+  }
+}
+#endif
+
+TEST(HitsMed, FastDecoderMatchesTheScalarOneOnCorruptStreams) {
+  std::mt19937 rng(7);
+  for (int round = 0; round < 200; ++round) {
+    const uint32_t m = kResolutions[uint32_t(rng()) % std::size(kResolutions)];
+    const uint32_t maps = 1 + uint32_t(rng()) % 40;
+    const auto raw = randomBlock(rng, m, maps);
+    auto stream = detail::applyFilter(Filter::kHitsMed, {m, 1}, raw);
+    const uint64_t nMask = (raw.size() + 7) / 8;
+    const std::string what =
+        "M " + std::to_string(m) + ", " + std::to_string(maps) + " maps, round " + std::to_string(round);
+    switch (round % 4) {
+      case 0:  // residuals changed at random: hits that decode to the miss code, in any map
+        for (uint32_t n = 1 + uint32_t(rng()) % 4; n && stream.size() > nMask; --n)
+          stream[nMask + uint32_t(rng()) % (stream.size() - nMask)] = uint8_t(uint32_t(rng()));
+        break;
+      case 1:  // one hit made to decode to the miss code: the residual that adds 1 to a hit at 254
+        if (stream.size() > nMask)
+          stream[nMask + uint32_t(rng()) % (stream.size() - nMask)] += uint8_t(1 + uint32_t(rng()) % 255);
+        break;
+      case 2:  // a mask bit flipped: the residual count no longer matches
+        stream[uint32_t(rng()) % nMask] ^= uint8_t(1u << (uint32_t(rng()) % 8));
+        break;
+      default:  // cut short, or a byte too many
+        if (uint32_t(rng()) % 2)
+          stream.resize(uint32_t(rng()) % stream.size());
+        else
+          stream.push_back(0);
+    }
+    expectSameDecode(m, stream, raw.size(), what);
+  }
+}
+
+TEST(HitsMed, FastDecoderReportsTheFirstBadHitOfTheBlock) {
+  // Residuals that make a hit of each later map decode to 255: the error names the first one, in a
+  // group of 16 maps or in the maps after the last whole group.
+  std::mt19937 rng(3);
+  for (uint32_t maps : {16u, 35u}) {
+    const auto raw = randomBlock(rng, 64, maps);
+    const auto clean = detail::applyFilter(Filter::kHitsMed, {64, 1}, raw);
+    const uint64_t nMask = (raw.size() + 7) / 8;
+    for (uint64_t at = nMask; at < clean.size(); at += 1 + uint32_t(rng()) % 3000) {
+      auto stream = clean;
+      for (uint64_t j = at; j < stream.size(); j += 997) stream[j] = uint8_t(stream[j] + 1 + uint32_t(rng()) % 255);
+      expectSameDecode(64, stream, raw.size(),
+                       "M 64, " + std::to_string(maps) + " maps, residual " + std::to_string(at));
+    }
+  }
+}
+
+TEST(HitsMed, FastDecoderOnRandomStreams) {
+  // Masks and residuals that no writer made: both decoders still agree, hit for hit.
+  std::mt19937 rng(11);
+  for (int round = 0; round < 100; ++round) {
+    const uint32_t m = kResolutions[uint32_t(rng()) % std::size(kResolutions)];
+    const uint32_t maps = 1 + uint32_t(rng()) % 40;
+    const uint64_t texels = uint64_t(maps) * m * m;
+    std::vector<uint8_t> stream((texels + 7) / 8);
+    const uint32_t density = uint32_t(rng()) % 9;  // 0: no hit ... 8: all hits
+    uint64_t hits = 0;
+    for (uint64_t t = 0; t < texels; ++t)
+      if (uint32_t(rng()) % 8 < density) stream[t / 8] |= uint8_t(1u << (t % 8)), ++hits;
+    // Small residuals mostly, so that most streams decode; now and then any byte.
+    for (uint64_t h = 0; h < hits; ++h)
+      stream.push_back(uint32_t(rng()) % 64 ? uint8_t(uint32_t(rng()) % 5 - 2) : uint8_t(uint32_t(rng())));
+    expectSameDecode(m, stream, texels,
+                     "M " + std::to_string(m) + ", " + std::to_string(maps) + " maps, round " + std::to_string(round));
   }
 }
 

@@ -1,0 +1,248 @@
+// filter_simd.cpp - the hits-med decoder for 16 maps at once, one map per byte lane of SSE2 vectors.
+//
+// Why: each map decodes as one serial chain (a hit's prediction needs the hit just decoded to its
+// left and the map's previous hit), so the scalar decoder runs at the latency of that chain and
+// mispredicts a branch at every hit/miss edge. The maps of a block are independent, so here lane i
+// carries map i of a group of 16: the chain is walked once per texel position for all 16 maps,
+// without branches, misses costing as much as hits. The result is exactly the scalar decoder's
+// (filter.cpp, unapplyHitsMedScalar), which tests/unit/test_filter.cpp checks on random blocks.
+//
+// Per row y of the group:
+//   1. each lane's residuals of the row are put at the x of its hits, in the transposed layout (one
+//      vector per x). Each map's residuals lie contiguous in the stream, map after map, so a lane
+//      starts where the previous lane's map ends. With SSSE3 (nearly every x86-64 processor, checked
+//      at run time), PSHUFB spreads them 8 texels at a time; with SSE2 alone, a scalar store per hit
+//      (the lanes then take a quarter longer on the bunny: the per-hit loops' exits mispredict);
+//   2. x walks the row 16 texels at a time: MED prediction from a (left), b (up) and c (up-left),
+//      255 standing for a miss or a texel outside the map as in the spec, + residual, 255 where the
+//      mask has a miss; the 16 result vectors are transposed back into 16 map rows and stored.
+// The row above lives transposed (one vector per x) in `above`, which the walk overwrites in place.
+#include "filter.h"
+
+#if VFF_HITS_MED_LANES
+
+#include <emmintrin.h>  // SSE2
+#include <tmmintrin.h>  // SSSE3, behind a run-time check
+
+#include <bit>
+#include <cstring>
+#include <vector>
+
+namespace vff::detail {
+
+namespace {
+
+// Hits in `n` mask bytes (n a multiple of 16): a population count per byte, summed by PSADBW.
+uint64_t countHits(const uint8_t* mask, uint64_t n) noexcept {
+  const __m128i m1 = _mm_set1_epi8(0x55), m2 = _mm_set1_epi8(0x33), m4 = _mm_set1_epi8(0x0F);
+  __m128i sum = _mm_setzero_si128();
+  for (uint64_t i = 0; i < n; i += 16) {
+    __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(mask + i));
+    v = _mm_sub_epi8(v, _mm_and_si128(_mm_srli_epi16(v, 1), m1));
+    v = _mm_add_epi8(_mm_and_si128(v, m2), _mm_and_si128(_mm_srli_epi16(v, 2), m2));
+    v = _mm_and_si128(_mm_add_epi8(v, _mm_srli_epi16(v, 4)), m4);
+    sum = _mm_add_epi64(sum, _mm_sad_epu8(v, _mm_setzero_si128()));
+  }
+  return uint64_t(_mm_cvtsi128_si64(sum)) + uint64_t(_mm_cvtsi128_si64(_mm_unpackhi_epi64(sum, sum)));
+}
+
+// Transposes a 16 x 16 byte matrix (v[i] byte j becomes v[j] byte i). Each round interleaves row i
+// with row i + 8, which rotates the 8-bit (row, byte) index left by one; four rounds swap its halves.
+inline void transpose16(__m128i v[16]) noexcept {
+  for (int round = 0; round < 4; ++round) {
+    __m128i t[16];
+    for (int i = 0; i < 8; ++i) {
+      t[2 * i] = _mm_unpacklo_epi8(v[i], v[i + 8]);
+      t[2 * i + 1] = _mm_unpackhi_epi8(v[i], v[i + 8]);
+    }
+    for (int i = 0; i < 16; ++i) v[i] = t[i];
+  }
+}
+
+inline __m128i select(__m128i mask, __m128i yes, __m128i no) noexcept {
+  return _mm_or_si128(_mm_and_si128(mask, yes), _mm_andnot_si128(mask, no));
+}
+
+// The mask bits of x .. x + 63 of a row (x + 64 <= M) or x .. M - 1 (fewer when M is not a
+// multiple of 64; rows start on a byte, M being a multiple of 16, and end on one).
+inline uint64_t rowBits(const uint8_t* row, uint32_t x, uint32_t M) noexcept {
+  uint64_t bits = 0;
+  std::memcpy(&bits, row + x / 8, M - x >= 64 ? 8 : (M - x) / 8);  // little-endian, as le.h assumes
+  return bits;
+}
+
+// One row of a group: each lane's mask bits and next residual.
+struct GroupRow {
+  const uint8_t* mask[kHitsMedLanes];  // lane i's mask bits of the row
+  const uint8_t* res[kHitsMedLanes];   // lane i's next residual; advanced past the row's
+  const uint8_t* end;                  // the end of the stream
+  uint32_t M;
+};
+
+// Puts each lane's residuals of the row at the x of its hits (resT[x] byte i; the bytes at misses
+// are left as they were). Two ways: a scalar store per hit (SSE2), or PSHUFB (SSSE3).
+using ExpandResiduals = void (*)(GroupRow& row, uint8_t* scratch, __m128i* resT);
+
+void scatterResiduals(GroupRow& row, uint8_t* /*scratch*/, __m128i* resT) {
+  uint8_t* out = reinterpret_cast<uint8_t*>(resT);
+  for (uint32_t i = 0; i < kHitsMedLanes; ++i) {
+    const uint8_t* r = row.res[i];
+    // A whole 64-bit word per loop keeps the mispredicted loop exits to one per 64 texels.
+    for (uint32_t x0 = 0; x0 < row.M; x0 += 64)
+      for (uint64_t b = rowBits(row.mask[i], x0, row.M); b; b &= b - 1)
+        out[(x0 + uint32_t(std::countr_zero(b))) * 16 + i] = *r++;
+    row.res[i] = r;
+  }
+}
+
+// For each mask byte, the PSHUFB control that spreads the next residuals over its hits (0x80, a
+// zero, at its misses), and how many residuals it takes.
+struct SpreadTable {
+  uint8_t shuffle[256][8];
+  uint8_t count[256];
+};
+constexpr SpreadTable makeSpreadTable() {
+  SpreadTable t{};
+  for (uint32_t m = 0; m < 256; ++m) {
+    uint8_t k = 0;
+    for (uint32_t j = 0; j < 8; ++j) t.shuffle[m][j] = (m >> j) & 1 ? k++ : 0x80;
+    t.count[m] = k;
+  }
+  return t;
+}
+constexpr SpreadTable kSpread = makeSpreadTable();
+
+// Each lane's row spread 8 texels at a time into `scratch` (16 rows of M bytes, then M + 8 for a
+// row's residuals at the end of the stream), then transposed: no branch per hit, and 8 texels for a
+// few instructions.
+__attribute__((target("ssse3"))) void shuffleResiduals(GroupRow& row, uint8_t* scratch, __m128i* resT) {
+  const uint32_t M = row.M;
+  for (uint32_t i = 0; i < kHitsMedLanes; ++i) {
+    // A row takes at most M residuals, so each 8-byte load stays inside the row's M bytes; near the
+    // end of the stream those are copied first, so that no load passes it.
+    const uint8_t* r = row.res[i];
+    if (uint64_t(row.end - r) < M) r = static_cast<uint8_t*>(std::memcpy(scratch + 16 * M, r, size_t(row.end - r)));
+    const uint8_t* const from = r;
+    uint8_t* out = scratch + i * M;
+    for (uint32_t k = 0; k < M / 8; ++k) {
+      const uint8_t m = row.mask[i][k];
+      const __m128i v = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(r));
+      const __m128i spread = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(kSpread.shuffle[m]));
+      _mm_storel_epi64(reinterpret_cast<__m128i*>(out + 8 * k), _mm_shuffle_epi8(v, spread));
+      r += kSpread.count[m];
+    }
+    row.res[i] += r - from;
+  }
+  for (uint32_t x0 = 0; x0 < M; x0 += 16) {
+    __m128i t[16];
+    for (uint32_t i = 0; i < kHitsMedLanes; ++i)
+      t[i] = _mm_loadu_si128(reinterpret_cast<const __m128i*>(scratch + i * M + x0));
+    transpose16(t);
+    for (uint32_t x = 0; x < 16; ++x) resT[x0 + x] = t[x];
+  }
+}
+
+// Decodes maps first .. first + 15 (lane i: map first + i), whose residuals start at start[i].
+// `above` holds M + 1 vectors, `resT` M, `bits` M uint16, `scratch` 17 M + 8 bytes. False when a hit
+// decoded to the miss code (the output is then incomplete).
+bool decodeGroup(ExpandResiduals expand, const uint8_t* mask, const uint8_t* const start[kHitsMedLanes],
+                 const uint8_t* end, uint32_t M, uint64_t first, uint8_t* raw, __m128i* above, __m128i* resT,
+                 uint16_t* bits, uint8_t* scratch) {
+  const uint64_t mapTexels = uint64_t(M) * M;
+  const __m128i miss = _mm_set1_epi8(-1), zero = _mm_setzero_si128();
+  GroupRow row;
+  row.end = end;
+  row.M = M;
+  for (uint32_t i = 0; i < kHitsMedLanes; ++i) row.res[i] = start[i];
+  for (uint32_t x = 0; x <= M; ++x) above[x] = miss;  // above[0] is x = -1; the row above the first
+  __m128i last = zero, bad = zero;
+  for (uint32_t y = 0; y < M; ++y) {
+    // 1. Each lane's row of mask bits, kept 16 at a time (bits[16 * tile + lane]), and its residuals
+    //    at their x.
+    for (uint32_t i = 0; i < kHitsMedLanes; ++i) {
+      row.mask[i] = mask + ((first + i) * mapTexels + uint64_t(y) * M) / 8;
+      for (uint32_t t = 0; t < M / 16; ++t) std::memcpy(&bits[t * 16 + i], row.mask[i] + 2 * t, 2);
+    }
+    expand(row, scratch, resT);
+    // 2. The walk along x (predict() in filter.cpp for 16 maps, with compare masks for its branches),
+    //    16 texels at a time, and 3. their transposition back into map rows.
+    __m128i a = miss, c = miss;
+    for (uint32_t x0 = 0; x0 < M; x0 += 16) {
+      // The tile's mask bits as bytes, lane i in byte i: x 0..7 in lo, 8..15 in hi (the words are
+      // < 256 after masking or shifting, so the saturating pack keeps them).
+      const __m128i w0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(bits + x0));
+      const __m128i w1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(bits + x0 + 8));
+      const __m128i low = _mm_set1_epi16(0xFF);
+      const __m128i lo = _mm_packus_epi16(_mm_and_si128(w0, low), _mm_and_si128(w1, low));
+      const __m128i hi = _mm_packus_epi16(_mm_srli_epi16(w0, 8), _mm_srli_epi16(w1, 8));
+      __m128i* out = above + x0 + 1;
+#pragma GCC unroll 16
+      for (int x = 0; x < 16; ++x) {
+        const __m128i bit = _mm_set1_epi8(char(1 << (x & 7)));
+        const __m128i isMiss = _mm_cmpeq_epi8(_mm_and_si128(x < 8 ? lo : hi, bit), zero);
+        const __m128i b = out[x];
+        const __m128i mx = _mm_max_epu8(a, b), mn = _mm_min_epu8(a, b);
+        // a and b hits: MED, a + b - c clamped to [min, max], which is min + max - (c clamped to
+        // [min, max]) and so needs no more than 8 bits. Without c it is floor((a + b) / 2), which
+        // is what MED gives for c = ceil((a + b) / 2), PAVGB's rounding.
+        const __m128i cMiss = _mm_cmpeq_epi8(c, miss);
+        const __m128i c2 = select(cMiss, _mm_avg_epu8(a, b), c);
+        const __m128i med = _mm_sub_epi8(_mm_add_epi8(mx, mn), _mm_min_epu8(_mm_max_epu8(c2, mn), mx));
+        // 255 is the largest code, so max(a, b) is 255 when either is missing and min(a, b) when
+        // both are; with exactly one missing, min(a, b) is the other one, the prediction. With
+        // neither: c, else the map's previous hit.
+        const __m128i single = select(_mm_cmpeq_epi8(mn, miss), select(cMiss, last, c), mn);
+        const __m128i p = select(_mm_cmpeq_epi8(mx, miss), single, med);
+        const __m128i v = _mm_add_epi8(p, resT[x0 + x]);
+        const __m128i hit = _mm_andnot_si128(isMiss, v);  // v at the hits, 0 at the misses
+        bad = _mm_max_epu8(bad, hit);                     // 255 once a hit decodes to the miss code
+        last = _mm_or_si128(hit, _mm_and_si128(isMiss, last));
+        a = _mm_or_si128(v, isMiss);  // the miss code where the mask has a miss
+        c = b;
+        out[x] = a;
+      }
+      __m128i rows[16];
+      for (int x = 0; x < 16; ++x) rows[x] = out[x];
+      transpose16(rows);
+      for (uint32_t i = 0; i < kHitsMedLanes; ++i)
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(raw + (first + i) * mapTexels + uint64_t(y) * M + x0), rows[i]);
+    }
+  }
+  return _mm_movemask_epi8(_mm_cmpeq_epi8(bad, miss)) == 0;
+}
+
+}  // namespace
+
+bool hitsMedLanesSsse3() noexcept {
+  static const bool has = __builtin_cpu_supports("ssse3");
+  return has;
+}
+
+HitsMedProgress unapplyHitsMedLanes(std::span<const uint8_t> filtered, const uint8_t* residuals, uint32_t M,
+                                    uint64_t mapCount, uint8_t* raw, bool ssse3) {
+  const ExpandResiduals expand = ssse3 ? shuffleResiduals : scatterResiduals;
+  const uint8_t* mask = filtered.data();
+  const uint64_t mapMaskBytes = uint64_t(M) * M / 8;  // a multiple of 32: maps start on a byte
+  struct alignas(16) Vec {  // storage for __m128i (which a std::vector would lose the attributes of)
+    uint8_t bytes[16];
+  };
+  std::vector<Vec> above(M + 1), resT(M);
+  std::vector<uint16_t> bits(M);
+  std::vector<uint8_t> scratch(17 * uint64_t(M) + 8);
+  HitsMedProgress done{0, residuals};
+  for (; done.maps + kHitsMedLanes <= mapCount; done.maps += kHitsMedLanes) {
+    const uint8_t* start[kHitsMedLanes + 1] = {done.residuals};
+    for (uint32_t i = 0; i < kHitsMedLanes; ++i)
+      start[i + 1] = start[i] + countHits(mask + (done.maps + i) * mapMaskBytes, mapMaskBytes);
+    if (!decodeGroup(expand, mask, start, filtered.data() + filtered.size(), M, done.maps, raw,
+                     reinterpret_cast<__m128i*>(above.data()), reinterpret_cast<__m128i*>(resT.data()), bits.data(),
+                     scratch.data()))
+      break;
+    done.residuals = start[kHitsMedLanes];
+  }
+  return done;
+}
+
+}  // namespace vff::detail
+
+#endif
