@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "codec.h"
+#include "vff/reader.h"
 #include "le.h"
 
 namespace vff {
@@ -464,8 +465,15 @@ Result<std::unique_ptr<Writer::Impl>> prepare(const FieldDesc& field, const Writ
     ps.mapBytes = mapBytes[p];
     uint64_t g = options.mapsPerBlock ? options.mapsPerBlock : std::max<uint64_t>(1, (256u << 10) / mapBytes[p]);
     g = std::min<uint64_t>(g, field.mapCount);
-    if (g * mapBytes[p] > 0xFFFFFFFFull)
-      return makeError(Code::kInvalidArgument, "mapsPerBlock x map size exceeds 4 GiB per block");
+    // A block of several maps stays within what a reader accepts by default (one map is always
+    // allowed: the largest, 4096^2 normals, is exactly the limit), so the writer never makes a file
+    // that its own reader refuses with decoded-limit (5011).
+    const uint64_t readerLimit = ReadOptions{}.maxBlockBytes;
+    if (g > 1 && g * mapBytes[p] > readerLimit)
+      return makeError(Code::kInvalidArgument, "mapsPerBlock " + std::to_string(g) + " x " + std::to_string(mapBytes[p]) +
+                                                   "-byte maps gives blocks of " + std::to_string(g * mapBytes[p]) +
+                                                   " bytes, above the " + std::to_string(readerLimit) +
+                                                   " bytes a reader accepts by default (ReadOptions::maxBlockBytes)");
     ps.g = uint32_t(g);
     ps.blockCount = uint32_t((uint64_t(field.mapCount) + g - 1) / g);
   }

@@ -212,6 +212,20 @@ TEST(Writer, RejectsMisuse) {
   EXPECT_EQ(Writer::createInMemory(f, wo).error().code, Code::kMetadataNotObject);
 }
 
+TEST(Writer, RefusesBlocksADefaultReaderRefuses) {
+  // 1024^2 normals are 4 MiB a map: 16 maps a block are exactly ReadOptions::maxBlockBytes.
+  FieldDesc f = smallField(DistanceEncoding::kUnorm8Diameter, NormalEncoding::kOctSnorm16, 3, 1024);
+  ASSERT_GE(f.mapCount, 17u);
+  WriteOptions wo;
+  wo.mapsPerBlock = 16;
+  EXPECT_TRUE(Writer::createInMemory(f, wo).ok());
+  wo.mapsPerBlock = 17;
+  auto w = Writer::createInMemory(f, wo);
+  ASSERT_FALSE(w.ok());
+  EXPECT_EQ(w.error().code, Code::kInvalidArgument);
+  EXPECT_NE(w.error().message.find("ReadOptions::maxBlockBytes"), std::string::npos) << w.error().message;
+}
+
 TEST(Reader, LimitsRejectBeforeAllocating) {
   FieldDesc f = smallField(DistanceEncoding::kUnorm8Diameter, NormalEncoding::kNone, 2, 8);
   auto bytes = writeMemory(f, syntheticDistance(f));

@@ -26,7 +26,9 @@ namespace vff {
 struct WriteOptions {
   Codec codec = Codec::kStored;  // block codec of both planes
   int zstdLevel = 19;            // 1..22, used when codec is kZstd
-  uint32_t mapsPerBlock = 0;     // G; 0 picks the largest G with G * mapBytes <= 256 KiB (>= 1)
+  // G; 0 picks the largest G with G * mapBytes <= 256 KiB (>= 1). A G > 1 whose blocks exceed
+  // ReadOptions::maxBlockBytes (64 MiB), which default readers refuse, is kInvalidArgument.
+  uint32_t mapsPerBlock = 0;
   // Filter tried on every distance block before the codec (spec/format.md section 4): each block is
   // compressed with and without it and the smaller is kept (a tie keeps the plain block). kHitsMed
   // needs codec kZstd and an 8-bit distance encoding (else kInvalidArgument); a file that uses it is
