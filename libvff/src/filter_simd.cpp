@@ -59,10 +59,6 @@ inline void transpose16(__m128i v[16]) noexcept {
   }
 }
 
-inline __m128i select(__m128i mask, __m128i yes, __m128i no) noexcept {
-  return _mm_or_si128(_mm_and_si128(mask, yes), _mm_andnot_si128(mask, no));
-}
-
 // The mask bits of x .. x + 63 of a row (x + 64 <= M) or x .. M - 1 (fewer when M is not a
 // multiple of 64; rows start on a byte, M being a multiple of 16, and end on one).
 inline uint64_t rowBits(const uint8_t* row, uint32_t x, uint32_t M) noexcept {
@@ -143,11 +139,12 @@ __attribute__((target("ssse3"))) void shuffleResiduals(GroupRow& row, uint8_t* s
 }
 
 // Decodes maps first .. first + 15 (lane i: map first + i), whose residuals start at start[i].
-// `above` holds M + 1 vectors, `resT` M, `bits` M uint16, `scratch` 17 M + 8 bytes. False when a hit
-// decoded to the miss code (the output is then incomplete).
+// `above` holds M + 1 vectors, `resT` M, `scratch` 17 M + 8 bytes. False when a hit decoded to the
+// miss code (the output is then incomplete): there are then more miss codes in the output than
+// misses in the mask, which is what is checked (counted per tile, out of the walk's registers).
 bool decodeGroup(ExpandResiduals expand, const uint8_t* mask, const uint8_t* const start[kHitsMedLanes],
                  const uint8_t* end, uint32_t M, uint64_t first, uint8_t* raw, __m128i* above, __m128i* resT,
-                 uint16_t* bits, uint8_t* scratch) {
+                 uint8_t* scratch) {
   const uint64_t mapTexels = uint64_t(M) * M;
   const __m128i miss = _mm_set1_epi8(-1), zero = _mm_setzero_si128();
   GroupRow row;
@@ -155,23 +152,41 @@ bool decodeGroup(ExpandResiduals expand, const uint8_t* mask, const uint8_t* con
   row.M = M;
   for (uint32_t i = 0; i < kHitsMedLanes; ++i) row.res[i] = start[i];
   for (uint32_t x = 0; x <= M; ++x) above[x] = miss;  // above[0] is x = -1; the row above the first
-  __m128i last = zero, bad = zero;
+  __m128i last = zero, missCount = zero;
   for (uint32_t y = 0; y < M; ++y) {
-    // 1. Each lane's row of mask bits, kept 16 at a time (bits[16 * tile + lane]), and its residuals
-    //    at their x.
-    for (uint32_t i = 0; i < kHitsMedLanes; ++i) {
-      row.mask[i] = mask + ((first + i) * mapTexels + uint64_t(y) * M) / 8;
-      for (uint32_t t = 0; t < M / 16; ++t) std::memcpy(&bits[t * 16 + i], row.mask[i] + 2 * t, 2);
-    }
+    // 1. Each lane's row of mask bits, and its residuals at their x.
+    for (uint32_t i = 0; i < kHitsMedLanes; ++i) row.mask[i] = mask + ((first + i) * mapTexels + uint64_t(y) * M) / 8;
     expand(row, scratch, resT);
     // 2. The walk along x (predict() in filter.cpp for 16 maps, with compare masks for its branches),
     //    16 texels at a time, and 3. their transposition back into map rows.
-    __m128i a = miss, c = miss;
+    //    The walk is one chain per lane (a -> v -> a), so it is written to put as little as possible
+    //    on it; everything that hangs on the mask and the row above is computed beside it. Which
+    //    neighbours are hits is known from the mask (aMiss: the previous texel's isMiss) and the row
+    //    above (bMiss; cMiss, the previous bMiss), not from a. With 255 the code of a miss, every case
+    //    of predict() is a + b - M for one M, v = a + b' + r - M:
+    //      a, b, c hits:           M = median(a, b, c)                      (MED: a + b - median)
+    //      a, b hits, c a miss:    M = ceil((a + b) / 2) = PAVGB(a, b)      (floor((a + b) / 2))
+    //      one of a, b a miss:     M = 255 (so the prediction is the other one)
+    //      a, b misses:            M = 255, b' = c, or the previous hit where c is a miss too
+    //    with b' = b but in the last case. M = min(median(a, b, c'), max(PAVGB(a, b), x1)), where
+    //    c' = 255 unless a and b are hits, and x1 = c (a, b, c hits: the median is no more than
+    //    max(PAVGB, c)), 0 (c a miss: the median of a, b, 255 is max(a, b), PAVGB is less) or 255
+    //    (a or b a miss). The median is max(min(a, max(b, c')), min(b, c')), so a goes through five
+    //    operations (min, max / PAVGB, max; min; sub; or), where predict()'s selects took ten.
+    //    The previous hit: where it counts, the previous texel is a miss, so the value before that
+    //    texel (lastPrev) is the same and keeps `last`'s update off the chain.
+    __m128i a = miss, c = miss, aMiss = miss, cMiss = miss, lastPrev = last;
     for (uint32_t x0 = 0; x0 < M; x0 += 16) {
-      // The tile's mask bits as bytes, lane i in byte i: x 0..7 in lo, 8..15 in hi (the words are
-      // < 256 after masking or shifting, so the saturating pack keeps them).
-      const __m128i w0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(bits + x0));
-      const __m128i w1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(bits + x0 + 8));
+      // The tile's mask bits as bytes, lane i in byte i: x 0..7 in lo, 8..15 in hi (each lane's 16
+      // bits set as a word, then split; the words are < 256 after masking or shifting, so the
+      // saturating pack keeps them). _mm_setr_epi16 rather than a loop of _mm_insert_epi16, whose
+      // index must be a constant (Clang insists even in an unrolled loop).
+      uint16_t u[16];
+      for (int i = 0; i < 16; ++i) std::memcpy(&u[i], row.mask[i] + x0 / 8, 2);
+      const __m128i w0 = _mm_setr_epi16(short(u[0]), short(u[1]), short(u[2]), short(u[3]), short(u[4]),
+                                        short(u[5]), short(u[6]), short(u[7]));
+      const __m128i w1 = _mm_setr_epi16(short(u[8]), short(u[9]), short(u[10]), short(u[11]), short(u[12]),
+                                        short(u[13]), short(u[14]), short(u[15]));
       const __m128i low = _mm_set1_epi16(0xFF);
       const __m128i lo = _mm_packus_epi16(_mm_and_si128(w0, low), _mm_and_si128(w1, low));
       const __m128i hi = _mm_packus_epi16(_mm_srli_epi16(w0, 8), _mm_srli_epi16(w1, 8));
@@ -181,34 +196,37 @@ bool decodeGroup(ExpandResiduals expand, const uint8_t* mask, const uint8_t* con
         const __m128i bit = _mm_set1_epi8(char(1 << (x & 7)));
         const __m128i isMiss = _mm_cmpeq_epi8(_mm_and_si128(x < 8 ? lo : hi, bit), zero);
         const __m128i b = out[x];
-        const __m128i mx = _mm_max_epu8(a, b), mn = _mm_min_epu8(a, b);
-        // a and b hits: MED, a + b - c clamped to [min, max], which is min + max - (c clamped to
-        // [min, max]) and so needs no more than 8 bits. Without c it is floor((a + b) / 2), which
-        // is what MED gives for c = ceil((a + b) / 2), PAVGB's rounding.
-        const __m128i cMiss = _mm_cmpeq_epi8(c, miss);
-        const __m128i c2 = select(cMiss, _mm_avg_epu8(a, b), c);
-        const __m128i med = _mm_sub_epi8(_mm_add_epi8(mx, mn), _mm_min_epu8(_mm_max_epu8(c2, mn), mx));
-        // 255 is the largest code, so max(a, b) is 255 when either is missing and min(a, b) when
-        // both are; with exactly one missing, min(a, b) is the other one, the prediction. With
-        // neither: c, else the map's previous hit.
-        const __m128i single = select(_mm_cmpeq_epi8(mn, miss), select(cMiss, last, c), mn);
-        const __m128i p = select(_mm_cmpeq_epi8(mx, miss), single, med);
-        const __m128i v = _mm_add_epi8(p, resT[x0 + x]);
-        const __m128i hit = _mm_andnot_si128(isMiss, v);  // v at the hits, 0 at the misses
-        bad = _mm_max_epu8(bad, hit);                     // 255 once a hit decodes to the miss code
-        last = _mm_or_si128(hit, _mm_and_si128(isMiss, last));
+        const __m128i bMiss = _mm_cmpeq_epi8(b, miss);
+        const __m128i abMiss = _mm_or_si128(aMiss, bMiss);
+        const __m128i c1 = _mm_or_si128(c, abMiss);
+        const __m128i hiBC = _mm_max_epu8(b, c1), loBC = _mm_min_epu8(b, c1);
+        const __m128i x1 = _mm_andnot_si128(_mm_andnot_si128(abMiss, cMiss), c1);
+        const __m128i e = _mm_sub_epi8(c, _mm_andnot_si128(lastPrev, cMiss));
+        const __m128i be = _mm_sub_epi8(b, _mm_andnot_si128(e, _mm_and_si128(aMiss, bMiss)));
+        const __m128i br = _mm_add_epi8(be, resT[x0 + x]);
+        const __m128i med = _mm_max_epu8(_mm_min_epu8(a, hiBC), loBC);
+        const __m128i t = _mm_max_epu8(_mm_avg_epu8(a, b), x1);
+        const __m128i v = _mm_sub_epi8(_mm_add_epi8(a, br), _mm_min_epu8(med, t));
+        lastPrev = last;
+        last = _mm_or_si128(_mm_andnot_si128(isMiss, v), _mm_and_si128(isMiss, last));
         a = _mm_or_si128(v, isMiss);  // the miss code where the mask has a miss
+        aMiss = isMiss;
         c = b;
+        cMiss = bMiss;
         out[x] = a;
       }
       __m128i rows[16];
-      for (int x = 0; x < 16; ++x) rows[x] = out[x];
+      __m128i n = zero;
+      for (int x = 0; x < 16; ++x) rows[x] = out[x], n = _mm_sub_epi8(n, _mm_cmpeq_epi8(rows[x], miss));
+      missCount = _mm_add_epi64(missCount, _mm_sad_epu8(n, zero));
       transpose16(rows);
       for (uint32_t i = 0; i < kHitsMedLanes; ++i)
         _mm_storeu_si128(reinterpret_cast<__m128i*>(raw + (first + i) * mapTexels + uint64_t(y) * M + x0), rows[i]);
     }
   }
-  return _mm_movemask_epi8(_mm_cmpeq_epi8(bad, miss)) == 0;
+  const uint64_t hits = uint64_t(row.res[kHitsMedLanes - 1] - start[0]);
+  return uint64_t(_mm_cvtsi128_si64(missCount)) + uint64_t(_mm_cvtsi128_si64(_mm_unpackhi_epi64(missCount, missCount))) ==
+         kHitsMedLanes * mapTexels - hits;
 }
 
 }  // namespace
@@ -227,7 +245,6 @@ HitsMedProgress unapplyHitsMedLanes(std::span<const uint8_t> filtered, const uin
     uint8_t bytes[16];
   };
   std::vector<Vec> above(M + 1), resT(M);
-  std::vector<uint16_t> bits(M);
   std::vector<uint8_t> scratch(17 * uint64_t(M) + 8);
   HitsMedProgress done{0, residuals};
   for (; done.maps + kHitsMedLanes <= mapCount; done.maps += kHitsMedLanes) {
@@ -235,7 +252,7 @@ HitsMedProgress unapplyHitsMedLanes(std::span<const uint8_t> filtered, const uin
     for (uint32_t i = 0; i < kHitsMedLanes; ++i)
       start[i + 1] = start[i] + countHits(mask + (done.maps + i) * mapMaskBytes, mapMaskBytes);
     if (!decodeGroup(expand, mask, start, filtered.data() + filtered.size(), M, done.maps, raw,
-                     reinterpret_cast<__m128i*>(above.data()), reinterpret_cast<__m128i*>(resT.data()), bits.data(),
+                     reinterpret_cast<__m128i*>(above.data()), reinterpret_cast<__m128i*>(resT.data()),
                      scratch.data()))
       break;
     done.residuals = start[kHitsMedLanes];
