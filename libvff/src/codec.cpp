@@ -50,6 +50,17 @@ Status compress(Codec codec, int level, std::span<const uint8_t> raw, std::vecto
   return makeError(Code::kInvalidArgument, "unknown codec");
 }
 
+namespace {
+
+// One decompression context per thread, reused for every block it decodes (a block is one frame,
+// and ZSTD_decompressDCtx starts each frame afresh), rather than one created and freed per block.
+ZSTD_DCtx* threadDCtx() {
+  thread_local const std::unique_ptr<ZSTD_DCtx, size_t (*)(ZSTD_DCtx*)> context(ZSTD_createDCtx(), ZSTD_freeDCtx);
+  return context.get();
+}
+
+}  // namespace
+
 Status decompress(Codec codec, std::span<const uint8_t> stored, std::span<uint8_t> out,
                   Code failCode) {
   switch (codec) {
@@ -71,10 +82,9 @@ Status decompress(Codec codec, std::span<const uint8_t> stored, std::span<uint8_
       size_t frame = ZSTD_findFrameCompressedSize(stored.data(), stored.size());
       if (ZSTD_isError(frame) || frame != stored.size())
         return makeError(failCode, "stored bytes are not exactly one zstd frame");
-      ZSTD_DCtx* dctx = ZSTD_createDCtx();
+      ZSTD_DCtx* dctx = threadDCtx();
       if (!dctx) return makeError(Code::kOutOfMemory, "cannot create a zstd context");
       size_t n = ZSTD_decompressDCtx(dctx, out.data(), out.size(), stored.data(), stored.size());
-      ZSTD_freeDCtx(dctx);
       if (ZSTD_isError(n)) return makeError(failCode, std::string("zstd: ") + ZSTD_getErrorName(n));
       if (n != out.size())
         return makeError(failCode, "zstd frame decoded to " + std::to_string(n) + " bytes, expected " +
