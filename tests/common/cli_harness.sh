@@ -24,6 +24,11 @@ expect_err() { grep -q -F -e "$1" "$WORK/err" || { show; fail "stderr lacks: $1"
 expect_err_re() { grep -q -E -e "$1" "$WORK/err" || { show; fail "stderr matches no line: $1"; }; }
 expect_no_out() { [[ ! -s $WORK/out ]] || { show; fail "stdout is not empty"; }; }
 expect_no_err() { [[ ! -s $WORK/err ]] || { show; fail "stderr is not empty"; }; }
+# valid FILE: `$VFF_INSPECT FILE --validate` accepts it (exit 0).
+valid() {
+  run "$VFF_INSPECT" "$1" --validate
+  [[ $RC -eq 0 ]] || { show; fail "$1 does not validate"; }
+}
 # run_test NAME: the last line of every suite (`run_test "$1"`): runs the test function NAME in an
 # emptied $WORK and prints "PASS: NAME" when it returns. tests/CMakeLists.txt checks for that line.
 run_test() {

@@ -22,10 +22,6 @@ same() {
   run "$CHECK" compare "$@"
   [[ $RC -eq 0 ]] || { show; fail "fields differ: $*"; }
 }
-valid() {
-  run "$VFF_INSPECT" "$1" --validate
-  [[ $RC -eq 0 ]] || { show; fail "$1 does not validate"; }
-}
 # no_leftovers: nothing but the listed files (and out/err) is in $WORK: no temporary, no partial output.
 no_leftovers() {
   local f left=""

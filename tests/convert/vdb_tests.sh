@@ -26,10 +26,6 @@ same() {
   run "$CHECK" compare "$@"
   [[ $RC -eq 0 ]] || { show; fail "fields differ: $*"; }
 }
-valid() {
-  run "$VFF_INSPECT" "$1" --validate
-  [[ $RC -eq 0 ]] || { show; fail "$1 does not validate"; }
-}
 need_vdb_print() {
   if [[ -z ${VDB_PRINT:-} || ! -x ${VDB_PRINT:-} ]]; then
     echo "SKIP: vdb_print not found (Debian package libopenvdb-tools, installed by scripts/setup.sh)"
