@@ -10,6 +10,9 @@
 #include "vff/encoding.h"
 #include "vff/reader.h"
 
+#include "fast_lookup.h"
+#include "query_group.h"
+
 namespace vff {
 namespace {
 
@@ -55,6 +58,8 @@ struct FieldQuery::Impl {
   std::vector<const uint8_t*> norm;  // per map, empty without normals
   std::vector<Vec3> unit;            // û_k, float
   std::vector<Frame> frames;         // frame of map k (inward normal)
+  std::vector<float> unit4;          // unit, padded to 4 floats per map (the group kernel)
+  std::vector<float> frame12;        // frames, each row padded to 4 floats (the group kernel)
   static constexpr uint32_t kNeighbours = kQueryNeighbours;
   std::vector<uint32_t> neighbours;  // kNeighbours per map; UINT32_MAX pads
   float spacing = 0;                 // mean angular spacing sqrt(4 pi / mapCount)
@@ -105,6 +110,9 @@ struct FieldQuery::Impl {
   // positions (spec/positions.md section 2 allows a decoder this; it differs from the binary64
   // choice only between samples equally near to within rounding).
   uint32_t nearestSample(Vec3 d) const noexcept {
+    uint32_t fast;
+    if (positions.scheme() == PositionScheme::kOctaHemi2 && detail::octaNearestFast(positions.param(), unit.data(), d, &fast))
+      return fast;
     uint32_t c[PositionSet::kMaxCandidates];
     const uint32_t n = positions.candidates(d, c);
     uint32_t best = c[0];
@@ -131,17 +139,21 @@ struct FieldQuery::Impl {
   };
   bool prepare(const Ray& ray, const QueryOptions& o, Lookup* l) const noexcept;
   QueryHit nearestHit(const Ray& ray, const Lookup& l, float* visibility) const noexcept;
+  // The answer of a nearest lookup at texel (i, j) of map k (nearestHit, from its parts).
+  QueryHit hitAt(const Ray& ray, uint32_t k, uint32_t i, uint32_t j, float t0, bool inside, float lo, float hi,
+                 float len, float* visibility) const noexcept;
+  detail::GroupTables groupTables(const QueryOptions& o) const noexcept;
   QueryHit interpolated(const Ray& ray, const Lookup& l, float* visibility) const noexcept;
   QueryHit query(const Ray& ray, const QueryOptions& o, float* visibility) const noexcept;
   template <class Emit>
   void batchNearest(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept;
-  const uint8_t* texelAddress(const Lookup& l) const noexcept {
-    const size_t t = size_t(l.j) * m + l.i;
+  const uint8_t* texelAddress(uint32_t k, uint32_t i, uint32_t j) const noexcept {
+    const size_t t = size_t(j) * m + i;
     switch (field.distanceEncoding) {
-      case DistanceEncoding::kUnorm16Diameter: return dist[l.k0] + 2 * t;
-      case DistanceEncoding::kBit1: return dist[l.k0] + t / 8;
-      case DistanceEncoding::kBc4Diameter: return dist[l.k0] + bc4Block(l.i, l.j);
-      default: return dist[l.k0] + t;
+      case DistanceEncoding::kUnorm16Diameter: return dist[k] + 2 * t;
+      case DistanceEncoding::kBit1: return dist[k] + t / 8;
+      case DistanceEncoding::kBc4Diameter: return dist[k] + bc4Block(i, j);
+      default: return dist[k] + t;
     }
   }
 };
@@ -159,9 +171,18 @@ void FieldQuery::Impl::build() {
   m = field.mapResolution;
   unit.resize(n);
   frames.resize(n);
+  unit4.assign(size_t(n) * 4, 0.0f);
+  frame12.assign(size_t(n) * 12, 0.0f);
   for (uint32_t k = 0; k < n; ++k) {
     unit[k] = positions.position(k);
     frames[k] = positions.frame(k);
+    const Vec3 rows[4] = {unit[k], frames[k].t, frames[k].b, frames[k].n};
+    for (int r = 0; r < 4; ++r) {
+      float* dst = r == 0 ? &unit4[size_t(k) * 4] : &frame12[size_t(k) * 12 + size_t(r - 1) * 4];
+      dst[0] = rows[r].x;
+      dst[1] = rows[r].y;
+      dst[2] = rows[r].z;
+    }
   }
   spacing = std::sqrt(4.0f * kPi / float(n));
   // The kernel reaches 1.3 mean spacings (ground AO under the bunny: 1.0 and 1.6 are worse or
@@ -334,23 +355,29 @@ bool FieldQuery::Impl::prepare(const Ray& ray, const QueryOptions& o, Lookup* l)
   l->eu = (ray.origin + w * t0 - center) * (1.0f / radius);
   l->k0 = nearestSample(l->eu);
   const Vec3 local = toLocal(frames[l->k0], l->v);
-  squareToTexel(hemisphereToSquare(field.directionScheme, local), m, &l->i, &l->j);
+  if (!detail::texelFast(field.directionScheme, local, m, &l->i, &l->j))
+    squareToTexel(hemisphereToSquare(field.directionScheme, local), m, &l->i, &l->j);
   return true;
 }
 
 QueryHit FieldQuery::Impl::nearestHit(const Ray& ray, const Lookup& l, float* visibility) const noexcept {
+  return hitAt(ray, l.k0, l.i, l.j, l.t0, l.inside, l.lo, l.hi, l.len, visibility);
+}
+
+QueryHit FieldQuery::Impl::hitAt(const Ray& ray, uint32_t k, uint32_t i, uint32_t j, float t0, bool inside, float lo,
+                                 float hi, float len, float* visibility) const noexcept {
   QueryHit out;
-  const Sample s = texel(l.k0, l.i, l.j);
+  const Sample s = texel(k, i, j);
   if (!s.hit) return out;
-  const float t = l.t0 + l.sign * s.distance;
-  if (t < l.lo || t > l.hi) return out;
+  const float t = inside ? t0 - s.distance : t0 + s.distance;
+  if (t < lo || t > hi) return out;
   if (visibility) *visibility = 0.0f;
   out.hit = true;
-  out.inside = l.inside;
-  out.t = t / l.len;
-  out.point = ray.origin + l.w * t;
+  out.inside = inside;
+  out.t = t / len;
+  out.point = ray.origin + ray.direction * (1.0f / len) * t;
   if (!norm.empty()) {
-    out.normal = normalAt(l.k0, l.i, l.j);
+    out.normal = normalAt(k, i, j);
     out.hasNormal = true;
   }
   return out;
@@ -466,23 +493,60 @@ float FieldQuery::visibility(const Ray& ray, const QueryOptions& options) const 
   return v;
 }
 
-// Batches of nearest lookups run in groups: the first pass computes every ray's texel address and
-// asks the memory system for it, the second decodes. The scattered texel reads of a group then
-// overlap instead of waiting one after the other.
+detail::GroupTables FieldQuery::Impl::groupTables(const QueryOptions& o) const noexcept {
+  detail::GroupTables t;
+  t.center = center;
+  t.radius = radius;
+  t.octaN = positions.scheme() == PositionScheme::kOctaHemi2 ? positions.param() : 0;
+  t.unit4 = unit4.data();
+  t.frame12 = frame12.data();
+  t.scheme = field.directionScheme;
+  t.m = m;
+  t.bit1 = field.distanceEncoding == DistanceEncoding::kBit1;
+  t.insideLo = (o.intraBias >= 0 ? o.intraBias : defaultBias) * radius;
+  return t;
+}
+
+// Batches of nearest lookups run in groups: the group kernel (query_group.h) prepares every ray
+// of a group, prepare() redoes the few rays the kernel leaves to it, the texels of the group are
+// requested from memory together, and then decoded. The scattered texel reads of a group overlap
+// instead of waiting one after the other.
 template <class Emit>
 void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept {
-  constexpr size_t kGroup = 32;
-  Lookup l[kGroup];
-  bool live[kGroup];
-  for (size_t base = 0; base < rays.size(); base += kGroup) {
-    const size_t n = std::min(kGroup, rays.size() - base);
+  if (!detail::groupKernelAvailable()) {
+    for (size_t r = 0; r < rays.size(); ++r) {
+      float vis = 1.0f;
+      Lookup l;
+      const QueryHit h = prepare(rays[r], o, &l) ? nearestHit(rays[r], l, &vis) : QueryHit{};
+      emit(r, h, vis);
+    }
+    return;
+  }
+  const detail::GroupTables tables = groupTables(o);
+  detail::Group g;
+  for (size_t base = 0; base < rays.size(); base += detail::kGroupRays) {
+    const size_t n = std::min(detail::kGroupRays, rays.size() - base);
+    detail::prepareGroup(tables, rays.data() + base, n, &g);
     for (size_t r = 0; r < n; ++r) {
-      live[r] = prepare(rays[base + r], o, &l[r]);
-      if (live[r]) __builtin_prefetch(texelAddress(l[r]));
+      if (g.redo[r]) {
+        Lookup l;
+        g.live[r] = prepare(rays[base + r], o, &l);
+        g.k[r] = l.k0;
+        g.i[r] = l.i;
+        g.j[r] = l.j;
+        g.t0[r] = l.t0;
+        g.lo[r] = l.lo;
+        g.hi[r] = l.hi;
+        g.len[r] = l.len;
+        g.inside[r] = l.inside;
+      }
+      if (g.live[r]) __builtin_prefetch(texelAddress(g.k[r], g.i[r], g.j[r]));
     }
     for (size_t r = 0; r < n; ++r) {
       float vis = 1.0f;
-      const QueryHit h = live[r] ? nearestHit(rays[base + r], l[r], &vis) : QueryHit{};
+      const QueryHit h = g.live[r] ? hitAt(rays[base + r], g.k[r], g.i[r], g.j[r], g.t0[r], g.inside[r] != 0, g.lo[r],
+                                           g.hi[r], g.len[r], &vis)
+                                   : QueryHit{};
       emit(base + r, h, vis);
     }
   }

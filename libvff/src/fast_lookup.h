@@ -1,0 +1,129 @@
+// fast_lookup.h - the two hot steps of a nearest lookup in binary32, inlined, with a fallback.
+//
+// A query's cost is dominated by (1) finding the positional sample nearest to the entry point and
+// (2) mapping the lookup direction to a texel of that sample's map. The reference functions
+// (PositionSet::candidates, hemisphereToSquare + squareToTexel) are exact but slow: binary64
+// arithmetic, atan2f, calls across the library. The functions below compute the same answers in a
+// few dozen binary32 operations, and refuse (return false) whenever a rounding difference between
+// the two could change the answer: when the query lies within a guard band of a grid line or of a
+// texel edge. The caller then takes the reference path, so the fast and reference paths agree on
+// every ray (tests/unit/test_fast_lookup.cpp compares them on millions of directions, including
+// every kind of boundary).
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include "vff/direction.h"
+
+namespace vff::detail {
+
+// Guard bands: far wider than the binary32 error of the quantities they protect (a few ulps of
+// values <= 1, scaled by the grid or map resolution), and narrow enough that the fallback runs
+// for well under 1% of random rays.
+inline constexpr float kGridGuard = 1e-4f;   // grid units: candidates of octa-hemi2
+inline constexpr float kTexelGuard = 1e-4f;  // texel units, plus 2e-6 per texel of map width
+
+// The octa-hemi2 candidates of PositionSet::candidates (positions.cpp, octaCandidates) for the
+// direction q (finite, non-zero, need not be unit), evaluated in binary32, then the nearest of
+// them by binary32 dot products with the float table `unit` (ties to the smallest index), as
+// FieldQuery does with the reference candidates. False when the projection of q lies within
+// kGridGuard of a grid line, where the binary64 reference could choose another cell.
+inline bool octaNearestFast(uint32_t un, const Vec3* unit, Vec3 q, uint32_t* out) noexcept {
+  const int32_t n = int32_t(un);
+  const float ax = std::fabs(q.x), ay = std::fabs(q.y), az = std::fabs(q.z);
+  const float l1 = ax + ay + az;
+  if (!(l1 > 0) || !(l1 < 3.0e38f)) return false;
+  const float fn = float(n);
+  const float pa = ax / l1 * fn, pb = ay / l1 * fn;
+  const float fa = std::floor(pa), fb = std::floor(pb);
+  // Near a grid line (or at the edge |i| + |j| = n, or at the clamp to n - 1) the reference,
+  // which normalises in binary64 first, may land in the neighbouring cell.
+  if (pa - fa < kGridGuard || fa + 1.0f - pa < kGridGuard || pb - fb < kGridGuard || fb + 1.0f - pb < kGridGuard)
+    return false;
+  const int32_t a0 = std::min(int32_t(fa), n - 1), b0 = std::min(int32_t(fb), n - 1);
+  const int32_t h = q.z >= 0 ? 0 : 1;
+  const int32_t si = q.x < 0 ? -1 : 1, sj = q.y < 0 ? -1 : 1;
+  const int32_t hemi = 2 * n * n + 2 * n + 1;
+  static constexpr int8_t kCand[8][2] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}, {-1, 1}, {1, -1}, {2, 0}, {0, 2}};
+  uint32_t best = 0;
+  float bestDot = -INFINITY;
+  bool any = false;
+  for (const auto& c : kCand) {
+    const int32_t a = a0 + c[0], b = b0 + c[1];
+    const int32_t aa = a < 0 ? -a : a, ab = b < 0 ? -b : b;
+    if (aa + ab > n) continue;
+    const int32_t i = si * a, j = sj * b;
+    const int32_t hh = aa + ab == n ? 0 : h;  // an equator point is its hemisphere-0 copy
+    // octaIndex: row j starts at (n + j)^2, less 2 j (j - 1) for j > 0; row j spans i = -w .. w.
+    const int32_t t = n + j;
+    const int32_t rowStart = j <= 0 ? t * t : t * t - 2 * j * (j - 1);
+    const int32_t w = n - (j < 0 ? -j : j);
+    const uint32_t k = uint32_t(hh * hemi + rowStart + i + w);
+    const Vec3 u = unit[k];
+    const float d = u.x * q.x + u.y * q.y + u.z * q.z;
+    if (!any || d > bestDot || (d == bestDot && k < best)) {
+      bestDot = d;
+      best = k;
+      any = true;
+    }
+  }
+  if (!any) return false;
+  *out = best;
+  return true;
+}
+
+// atan(t) for |t| <= 1 in binary32 (Cephes atanf: range reduction at tan(pi/8), degree-9
+// polynomial; error about 2e-7).
+inline float atanUnit(float t) noexcept {
+  const float at = std::fabs(t);
+  const bool big = at > 0.41421356f;
+  const float x = big ? (at - 1.0f) / (at + 1.0f) : at;
+  const float y0 = big ? 0.78539816f : 0.0f;
+  const float z = x * x;
+  const float p = (((8.05374449538e-2f * z - 1.38776856032e-1f) * z + 1.99777106478e-1f) * z - 3.33329491539e-1f) * z * x + x;
+  const float r = y0 + p;
+  return t < 0 ? -r : r;
+}
+
+// The texel of an M x M map that holds the unit local direction `local` (z >= 0 side), as
+// squareToTexel(hemisphereToSquare(scheme, local), M): without atan2f for the concentric map.
+// False when the direction lies within the guard band of a texel edge or of an octant diagonal of
+// the concentric map (where the reference's atan2f decides).
+inline bool texelFast(DirectionScheme scheme, Vec3 local, uint32_t m, uint32_t* i, uint32_t* j) noexcept {
+  const float fm = float(m);
+  float a, b;
+  const float z = std::max(0.0f, local.z);
+  if (scheme == DirectionScheme::kHemiOctahedral) {
+    const float inv = 1.0f / (std::fabs(local.x) + std::fabs(local.y) + z);
+    const float x = local.x * inv, y = local.y * inv;
+    a = x + y;
+    b = x - y;
+  } else {
+    const float r = std::sqrt(std::max(0.0f, 1.0f - z));
+    const float ax = std::fabs(local.x), ay = std::fabs(local.y);
+    // Octant diagonals |x| = |y| (and the centre, x = y = 0): left to the reference.
+    if (!(std::fabs(ax - ay) > 1e-5f * (ax + ay))) return false;
+    const float k = r * (4.0f / 3.14159265358979323846f);
+    if (ax > ay) {
+      a = local.x < 0 ? -r : r;
+      const float s = atanUnit(local.y / local.x) * k;
+      b = local.x < 0 ? -s : s;
+    } else {
+      b = local.y < 0 ? -r : r;
+      const float s = atanUnit(local.x / local.y) * k;
+      a = local.y < 0 ? -s : s;
+    }
+  }
+  a = std::min(std::max(a, -1.0f), 1.0f);
+  b = std::min(std::max(b, -1.0f), 1.0f);
+  const float x = (a + 1.0f) * 0.5f * fm, y = (b + 1.0f) * 0.5f * fm;
+  const float fx = std::floor(x), fy = std::floor(y);
+  const float g = kTexelGuard + 2e-6f * fm;
+  if (x - fx < g || fx + 1.0f - x < g || y - fy < g || fy + 1.0f - y < g) return false;
+  *i = uint32_t(std::min(std::max(fx, 0.0f), fm - 1.0f));
+  *j = uint32_t(std::min(std::max(fy, 0.0f), fm - 1.0f));
+  return true;
+}
+
+}  // namespace vff::detail

@@ -1,0 +1,52 @@
+// query_group.h - the nearest lookup of many rays at once, four at a time in SSE2 (internal).
+//
+// FieldQuery's batch functions hand rays to prepareGroup() in groups of kGroupRays. It computes,
+// for every ray, what FieldQuery::Impl::prepare computes one ray at a time: the sphere entry, the
+// nearest positional sample (octa-hemi2: the candidates of PositionSet::candidates in binary32)
+// and the texel of the lookup direction in that sample's map. It performs the same binary32
+// operations in the same order as prepare(), and leaves to the caller (flag `redo`) every ray on
+// which a guard of fast_lookup.h trips or whose scheme it does not handle, so that a group gives
+// exactly the texel prepare() gives (tests/unit/test_query_group.cpp checks this ray by ray).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "vff/direction.h"
+#include "vff/format.h"
+#include "vff/query.h"
+
+namespace vff::detail {
+
+inline constexpr size_t kGroupRays = 64;
+
+// What the kernel reads: plain tables owned by FieldQuery::Impl.
+struct GroupTables {
+  Vec3 center;
+  float radius = 0;
+  uint32_t octaN = 0;               // octa-hemi2 parameter n; 0: another scheme (every hit ray is redone)
+  const float* unit4 = nullptr;     // 4 floats per map: the unit position x, y, z and 0
+  const float* frame12 = nullptr;   // 12 floats per map: the frame's t, b, n, each padded to 4
+  DirectionScheme scheme = DirectionScheme::kInvalid;
+  uint32_t m = 0;                   // map resolution
+  bool bit1 = false;                // the distance encoding has no distances (rays from inside miss)
+  float insideLo = 0;               // intra-object bias times the radius (QueryOptions::intraBias)
+};
+
+// The state of up to kGroupRays rays (structure of arrays). Distances are along the unit
+// direction, as in prepare(): t = (t0 + sign * d) / len for a texel distance d.
+struct Group {
+  float t0[kGroupRays], lo[kGroupRays], hi[kGroupRays], len[kGroupRays];
+  uint32_t k[kGroupRays], i[kGroupRays], j[kGroupRays];
+  uint8_t live[kGroupRays];    // the ray reaches a texel (false: it misses; final unless redo)
+  uint8_t inside[kGroupRays];  // the origin is inside the sphere (the lookup is reversed)
+  uint8_t redo[kGroupRays];    // the caller must run the reference prepare() on this ray
+};
+
+// True where prepareGroup is implemented (x86-64: SSE2). Elsewhere the caller uses prepare().
+bool groupKernelAvailable() noexcept;
+
+// Fills g for rays[0, n), n <= kGroupRays.
+void prepareGroup(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept;
+
+}  // namespace vff::detail

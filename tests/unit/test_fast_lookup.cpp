@@ -1,0 +1,270 @@
+// The query's fast paths against their references: the binary32 octa-hemi2 nearest sample and the
+// atan2-free texel mapping (libvff/src/fast_lookup.h), and the four-ray group kernel behind the
+// batch functions (libvff/src/query_group.cpp), which must answer every ray exactly as a lookup
+// written here from the reference functions does.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "../../libvff/src/fast_lookup.h"  // private: the fast paths against their references
+#include "test_util.h"
+#include "vff/vff.h"
+
+namespace vff {
+namespace {
+
+float dot3(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+
+// FieldQuery's reference choice: the reference candidates, binary32 dot products with the float
+// positions, ties to the smallest index.
+uint32_t referenceNearest(const PositionSet& ps, const std::vector<Vec3>& unit, Vec3 d) {
+  uint32_t c[PositionSet::kMaxCandidates];
+  const uint32_t n = ps.candidates(d, c);
+  uint32_t best = c[0];
+  float bestDot = dot3(unit[best], d);
+  for (uint32_t i = 1; i < n; ++i) {
+    const float v = dot3(unit[c[i]], d);
+    if (v > bestDot || (v == bestDot && c[i] < best)) {
+      bestDot = v;
+      best = c[i];
+    }
+  }
+  return best;
+}
+
+// Random unit directions, and directions on the features where the fast paths must refuse:
+// axes, octant diagonals, the equator, grid lines of the octahedral projection.
+std::vector<Vec3> testDirections(uint32_t gridN, size_t random) {
+  std::mt19937 rng(7);
+  std::normal_distribution<float> g;
+  std::vector<Vec3> out;
+  for (size_t r = 0; r < random; ++r) out.push_back({g(rng), g(rng), g(rng)});
+  for (float x : {-1.0f, -0.5f, 0.0f, 0.5f, 1.0f})
+    for (float y : {-1.0f, -0.5f, 0.0f, 0.5f, 1.0f})
+      for (float z : {-1.0f, -0.5f, 0.0f, 0.5f, 1.0f})
+        if (x != 0 || y != 0 || z != 0) out.push_back({x, y, z});
+  std::uniform_int_distribution<uint32_t> cell(0, gridN);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (int r = 0; r < 20000; ++r) {
+    // On a grid line a = integer (or b), or a hair away from it, in every octant.
+    const float a = float(cell(rng)) + (r % 3 == 0 ? 0.0f : (r % 3 == 1 ? 1e-6f : -1e-6f));
+    const float b = u(rng) * (float(gridN) - a);
+    const float c = float(gridN) - a - b;
+    const float sx = (r & 8) ? -1.0f : 1.0f, sy = (r & 16) ? -1.0f : 1.0f, sz = (r & 32) ? -1.0f : 1.0f;
+    if (r & 64)
+      out.push_back({sx * b, sy * a, sz * std::max(c, 0.0f)});
+    else
+      out.push_back({sx * a, sy * b, sz * std::max(c, 0.0f)});
+  }
+  return out;
+}
+
+TEST(FastLookup, OctaNearestEqualsTheReferenceWhereverItAnswers) {
+  for (uint32_t n : {1u, 2u, 3u, 8u, 32u, 64u, 255u}) {
+    auto ps = PositionSet::create(PositionScheme::kOctaHemi2, n);
+    ASSERT_TRUE(ps);
+    std::vector<Vec3> unit(ps->count());
+    for (uint32_t k = 0; k < ps->count(); ++k) unit[k] = ps->position(k);
+    const std::vector<Vec3> dirs = testDirections(n, 200000);
+    size_t answered = 0, randomRefused = 0;
+    for (size_t r = 0; r < dirs.size(); ++r) {
+      uint32_t fast = 0;
+      if (!detail::octaNearestFast(n, unit.data(), dirs[r], &fast)) {
+        randomRefused += r < 200000;
+        continue;
+      }
+      ++answered;
+      ASSERT_EQ(fast, referenceNearest(*ps, unit, dirs[r]))
+          << "n " << n << " direction " << dirs[r].x << " " << dirs[r].y << " " << dirs[r].z;
+    }
+    // The guard band is narrow: random directions almost never fall back.
+    EXPECT_LT(randomRefused, 200000 / 100) << "n " << n;
+    EXPECT_GT(answered, 190000u);
+  }
+}
+
+TEST(FastLookup, TexelEqualsTheReferenceWhereverItAnswers) {
+  std::mt19937 rng(3);
+  std::normal_distribution<float> g;
+  std::vector<Vec3> dirs;
+  for (int r = 0; r < 300000; ++r) dirs.push_back({g(rng), g(rng), std::fabs(g(rng))});
+  const size_t random = dirs.size();
+  for (float x : {-1.0f, -0.5f, 0.0f, 0.5f, 1.0f})
+    for (float y : {-1.0f, -0.5f, 0.0f, 0.5f, 1.0f})
+      for (float z : {-0.1f, 0.0f, 0.5f, 1.0f}) dirs.push_back({x, y, z});
+  for (int r = 0; r < 20000; ++r) {  // near the octant diagonals and the horizon
+    const float x = g(rng), e = (r % 2 ? 1e-7f : 0.0f) * x;
+    dirs.push_back({x, ((r & 2) ? -x : x) + e, (r & 4) ? 0.0f : std::fabs(g(rng))});
+  }
+  for (Vec3& d : dirs) {
+    const float l = std::sqrt(dot3(d, d));
+    if (l > 0) d = {d.x / l, d.y / l, d.z / l};
+  }
+  for (DirectionScheme scheme : {DirectionScheme::kConcentricEqualArea, DirectionScheme::kHemiOctahedral}) {
+    for (uint32_t m : {1u, 2u, 4u, 16u, 64u, 255u, 1024u}) {
+      size_t randomRefused = 0;
+      for (size_t r = 0; r < dirs.size(); ++r) {
+        uint32_t fi = 0, fj = 0, ri = 0, rj = 0;
+        if (!detail::texelFast(scheme, dirs[r], m, &fi, &fj)) {
+          randomRefused += r < random;
+          continue;
+        }
+        squareToTexel(hemisphereToSquare(scheme, dirs[r]), m, &ri, &rj);
+        ASSERT_EQ(fi, ri) << "m " << m << " direction " << dirs[r].x << " " << dirs[r].y << " " << dirs[r].z;
+        ASSERT_EQ(fj, rj) << "m " << m << " direction " << dirs[r].x << " " << dirs[r].y << " " << dirs[r].z;
+      }
+      EXPECT_LT(randomRefused, random * (m >= 1024 ? 3 : 1) / 100) << "m " << m;
+    }
+  }
+}
+
+// ---- The batch functions (group kernel) against a lookup written from the reference functions --
+
+struct RefHit {
+  bool hit = false;
+  float t = 0;
+};
+
+// spec/geometry.md section 7 for an unorm8-diameter field, from the public reference functions.
+RefHit referenceLookup(const FieldDesc& f, const std::vector<Vec3>& unit, const PositionSet& ps,
+                       const std::vector<uint8_t>& dist, const Ray& ray, float biasR) {
+  const float len = std::sqrt(dot3(ray.direction, ray.direction));
+  if (!(len > 0) || !std::isfinite(len)) return {};
+  const float il = 1.0f / len;
+  const Vec3 w{ray.direction.x * il, ray.direction.y * il, ray.direction.z * il};
+  const Vec3 c{f.sphere.center[0], f.sphere.center[1], f.sphere.center[2]};
+  const float r = f.sphere.radius;
+  const Vec3 delta{ray.origin.x - c.x, ray.origin.y - c.y, ray.origin.z - c.z};
+  const float beta = dot3(delta, w), gamma = dot3(delta, delta) - r * r, disc = beta * beta - gamma;
+  if (!(disc >= 0)) return {};
+  const float sq = std::sqrt(disc), t1 = -beta + sq;
+  if (t1 < 0) return {};
+  const bool inside = gamma <= 0;
+  const float t0 = inside ? t1 : std::max(-beta - sq, 0.0f);
+  float lo = ray.tmin * len;
+  const float hi = ray.tmax * len;
+  if (inside) lo = std::max(lo, biasR);
+  if (!inside && t0 > hi) return {};
+  const float ir = 1.0f / r;
+  const Vec3 eu{(ray.origin.x + w.x * t0 - c.x) * ir, (ray.origin.y + w.y * t0 - c.y) * ir,
+                (ray.origin.z + w.z * t0 - c.z) * ir};
+  const Vec3 v = inside ? Vec3{-w.x, -w.y, -w.z} : w;
+  const uint32_t k = referenceNearest(ps, unit, eu);
+  uint32_t i = 0, j = 0;
+  squareToTexel(hemisphereToSquare(f.directionScheme, toLocal(ps.frame(k), v)), f.mapResolution, &i, &j);
+  const uint32_t code = dist[size_t(k) * f.mapResolution * f.mapResolution + size_t(j) * f.mapResolution + i];
+  if (code == 255) return {};
+  const float d = float(code) * (2.0f * r / 254.0f);
+  const float t = inside ? t0 - d : t0 + d;
+  if (t < lo || t > hi) return {};
+  return {true, t / len};
+}
+
+std::vector<Ray> testRays(const FieldDesc& f, size_t count, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> g;
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const Vec3 c{f.sphere.center[0], f.sphere.center[1], f.sphere.center[2]};
+  const float r = f.sphere.radius;
+  std::vector<Ray> rays;
+  for (size_t n = 0; n < count; ++n) {
+    Vec3 o{g(rng), g(rng), g(rng)};
+    const float ol = std::sqrt(dot3(o, o)) + 1e-12f, dist = r * 3.0f * u(rng);  // inside and outside
+    o = {c.x + o.x / ol * dist, c.y + o.y / ol * dist, c.z + o.z / ol * dist};
+    Ray ray{o, {g(rng), g(rng), g(rng)}};
+    if (n % 3 == 0) {  // aimed at the sphere, with a scaled direction
+      const Vec3 target{c.x + r * 0.9f * g(rng) / 3, c.y + r * 0.9f * g(rng) / 3, c.z + r * 0.9f * g(rng) / 3};
+      ray.direction = {(target.x - o.x) * 0.37f, (target.y - o.y) * 0.37f, (target.z - o.z) * 0.37f};
+    }
+    if (n % 5 == 1) ray.tmax = r * 2.0f * u(rng);
+    if (n % 7 == 2) ray.tmin = r * 0.5f * u(rng);
+    rays.push_back(ray);
+  }
+  // Degenerate rays: zero, infinite and NaN directions, an infinite origin, a tangent ray.
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  rays.push_back({c, {0, 0, 0}});
+  rays.push_back({c, {inf, 0, 0}});
+  rays.push_back({c, {nan, 1, 0}});
+  rays.push_back({{inf, 0, 0}, {-1, 0, 0}});
+  rays.push_back({{c.x - 3 * r, c.y + r, c.z}, {1, 0, 0}});
+  rays.push_back({{c.x - 3 * r, c.y, c.z}, {1, 0, 0}, 0.0f, 0.0f});
+  return rays;
+}
+
+TEST(FastLookup, BatchesAnswerLikeTheReferenceLookup) {
+  for (uint32_t n : {1u, 5u, 32u}) {
+    for (DirectionScheme scheme : {DirectionScheme::kConcentricEqualArea, DirectionScheme::kHemiOctahedral}) {
+      FieldDesc f = test::smallField(DistanceEncoding::kUnorm8Diameter, NormalEncoding::kNone, n, 16);
+      f.directionScheme = scheme;
+      const std::vector<uint8_t> dist = test::syntheticDistance(f);
+      auto q = FieldQuery::fromMaps(f, dist);
+      ASSERT_TRUE(q);
+      auto ps = PositionSet::fromField(f);
+      std::vector<Vec3> unit(ps->count());
+      for (uint32_t k = 0; k < ps->count(); ++k) unit[k] = ps->position(k);
+      const std::vector<Ray> rays = testRays(f, 20000, n);
+      QueryOptions o;
+      o.intraBias = 0.05f;
+      const float biasR = o.intraBias * f.sphere.radius;
+      // Batch sizes that leave partial quads and partial groups.
+      for (size_t batch : {size_t(1), size_t(3), size_t(63), size_t(65), rays.size()}) {
+        std::vector<QueryHit> hits(rays.size());
+        std::vector<uint8_t> occ(rays.size());
+        for (size_t b = 0; b < rays.size(); b += batch) {
+          const size_t e = std::min(rays.size(), b + batch);
+          q->intersect(std::span<const Ray>(rays).subspan(b, e - b), std::span<QueryHit>(hits).subspan(b, e - b), o);
+          q->occluded(std::span<const Ray>(rays).subspan(b, e - b), std::span<uint8_t>(occ).subspan(b, e - b), o);
+        }
+        size_t hitCount = 0;
+        for (size_t r = 0; r < rays.size(); ++r) {
+          const RefHit ref = referenceLookup(f, unit, *ps, dist, rays[r], biasR);
+          ASSERT_EQ(hits[r].hit, ref.hit) << "n " << n << " batch " << batch << " ray " << r;
+          ASSERT_EQ(occ[r] != 0, ref.hit) << "n " << n << " batch " << batch << " ray " << r;
+          if (ref.hit) {
+            ASSERT_EQ(hits[r].t, ref.t) << "n " << n << " batch " << batch << " ray " << r;
+            ++hitCount;
+          }
+          const QueryHit single = q->intersect(rays[r], o);
+          ASSERT_EQ(single.hit, ref.hit);
+          if (ref.hit) {
+            ASSERT_EQ(single.t, ref.t);
+          }
+        }
+        EXPECT_GT(hitCount, rays.size() / 10);  // the test exercises hits, not only misses
+      }
+    }
+  }
+}
+
+TEST(FastLookup, OtherPositionSchemesTakeTheReferencePath) {
+  for (PositionScheme scheme : {PositionScheme::kEqualAreaOctaGrid, PositionScheme::kSphericalFibonacci}) {
+    FieldDesc f = test::smallField(DistanceEncoding::kUnorm8Diameter, NormalEncoding::kNone, 1, 8);
+    f.positionScheme = scheme;
+    f.positionParam = scheme == PositionScheme::kEqualAreaOctaGrid ? 6 : 40;
+    f.mapCount = positionCount(scheme, f.positionParam).value();
+    const std::vector<uint8_t> dist = test::syntheticDistance(f);
+    auto q = FieldQuery::fromMaps(f, dist);
+    ASSERT_TRUE(q);
+    auto ps = PositionSet::fromField(f);
+    std::vector<Vec3> unit(ps->count());
+    for (uint32_t k = 0; k < ps->count(); ++k) unit[k] = ps->position(k);
+    const std::vector<Ray> rays = testRays(f, 5000, 9);
+    QueryOptions o;
+    o.intraBias = 0.0f;
+    std::vector<QueryHit> hits(rays.size());
+    q->intersect(rays, hits, o);
+    for (size_t r = 0; r < rays.size(); ++r) {
+      const RefHit ref = referenceLookup(f, unit, *ps, dist, rays[r], 0.0f);
+      ASSERT_EQ(hits[r].hit, ref.hit) << "ray " << r;
+      if (ref.hit) {
+        ASSERT_EQ(hits[r].t, ref.t) << "ray " << r;
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace vff
