@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <vector>
 
 #include "vff/direction.h"
 
@@ -23,6 +24,68 @@ namespace vff::detail {
 // for well under 1% of random rays.
 inline constexpr float kGridGuard = 1e-4f;   // grid units: candidates of octa-hemi2
 inline constexpr float kTexelGuard = 1e-4f;  // texel units, plus 2e-6 per texel of map width
+
+// The candidates of an octa-hemi2 query in cell (a0, b0) of its quadrant (PositionSet::candidates):
+// grid vertices (a0 + da, b0 + db), those with |a| + |b| > n left out.
+inline constexpr int8_t kOctaCandidates[8][2] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}, {-1, 1}, {1, -1}, {2, 0}, {0, 2}};
+
+// For every cell (a0, b0) of an octa-hemi2 quadrant (index b0 * n + a0), the candidates that can
+// be the nearest somewhere in the cell: bit c stands for kOctaCandidates[c]. The cell is a planar
+// quadrilateral on the octahedron's face, and "candidate q is nearer than s, seen from the centre"
+// is a half-plane there; q is left out when clipping the cell by its half-planes against every
+// other candidate leaves nothing, each half-plane widened by a margin far above binary32
+// rounding, so a binary32 comparison never picks a candidate left out. The quadrants and
+// hemispheres are mirror images: one table serves all. Empty (no table: try all eight) for n > 128.
+inline std::vector<uint8_t> octaCandidateMasks(uint32_t un) {
+  if (un == 0 || un > 128) return {};
+  const int n = int(un);
+  std::vector<uint8_t> masks(size_t(n) * size_t(n), 0xFF);
+  struct D3 {
+    double x, y, z;
+  };
+  auto dotD = [](const D3& u, const D3& v) { return u.x * v.x + u.y * v.y + u.z * v.z; };
+  for (int b0 = 0; b0 < n; ++b0)
+    for (int a0 = 0; a0 < n; ++a0) {
+      D3 cand[8];
+      bool valid[8];
+      for (int c = 0; c < 8; ++c) {
+        const int a = a0 + kOctaCandidates[c][0], b = b0 + kOctaCandidates[c][1];
+        const int aa = a < 0 ? -a : a, ab = b < 0 ? -b : b;
+        valid[c] = aa + ab <= n;
+        const double z = double(n - aa - ab), l = std::sqrt(double(a) * a + double(b) * b + z * z);
+        cand[c] = {a / l, b / l, z / l};
+      }
+      const D3 cell[4] = {{double(a0), double(b0), double(n - a0 - b0)},
+                          {double(a0 + 1), double(b0), double(n - a0 - b0 - 1)},
+                          {double(a0 + 1), double(b0 + 1), double(n - a0 - b0 - 2)},
+                          {double(a0), double(b0 + 1), double(n - a0 - b0 - 1)}};
+      const double margin = 1e-5 * std::sqrt(3.0) * double(n);  // 1e-5 of the longest point of the face
+      uint8_t mask = 0;
+      for (int q = 0; q < 8; ++q) {
+        if (!valid[q]) continue;
+        std::vector<D3> poly(cell, cell + 4), next;
+        for (int s = 0; s < 8 && !poly.empty(); ++s) {
+          if (s == q || !valid[s]) continue;
+          const D3 d{cand[q].x - cand[s].x, cand[q].y - cand[s].y, cand[q].z - cand[s].z};
+          next.clear();
+          for (size_t e = 0; e < poly.size(); ++e) {
+            const D3& p1 = poly[e];
+            const D3& p2 = poly[(e + 1) % poly.size()];
+            const double f1 = dotD(d, p1) + margin, f2 = dotD(d, p2) + margin;
+            if (f1 >= 0) next.push_back(p1);
+            if ((f1 >= 0) != (f2 >= 0)) {
+              const double t = f1 / (f1 - f2);
+              next.push_back({p1.x + (p2.x - p1.x) * t, p1.y + (p2.y - p1.y) * t, p1.z + (p2.z - p1.z) * t});
+            }
+          }
+          poly.swap(next);
+        }
+        if (!poly.empty()) mask = uint8_t(mask | (1u << q));
+      }
+      masks[size_t(b0) * size_t(n) + size_t(a0)] = mask;
+    }
+  return masks;
+}
 
 // The octa-hemi2 candidates of PositionSet::candidates (positions.cpp, octaCandidates) for the
 // direction q (finite, non-zero, need not be unit), evaluated in binary32, then the nearest of
@@ -45,11 +108,10 @@ inline bool octaNearestFast(uint32_t un, const Vec3* unit, Vec3 q, uint32_t* out
   const int32_t h = q.z >= 0 ? 0 : 1;
   const int32_t si = q.x < 0 ? -1 : 1, sj = q.y < 0 ? -1 : 1;
   const int32_t hemi = 2 * n * n + 2 * n + 1;
-  static constexpr int8_t kCand[8][2] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}, {-1, 1}, {1, -1}, {2, 0}, {0, 2}};
   uint32_t best = 0;
   float bestDot = -INFINITY;
   bool any = false;
-  for (const auto& c : kCand) {
+  for (const auto& c : kOctaCandidates) {
     const int32_t a = a0 + c[0], b = b0 + c[1];
     const int32_t aa = a < 0 ? -a : a, ab = b < 0 ? -b : b;
     if (aa + ab > n) continue;

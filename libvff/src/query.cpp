@@ -60,6 +60,7 @@ struct FieldQuery::Impl {
   std::vector<Frame> frames;         // frame of map k (inward normal)
   std::vector<float> unit4;          // unit, padded to 4 floats per map (the group kernel)
   std::vector<float> frame12;        // frames, each row padded to 4 floats (the group kernel)
+  std::vector<uint8_t> octaMasks;    // octa-hemi2: detail::octaCandidateMasks (the group kernel)
   static constexpr uint32_t kNeighbours = kQueryNeighbours;
   std::vector<uint32_t> neighbours;  // kNeighbours per map; UINT32_MAX pads
   float spacing = 0;                 // mean angular spacing sqrt(4 pi / mapCount)
@@ -184,6 +185,7 @@ void FieldQuery::Impl::build() {
       dst[2] = rows[r].z;
     }
   }
+  if (positions.scheme() == PositionScheme::kOctaHemi2) octaMasks = detail::octaCandidateMasks(positions.param());
   spacing = std::sqrt(4.0f * kPi / float(n));
   // The kernel reaches 1.3 mean spacings (ground AO under the bunny: 1.0 and 1.6 are worse or
   // slower; vff-experiments ao).
@@ -500,6 +502,7 @@ detail::GroupTables FieldQuery::Impl::groupTables(const QueryOptions& o) const n
   t.octaN = positions.scheme() == PositionScheme::kOctaHemi2 ? positions.param() : 0;
   t.unit4 = unit4.data();
   t.frame12 = frame12.data();
+  t.octaMasks = octaMasks.empty() ? nullptr : octaMasks.data();
   t.scheme = field.directionScheme;
   t.m = m;
   t.bit1 = field.distanceEncoding == DistanceEncoding::kBit1;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <algorithm>
 
 #include "fast_lookup.h"
 
@@ -31,8 +32,7 @@ inline __m128 vabs(__m128 x) { return _mm_and_ps(x, _mm_castsi128_ps(_mm_set1_ep
 inline __m128 vneg(__m128 x) { return _mm_xor_ps(x, _mm_set1_ps(-0.0f)); }
 // floor(x) for 0 <= x < 2^31 (every use below; other lanes are masked off afterwards).
 inline __m128 floorPos(__m128 x) { return _mm_cvtepi32_ps(_mm_cvttps_epi32(x)); }
-// The smaller of a and b as std::min(a, b) with the roles of prepare(): b < a ? b : a.
-inline __m128 minStd(__m128 a, __m128 b) { return sel(_mm_cmplt_ps(b, a), b, a); }
+// std::max(a, b) as prepare() evaluates it.
 inline __m128 maxStd(__m128 a, __m128 b) { return sel(_mm_cmplt_ps(a, b), b, a); }  // a < b ? b : a
 
 // Loads 4-float rows at base + 4 * stride * index[l] (l = 0..3) and transposes them: out[c] holds
@@ -68,8 +68,17 @@ inline void storeMask(uint8_t* out, __m128 mask) {
   for (int l = 0; l < 4; ++l) out[l] = uint8_t((bits >> l) & 1);
 }
 
-// Four rays starting at rays[0] (all four readable).
-void quad(const GroupTables& tb, const Ray* rays, Group* g, size_t r0) {
+// The rays of a group that reach the sphere, packed: their entry points and lookup directions.
+struct Packed {
+  float eux[kGroupRays + 4], euy[kGroupRays + 4], euz[kGroupRays + 4];
+  float vx[kGroupRays + 4], vy[kGroupRays + 4], vz[kGroupRays + 4];
+  uint32_t ray[kGroupRays + 4];
+  size_t count = 0;
+};
+
+// Step 1 for four rays starting at rays[0] (all four readable), lanes r0 .. r0 + 3 of g: the
+// sphere; appends the live rays to `packed`.
+void sphereQuad(const GroupTables& tb, const Ray* rays, Group* g, size_t r0, Packed* packed) {
   const float* p = reinterpret_cast<const float*>(rays);
   __m128 ox = _mm_loadu_ps(p), oy = _mm_loadu_ps(p + 8), oz = _mm_loadu_ps(p + 16), dx = _mm_loadu_ps(p + 24);
   _MM_TRANSPOSE4_PS(ox, oy, oz, dx);
@@ -111,10 +120,36 @@ void quad(const GroupTables& tb, const Ray* rays, Group* g, size_t r0) {
   _mm_storeu_ps(g->len + r0, len);
   storeMask(g->live + r0, live);
   storeMask(g->inside + r0, inside);
-  if (tb.octaN == 0 || _mm_movemask_ps(live) == 0) {
-    storeMask(g->redo + r0, live);  // another scheme: the reference does the rest
-    return;
+  storeMask(g->redo + r0, _mm_setzero_ps());
+  const int bits = _mm_movemask_ps(live);
+  if (bits == 0) return;
+  alignas(16) float e[6][4];
+  _mm_store_ps(e[0], eux);
+  _mm_store_ps(e[1], euy);
+  _mm_store_ps(e[2], euz);
+  _mm_store_ps(e[3], vx);
+  _mm_store_ps(e[4], vy);
+  _mm_store_ps(e[5], vz);
+  for (int l = 0; l < 4; ++l) {
+    if (!((bits >> l) & 1)) continue;
+    const size_t slot = packed->count++;
+    packed->eux[slot] = e[0][l];
+    packed->euy[slot] = e[1][l];
+    packed->euz[slot] = e[2][l];
+    packed->vx[slot] = e[3][l];
+    packed->vy[slot] = e[4][l];
+    packed->vz[slot] = e[5][l];
+    packed->ray[slot] = uint32_t(r0 + size_t(l));
   }
+}
+
+// Steps 2 and 3 for packed rays p .. p + 3 (all four valid; the caller pads the last quad).
+// Writes k, i, j and redo of the first `lanes` of them into g.
+void lookupQuad(const GroupTables& tb, const Packed& pk, size_t p, size_t lanes, Group* g) {
+  const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
+  const __m128 eux = _mm_loadu_ps(pk.eux + p), euy = _mm_loadu_ps(pk.euy + p), euz = _mm_loadu_ps(pk.euz + p);
+  const __m128 vx = _mm_loadu_ps(pk.vx + p), vy = _mm_loadu_ps(pk.vy + p), vz = _mm_loadu_ps(pk.vz + p);
+  const __m128 live = _mm_castsi128_ps(_mm_set1_epi32(-1));
 
   // 2. The nearest sample: octaNearestFast.
   const float fnS = float(tb.octaN);
@@ -135,12 +170,24 @@ void quad(const GroupTables& tb, const Ray* rays, Group* g, size_t r0) {
   const __m128 hemi = _mm_set1_ps(float(2 * tb.octaN * tb.octaN + 2 * tb.octaN + 1));
   // Lanes that must not read the tables (dead, or redone) look up sample 0.
   const __m128 use = _mm_andnot_ps(redo, live);
-  static constexpr float kCand[8][2] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}, {-1, 1}, {1, -1}, {2, 0}, {0, 2}};
+  // The candidates any of the four lanes needs (octaCandidateMasks).
+  unsigned needed = 0xFF;
+  if (tb.octaMasks) {
+    alignas(16) int32_t ca[4], cb[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(ca), _mm_cvttps_epi32(_mm_and_ps(use, a0)));
+    _mm_store_si128(reinterpret_cast<__m128i*>(cb), _mm_cvttps_epi32(_mm_and_ps(use, b0)));
+    needed = 0;
+    const int useBits = _mm_movemask_ps(use);
+    for (int l = 0; l < 4; ++l)
+      if ((useBits >> l) & 1) needed |= tb.octaMasks[size_t(cb[l]) * tb.octaN + size_t(ca[l])];
+  }
   __m128 bestD = _mm_set1_ps(-INFINITY), bestK = _mm_set1_ps(3.0e38f);
   __m128 any = _mm_setzero_ps();
   alignas(16) int32_t idx[4];
-  for (const auto& c : kCand) {
-    const __m128 a = _mm_add_ps(a0, _mm_set1_ps(c[0])), b = _mm_add_ps(b0, _mm_set1_ps(c[1]));
+  for (unsigned ci = 0; ci < 8; ++ci) {
+    if (!((needed >> ci) & 1)) continue;
+    const __m128 a = _mm_add_ps(a0, _mm_set1_ps(kOctaCandidates[ci][0]));
+    const __m128 b = _mm_add_ps(b0, _mm_set1_ps(kOctaCandidates[ci][1]));
     const __m128 aa = vabs(a), ab = vabs(b), sum = _mm_add_ps(aa, ab);
     const __m128 valid = _mm_and_ps(_mm_cmple_ps(sum, fn), use);
     const __m128 i = sel(negX, vneg(a), a), j = sel(negY, vneg(b), b);
@@ -164,7 +211,6 @@ void quad(const GroupTables& tb, const Ray* rays, Group* g, size_t r0) {
   redo = _mm_or_ps(redo, _mm_andnot_ps(any, use));
   const __m128 kf = _mm_and_ps(_mm_andnot_ps(redo, live), bestK);
   _mm_store_si128(reinterpret_cast<__m128i*>(idx), _mm_cvttps_epi32(kf));
-  _mm_storeu_si128(reinterpret_cast<__m128i*>(g->k + r0), _mm_cvttps_epi32(kf));
 
   // 3. The texel: toLocal, then texelFast.
   __m128 ft[4], fb3[4], fnrm[4];
@@ -215,11 +261,17 @@ void quad(const GroupTables& tb, const Ray* rays, Group* g, size_t r0) {
   redo = _mm_or_ps(redo, _mm_and_ps(edge, live));
   const __m128 top = _mm_set1_ps(fmS - 1.0f);
   const __m128 ok = _mm_andnot_ps(redo, live);
-  _mm_storeu_si128(reinterpret_cast<__m128i*>(g->i + r0),
-                   _mm_cvttps_epi32(_mm_and_ps(ok, _mm_min_ps(_mm_max_ps(fx, zero), top))));
-  _mm_storeu_si128(reinterpret_cast<__m128i*>(g->j + r0),
-                   _mm_cvttps_epi32(_mm_and_ps(ok, _mm_min_ps(_mm_max_ps(fy, zero), top))));
-  storeMask(g->redo + r0, redo);
+  alignas(16) int32_t ti[4], tj[4];
+  _mm_store_si128(reinterpret_cast<__m128i*>(ti), _mm_cvttps_epi32(_mm_and_ps(ok, _mm_min_ps(_mm_max_ps(fx, zero), top))));
+  _mm_store_si128(reinterpret_cast<__m128i*>(tj), _mm_cvttps_epi32(_mm_and_ps(ok, _mm_min_ps(_mm_max_ps(fy, zero), top))));
+  const int redoBits = _mm_movemask_ps(redo);
+  for (size_t l = 0; l < lanes; ++l) {
+    const uint32_t r = pk.ray[p + l];
+    g->k[r] = uint32_t(idx[l]);
+    g->i[r] = uint32_t(ti[l]);
+    g->j[r] = uint32_t(tj[l]);
+    g->redo[r] = uint8_t((redoBits >> l) & 1);
+  }
 }
 
 }  // namespace
@@ -227,13 +279,25 @@ void quad(const GroupTables& tb, const Ray* rays, Group* g, size_t r0) {
 bool groupKernelAvailable() noexcept { return true; }
 
 void prepareGroup(const GroupTables& tb, const Ray* rays, size_t n, Group* g) noexcept {
+  Packed packed;
   size_t r = 0;
-  for (; r + 4 <= n; r += 4) quad(tb, rays + r, g, r);
+  for (; r + 4 <= n; r += 4) sphereQuad(tb, rays + r, g, r, &packed);
   if (r < n) {
     Ray tail[4] = {};  // zero directions: not live
     std::memcpy(tail, rays + r, (n - r) * sizeof(Ray));
     Group scratch;
-    quad(tb, tail, &scratch, 0);
+    Packed tailPacked;
+    sphereQuad(tb, tail, &scratch, 0, &tailPacked);
+    for (size_t l = 0; l < tailPacked.count; ++l) {
+      const size_t p = packed.count++;
+      packed.eux[p] = tailPacked.eux[l];
+      packed.euy[p] = tailPacked.euy[l];
+      packed.euz[p] = tailPacked.euz[l];
+      packed.vx[p] = tailPacked.vx[l];
+      packed.vy[p] = tailPacked.vy[l];
+      packed.vz[p] = tailPacked.vz[l];
+      packed.ray[p] = uint32_t(r + tailPacked.ray[l]);
+    }
     for (size_t l = 0; r + l < n; ++l) {
       g->t0[r + l] = scratch.t0[l];
       g->lo[r + l] = scratch.lo[l];
@@ -247,6 +311,22 @@ void prepareGroup(const GroupTables& tb, const Ray* rays, size_t n, Group* g) no
       g->redo[r + l] = scratch.redo[l];
     }
   }
+  if (packed.count == 0) return;
+  if (tb.octaN == 0) {  // another scheme: the reference does the rest
+    for (size_t p = 0; p < packed.count; ++p) g->redo[packed.ray[p]] = 1;
+    return;
+  }
+  // Pad the last quad with copies of the last live ray (their answers are not stored).
+  const size_t last = packed.count - 1;
+  for (size_t p = packed.count; p % 4 != 0; ++p) {
+    packed.eux[p] = packed.eux[last];
+    packed.euy[p] = packed.euy[last];
+    packed.euz[p] = packed.euz[last];
+    packed.vx[p] = packed.vx[last];
+    packed.vy[p] = packed.vy[last];
+    packed.vz[p] = packed.vz[last];
+  }
+  for (size_t p = 0; p < packed.count; p += 4) lookupQuad(tb, packed, p, std::min<size_t>(4, packed.count - p), g);
 }
 
 #else

@@ -86,6 +86,57 @@ TEST(FastLookup, OctaNearestEqualsTheReferenceWhereverItAnswers) {
   }
 }
 
+TEST(FastLookup, CandidateMasksKeepTheNearest) {
+  for (uint32_t n : {1u, 2u, 5u, 32u, 64u, 128u}) {
+    auto ps = PositionSet::create(PositionScheme::kOctaHemi2, n);
+    ASSERT_TRUE(ps);
+    std::vector<Vec3> unit(ps->count());
+    for (uint32_t k = 0; k < ps->count(); ++k) unit[k] = ps->position(k);
+    const std::vector<uint8_t> masks = detail::octaCandidateMasks(n);
+    ASSERT_EQ(masks.size(), size_t(n) * n);
+    size_t kept = 0;
+    for (uint8_t m : masks) kept += size_t(__builtin_popcount(m));
+    // Random directions, and some in every cell of the quadrant.
+    std::vector<Vec3> dirs = testDirections(n, 100000);
+    std::mt19937 rng(n);
+    std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+    for (uint32_t b0 = 0; b0 < n; ++b0)
+      for (uint32_t a0 = 0; a0 + b0 < n; ++a0) {
+        const int perCell = std::max(40, int(400000 / (n * n)));
+        for (int r = 0; r < perCell; ++r) {
+          const float a = float(a0) + u01(rng), b = float(b0) + u01(rng);
+          if (a + b > float(n)) continue;
+          dirs.push_back({(r & 1) ? -a : a, (r & 2) ? -b : b, ((r & 4) ? -1.0f : 1.0f) * (float(n) - a - b)});
+        }
+      }
+    for (const Vec3& d : dirs) {
+      // The cell of d, as octaNearestFast computes it (directions on a grid line are skipped:
+      // there the fast path defers to the reference).
+      const float ax = std::fabs(d.x), ay = std::fabs(d.y), l1 = ax + ay + std::fabs(d.z);
+      const float pa = ax / l1 * float(n), pb = ay / l1 * float(n);
+      const int a0 = std::min(int(pa), int(n) - 1), b0 = std::min(int(pb), int(n) - 1);
+      if (pa - std::floor(pa) < detail::kGridGuard || std::ceil(pa) - pa < detail::kGridGuard ||
+          pb - std::floor(pb) < detail::kGridGuard || std::ceil(pb) - pb < detail::kGridGuard)
+        continue;
+      const uint32_t ref = referenceNearest(*ps, unit, d);
+      // The candidate the reference chose, as an offset from the cell in the quadrant frame.
+      const Vec3 u = ps->position(ref);
+      const float ul1 = std::fabs(u.x) + std::fabs(u.y) + std::fabs(u.z);
+      const int ra = int(std::lround(std::fabs(u.x) / ul1 * float(n))), rb = int(std::lround(std::fabs(u.y) / ul1 * float(n)));
+      // Mirror candidates (offset -1) sit across the quadrant's edge: their |a| is the offset's size.
+      bool found = false;
+      for (int c = 0; c < 8; ++c) {
+        if (!((masks[size_t(b0) * n + size_t(a0)] >> c) & 1)) continue;
+        const int ca = a0 + detail::kOctaCandidates[c][0], cb = b0 + detail::kOctaCandidates[c][1];
+        found = found || (std::abs(ca) == ra && std::abs(cb) == rb);
+      }
+      ASSERT_TRUE(found) << "n " << n << " cell " << a0 << " " << b0 << " direction " << d.x << " " << d.y << " " << d.z;
+    }
+    // Away from the poles of the octahedron a cell needs its four corners only.
+    EXPECT_LT(kept, size_t(n) * n * 5) << "n " << n;
+  }
+}
+
 TEST(FastLookup, TexelEqualsTheReferenceWhereverItAnswers) {
   std::mt19937 rng(3);
   std::normal_distribution<float> g;
