@@ -146,7 +146,15 @@ struct FieldQuery::Impl {
   detail::GroupTables groupTables(const QueryOptions& o) const noexcept;
   QueryHit interpolated(const Ray& ray, const Lookup& l, float* visibility) const noexcept;
   QueryHit query(const Ray& ray, const QueryOptions& o, float* visibility) const noexcept;
-  template <class Emit>
+  // Whether the nearest lookup at texel (i, j) of map k hits within [lo, hi] (hitAt(...).hit).
+  bool hitsAt(uint32_t k, uint32_t i, uint32_t j, float t0, bool inside, float lo, float hi) const noexcept {
+    const Sample s = texel(k, i, j);
+    if (!s.hit) return false;
+    const float t = inside ? t0 - s.distance : t0 + s.distance;
+    return !(t < lo || t > hi);
+  }
+  // kHitOnly: emit(r, bool hit); otherwise emit(r, const QueryHit&, float visibility).
+  template <bool kHitOnly, class Emit>
   void batchNearest(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept;
   const uint8_t* texelAddress(uint32_t k, uint32_t i, uint32_t j) const noexcept {
     const size_t t = size_t(j) * m + i;
@@ -514,14 +522,18 @@ detail::GroupTables FieldQuery::Impl::groupTables(const QueryOptions& o) const n
 // of a group, prepare() redoes the few rays the kernel leaves to it, the texels of the group are
 // requested from memory together, and then decoded. The scattered texel reads of a group overlap
 // instead of waiting one after the other.
-template <class Emit>
+template <bool kHitOnly, class Emit>
 void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept {
   if (!detail::groupKernelAvailable()) {
     for (size_t r = 0; r < rays.size(); ++r) {
       float vis = 1.0f;
       Lookup l;
       const QueryHit h = prepare(rays[r], o, &l) ? nearestHit(rays[r], l, &vis) : QueryHit{};
-      emit(r, h, vis);
+      if constexpr (kHitOnly) {
+        emit(r, h.hit);
+      } else {
+        emit(r, h, vis);
+      }
     }
     return;
   }
@@ -546,11 +558,15 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
       if (g.live[r]) __builtin_prefetch(texelAddress(g.k[r], g.i[r], g.j[r]));
     }
     for (size_t r = 0; r < n; ++r) {
-      float vis = 1.0f;
-      const QueryHit h = g.live[r] ? hitAt(rays[base + r], g.k[r], g.i[r], g.j[r], g.t0[r], g.inside[r] != 0, g.lo[r],
-                                           g.hi[r], g.len[r], &vis)
-                                   : QueryHit{};
-      emit(base + r, h, vis);
+      if constexpr (kHitOnly) {
+        emit(base + r, g.live[r] && hitsAt(g.k[r], g.i[r], g.j[r], g.t0[r], g.inside[r] != 0, g.lo[r], g.hi[r]));
+      } else {
+        float vis = 1.0f;
+        const QueryHit h = g.live[r] ? hitAt(rays[base + r], g.k[r], g.i[r], g.j[r], g.t0[r], g.inside[r] != 0,
+                                             g.lo[r], g.hi[r], g.len[r], &vis)
+                                     : QueryHit{};
+        emit(base + r, h, vis);
+      }
     }
   }
 }
@@ -558,7 +574,7 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
 void FieldQuery::intersect(std::span<const Ray> rays, std::span<QueryHit> out, const QueryOptions& options) const noexcept {
   const size_t n = std::min(rays.size(), out.size());
   if (impl_ && options.reconstruction == Reconstruction::kNearest) {
-    impl_->batchNearest(rays.first(n), options, [&](size_t r, const QueryHit& h, float) { out[r] = h; });
+    impl_->batchNearest<false>(rays.first(n), options, [&](size_t r, const QueryHit& h, float) { out[r] = h; });
     return;
   }
   for (size_t r = 0; r < n; ++r) out[r] = intersect(rays[r], options);
@@ -567,7 +583,7 @@ void FieldQuery::intersect(std::span<const Ray> rays, std::span<QueryHit> out, c
 void FieldQuery::occluded(std::span<const Ray> rays, std::span<uint8_t> out, const QueryOptions& options) const noexcept {
   const size_t n = std::min(rays.size(), out.size());
   if (impl_ && options.reconstruction == Reconstruction::kNearest) {
-    impl_->batchNearest(rays.first(n), options, [&](size_t r, const QueryHit& h, float) { out[r] = h.hit ? 1 : 0; });
+    impl_->batchNearest<true>(rays.first(n), options, [&](size_t r, bool hit) { out[r] = hit ? 1 : 0; });
     return;
   }
   for (size_t r = 0; r < n; ++r) out[r] = occluded(rays[r], options) ? 1 : 0;
@@ -576,7 +592,7 @@ void FieldQuery::occluded(std::span<const Ray> rays, std::span<uint8_t> out, con
 void FieldQuery::visibility(std::span<const Ray> rays, std::span<float> out, const QueryOptions& options) const noexcept {
   const size_t n = std::min(rays.size(), out.size());
   if (impl_ && options.reconstruction == Reconstruction::kNearest) {
-    impl_->batchNearest(rays.first(n), options, [&](size_t r, const QueryHit&, float v) { out[r] = v; });
+    impl_->batchNearest<true>(rays.first(n), options, [&](size_t r, bool hit) { out[r] = hit ? 0.0f : 1.0f; });
     return;
   }
   for (size_t r = 0; r < n; ++r) out[r] = visibility(rays[r], options);
