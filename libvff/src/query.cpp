@@ -59,7 +59,6 @@ struct FieldQuery::Impl {
   std::vector<Vec3> unit;            // û_k, float
   std::vector<Frame> frames;         // frame of map k (inward normal)
   std::vector<float> unit4;          // unit, padded to 4 floats per map (the group kernel)
-  std::vector<float> frame12;        // frames, each row padded to 4 floats (the group kernel)
   std::vector<uint8_t> octaMasks;    // octa-hemi2: detail::octaCandidateMasks (the group kernel)
   static constexpr uint32_t kNeighbours = kQueryNeighbours;
   std::vector<uint32_t> neighbours;  // kNeighbours per map; UINT32_MAX pads
@@ -181,17 +180,12 @@ void FieldQuery::Impl::build() {
   unit.resize(n);
   frames.resize(n);
   unit4.assign(size_t(n) * 4, 0.0f);
-  frame12.assign(size_t(n) * 12, 0.0f);
   for (uint32_t k = 0; k < n; ++k) {
     unit[k] = positions.position(k);
     frames[k] = positions.frame(k);
-    const Vec3 rows[4] = {unit[k], frames[k].t, frames[k].b, frames[k].n};
-    for (int r = 0; r < 4; ++r) {
-      float* dst = r == 0 ? &unit4[size_t(k) * 4] : &frame12[size_t(k) * 12 + size_t(r - 1) * 4];
-      dst[0] = rows[r].x;
-      dst[1] = rows[r].y;
-      dst[2] = rows[r].z;
-    }
+    unit4[size_t(k) * 4] = unit[k].x;
+    unit4[size_t(k) * 4 + 1] = unit[k].y;
+    unit4[size_t(k) * 4 + 2] = unit[k].z;
   }
   if (positions.scheme() == PositionScheme::kOctaHemi2) octaMasks = detail::octaCandidateMasks(positions.param());
   spacing = std::sqrt(4.0f * kPi / float(n));
@@ -509,7 +503,6 @@ detail::GroupTables FieldQuery::Impl::groupTables(const QueryOptions& o) const n
   t.radius = radius;
   t.octaN = positions.scheme() == PositionScheme::kOctaHemi2 ? positions.param() : 0;
   t.unit4 = unit4.data();
-  t.frame12 = frame12.data();
   t.octaMasks = octaMasks.empty() ? nullptr : octaMasks.data();
   t.scheme = field.directionScheme;
   t.m = m;

@@ -182,6 +182,7 @@ void lookupQuad(const GroupTables& tb, const Packed& pk, size_t p, size_t lanes,
       if ((useBits >> l) & 1) needed |= tb.octaMasks[size_t(cb[l]) * tb.octaN + size_t(ca[l])];
   }
   __m128 bestD = _mm_set1_ps(-INFINITY), bestK = _mm_set1_ps(3.0e38f);
+  __m128 bestX = zero, bestY = zero, bestZ = one;  // the best candidate's position
   __m128 any = _mm_setzero_ps();
   alignas(16) int32_t idx[4];
   for (unsigned ci = 0; ci < 8; ++ci) {
@@ -206,27 +207,27 @@ void lookupQuad(const GroupTables& tb, const Packed& pk, size_t p, size_t lanes,
         valid, _mm_or_ps(_mm_cmpgt_ps(d, bestD), _mm_and_ps(_mm_cmpeq_ps(d, bestD), _mm_cmplt_ps(k, bestK))));
     bestD = sel(better, d, bestD);
     bestK = sel(better, k, bestK);
+    bestX = sel(better, u[0], bestX);
+    bestY = sel(better, u[1], bestY);
+    bestZ = sel(better, u[2], bestZ);
     any = _mm_or_ps(any, valid);
   }
   redo = _mm_or_ps(redo, _mm_andnot_ps(any, use));
   const __m128 kf = _mm_and_ps(_mm_andnot_ps(redo, live), bestK);
   _mm_store_si128(reinterpret_cast<__m128i*>(idx), _mm_cvttps_epi32(kf));
 
-  // 3. The texel: toLocal, then texelFast.
-  __m128 ft[4], fb3[4], fnrm[4];
-  {
-    // The frame rows t, b, n of each lane's sample: 12 floats per map.
-    const int32_t id3[4] = {idx[0] * 3, idx[1] * 3, idx[2] * 3, idx[3] * 3};
-    gather4(tb.frame12, 4, id3, ft);
-    const int32_t idb[4] = {id3[0] + 1, id3[1] + 1, id3[2] + 1, id3[3] + 1};
-    gather4(tb.frame12, 4, idb, fb3);
-    const int32_t idn[4] = {id3[0] + 2, id3[1] + 2, id3[2] + 2, id3[3] + 2};
-    gather4(tb.frame12, 4, idn, fnrm);
-  }
-  const __m128 lx = _mm_add_ps(_mm_add_ps(_mm_mul_ps(vx, ft[0]), _mm_mul_ps(vy, ft[1])), _mm_mul_ps(vz, ft[2]));
-  const __m128 ly = _mm_add_ps(_mm_add_ps(_mm_mul_ps(vx, fb3[0]), _mm_mul_ps(vy, fb3[1])), _mm_mul_ps(vz, fb3[2]));
-  const __m128 lz =
-      _mm_add_ps(_mm_add_ps(_mm_mul_ps(vx, fnrm[0]), _mm_mul_ps(vy, fnrm[1])), _mm_mul_ps(vz, fnrm[2]));
+  // 3. The texel: the sample's frame (frameFromNormal of its inward normal, as PositionSet::frame),
+  // toLocal, then texelFast.
+  const __m128 nx = vneg(bestX), ny = vneg(bestY), nz = vneg(bestZ);
+  const __m128 fs = sel(_mm_cmpge_ps(nz, zero), one, _mm_set1_ps(-1.0f));
+  const __m128 fA = vneg(_mm_div_ps(one, _mm_add_ps(fs, nz)));
+  const __m128 fk = _mm_mul_ps(_mm_mul_ps(nx, ny), fA);
+  const __m128 tx = _mm_add_ps(one, _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(fs, nx), nx), fA));
+  const __m128 ty = _mm_mul_ps(fs, fk), tz = _mm_mul_ps(vneg(fs), nx);
+  const __m128 bx = fk, by = _mm_add_ps(fs, _mm_mul_ps(_mm_mul_ps(ny, ny), fA)), bz = vneg(ny);
+  const __m128 lx = _mm_add_ps(_mm_add_ps(_mm_mul_ps(vx, tx), _mm_mul_ps(vy, ty)), _mm_mul_ps(vz, tz));
+  const __m128 ly = _mm_add_ps(_mm_add_ps(_mm_mul_ps(vx, bx), _mm_mul_ps(vy, by)), _mm_mul_ps(vz, bz));
+  const __m128 lz = _mm_add_ps(_mm_add_ps(_mm_mul_ps(vx, nx), _mm_mul_ps(vy, ny)), _mm_mul_ps(vz, nz));
   const __m128 z = _mm_max_ps(lz, zero);  // std::max(0.0f, z): 0 for NaN and -0
   __m128 a, b;
   if (tb.scheme == DirectionScheme::kHemiOctahedral) {

@@ -26,7 +26,6 @@ struct GroupTables {
   float radius = 0;
   uint32_t octaN = 0;               // octa-hemi2 parameter n; 0: another scheme (every hit ray is redone)
   const float* unit4 = nullptr;     // 4 floats per map: the unit position x, y, z and 0
-  const float* frame12 = nullptr;   // 12 floats per map: the frame's t, b, n, each padded to 4
   const uint8_t* octaMasks = nullptr;  // octaCandidateMasks(octaN) (fast_lookup.h); null: all eight
   DirectionScheme scheme = DirectionScheme::kInvalid;
   uint32_t m = 0;                   // map resolution
