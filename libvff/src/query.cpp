@@ -234,6 +234,8 @@ std::vector<uint32_t> queryNeighbours(const PositionSet& positions) {
   return out;
 }
 
+const char* batchKernelName() noexcept { return detail::groupKernelName(); }
+
 float defaultIntraBias(const FieldDesc& field) noexcept {
   if (field.mapCount == 0 || !(field.sphere.radius > 0)) return 0.0f;
   const float step = quantizationStep(field.distanceEncoding, 1.0f, 1.0f);

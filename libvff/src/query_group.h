@@ -43,8 +43,17 @@ struct Group {
   uint8_t redo[kGroupRays];    // the caller must run the reference prepare() on this ray
 };
 
-// True where prepareGroup is implemented (x86-64: SSE2). Elsewhere the caller uses prepare().
+// True where prepareGroup is implemented (x86-64). Elsewhere the caller uses prepare().
 bool groupKernelAvailable() noexcept;
+// The kernel prepareGroup runs: "avx2" (eight lanes, where the CPU has AVX2), "sse2" (four) or
+// "scalar" (none: prepare() per ray).
+const char* groupKernelName() noexcept;
+
+// For tests: force a kernel for the whole process. kAuto (the default) takes the widest the CPU
+// has; kSse2 the four-lane one; kNone makes groupKernelAvailable() false.
+enum class KernelChoice : uint8_t { kAuto = 0, kSse2 = 1, kNone = 2 };
+void forceGroupKernel(KernelChoice choice) noexcept;
+KernelChoice kernelOverride() noexcept;
 
 // Fills g for rays[0, n), n <= kGroupRays.
 void prepareGroup(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept;

@@ -88,9 +88,9 @@ int runBench(const Options& o) {
   const vff::FieldQuery& q = (*field)->query;
 
   std::printf("Query benchmark: %s (%zu triangles), field %s (%.2f MiB payload, baked in %.2f s), "
-              "%u rays per set, %u threads, best of %d\n\n",
+              "%u rays per set, %u threads, best of %d, batch kernel %s\n\n",
               o.mesh.c_str(), world->worldMesh.triangleCount(), config.name().c_str(), (*field)->payloadMiB(),
-              (*field)->bakeSeconds, o.benchRays, threads, o.repeat);
+              (*field)->bakeSeconds, o.benchRays, threads, o.repeat, vff::batchKernelName());
   std::printf("| ray set | query | Mrays/s | x Embree | occluded | agreement with Embree |\n");
   std::printf("|---|---|---:|---:|---:|---:|\n");
 

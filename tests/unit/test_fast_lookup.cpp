@@ -5,11 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <random>
 #include <vector>
 
 #include "../../libvff/src/fast_lookup.h"  // private: the fast paths against their references
+#include "../../libvff/src/query_group.h"  // private: choose the group kernel under test
 #include "test_util.h"
 #include "vff/vff.h"
 
@@ -245,7 +247,34 @@ std::vector<Ray> testRays(const FieldDesc& f, size_t count, uint32_t seed) {
   return rays;
 }
 
+// Restores the default kernel when a test ends, even a failed one.
+struct KernelScope {
+  explicit KernelScope(detail::KernelChoice c) { detail::forceGroupKernel(c); }
+  ~KernelScope() { detail::forceGroupKernel(detail::KernelChoice::kAuto); }
+};
+
+// Every kernel this CPU can run: the widest (AVX2 where present), SSE2, and none (per-ray prepare).
+void checkBatches(detail::KernelChoice choice);
+
 TEST(FastLookup, BatchesAnswerLikeTheReferenceLookup) {
+  const KernelScope scope(detail::KernelChoice::kAuto);
+  std::printf("group kernel: %s\n", detail::groupKernelName());
+  checkBatches(detail::KernelChoice::kAuto);
+}
+
+TEST(FastLookup, BatchesAnswerLikeTheReferenceLookupWithSse2Lanes) {
+  const KernelScope scope(detail::KernelChoice::kSse2);
+  std::printf("group kernel: %s\n", detail::groupKernelName());
+  checkBatches(detail::KernelChoice::kSse2);
+}
+
+TEST(FastLookup, BatchesAnswerLikeTheReferenceLookupWithoutGroupKernel) {
+  const KernelScope scope(detail::KernelChoice::kNone);
+  EXPECT_STREQ(detail::groupKernelName(), "scalar");
+  checkBatches(detail::KernelChoice::kNone);
+}
+
+void checkBatches(detail::KernelChoice) {
   for (uint32_t n : {1u, 5u, 32u}) {
     for (DirectionScheme scheme : {DirectionScheme::kConcentricEqualArea, DirectionScheme::kHemiOctahedral}) {
       FieldDesc f = test::smallField(DistanceEncoding::kUnorm8Diameter, NormalEncoding::kNone, n, 16);

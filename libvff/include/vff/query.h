@@ -38,6 +38,11 @@
 //
 // Threads. A FieldQuery is immutable after creation: every member function is const and may be
 // called from many threads at once. The batch functions run on the calling thread.
+//
+// Speed. Call the batch functions: they answer kNearest rays in groups, eight at a time in AVX2
+// where the CPU has it (four in SSE2 on other x86-64 CPUs), and fetch a group's texels from memory
+// together. They give bit for bit the answers of the one-ray functions. kInterpolated batches
+// answer one ray at a time.
 #pragma once
 
 #include <cstdint>
@@ -84,6 +89,9 @@ struct QueryOptions {
 // contacts.)
 float defaultIntraBias(const FieldDesc& field) noexcept;
 
+// The kernel the batch functions use for kNearest on this CPU: "avx2", "sse2" or "scalar".
+const char* batchKernelName() noexcept;
+
 // The neighbour lists kInterpolated blends over: for every positional sample, up to
 // kQueryNeighbours other samples around it (the samples nearest to two rings of probe directions
 // at 1 and 1.6 mean spacings), padded with UINT32_MAX: mapCount * kQueryNeighbours entries. A GPU
@@ -104,8 +112,9 @@ struct QueryHit {
 
 // A query-ready view of one field. Borrows its maps: from a File (which must outlive the
 // FieldQuery) or from caller memory. Holds a small table per positional sample (its position,
-// tangent frame and neighbour list: 80 bytes per map) and, for unorm8-chord, the decode scale of
-// each texel of a map (4 bytes per texel of one map).
+// twice, tangent frame and neighbour list: 96 bytes per map), for octa-hemi2 n <= 128 one byte
+// per cell of the sample grid (n^2 bytes) and, for unorm8-chord, the decode scale of each texel of
+// a map (4 bytes per texel of one map).
 class FieldQuery {
  public:
   FieldQuery() noexcept;  // empty: every ray misses

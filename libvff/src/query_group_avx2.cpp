@@ -1,0 +1,91 @@
+// The group kernel (query_group_kernel.h) with eight AVX2 lanes. This file alone is compiled with
+// -mavx2 (not -mfma: no operation may be fused); query_group.cpp calls it only on a CPU with AVX2.
+// It constructs no object of a type declared outside it, so that no inline function compiled here
+// can stand in for the baseline copy used elsewhere.
+#include "query_group.h"
+
+#if defined(__AVX2__)
+#include <immintrin.h>
+
+namespace vff::detail {
+namespace {
+
+struct F8 {
+  static constexpr size_t kLanes = 8;
+  __m256 v;
+  F8() = default;
+  F8(__m256 x) : v(x) {}  // NOLINT: implicit, so that intrinsics' results are lanes
+  explicit F8(float x) : v(_mm256_set1_ps(x)) {}
+};
+
+inline F8 operator+(F8 a, F8 b) { return _mm256_add_ps(a.v, b.v); }
+inline F8 operator-(F8 a, F8 b) { return _mm256_sub_ps(a.v, b.v); }
+inline F8 operator*(F8 a, F8 b) { return _mm256_mul_ps(a.v, b.v); }
+inline F8 operator/(F8 a, F8 b) { return _mm256_div_ps(a.v, b.v); }
+inline F8 vsqrt(F8 a) { return _mm256_sqrt_ps(a.v); }
+inline F8 vmin(F8 a, F8 b) { return _mm256_min_ps(a.v, b.v); }  // a < b ? a : b, as SSE2
+inline F8 vmax(F8 a, F8 b) { return _mm256_max_ps(a.v, b.v); }  // a > b ? a : b, as SSE2
+inline F8 gt(F8 a, F8 b) { return _mm256_cmp_ps(a.v, b.v, _CMP_GT_OQ); }
+inline F8 ge(F8 a, F8 b) { return _mm256_cmp_ps(a.v, b.v, _CMP_GE_OQ); }
+inline F8 lt(F8 a, F8 b) { return _mm256_cmp_ps(a.v, b.v, _CMP_LT_OQ); }
+inline F8 le(F8 a, F8 b) { return _mm256_cmp_ps(a.v, b.v, _CMP_LE_OQ); }
+inline F8 eq(F8 a, F8 b) { return _mm256_cmp_ps(a.v, b.v, _CMP_EQ_OQ); }
+inline F8 nlt(F8 a, F8 b) { return _mm256_cmp_ps(a.v, b.v, _CMP_NLT_UQ); }  // !(a < b): true for NaN
+inline F8 ngt(F8 a, F8 b) { return _mm256_cmp_ps(a.v, b.v, _CMP_NGT_UQ); }  // !(a > b): true for NaN
+inline F8 band(F8 a, F8 b) { return _mm256_and_ps(a.v, b.v); }
+inline F8 bor(F8 a, F8 b) { return _mm256_or_ps(a.v, b.v); }
+inline F8 bandnot(F8 a, F8 b) { return _mm256_andnot_ps(a.v, b.v); }  // ~a & b
+inline F8 bnot(F8 a) { return _mm256_xor_ps(a.v, _mm256_castsi256_ps(_mm256_set1_epi32(-1))); }
+inline F8 sel(F8 m, F8 a, F8 b) { return _mm256_blendv_ps(b.v, a.v, m.v); }  // masks are all-ones or zero
+inline F8 vabs(F8 a) { return _mm256_and_ps(a.v, _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff))); }
+inline F8 vneg(F8 a) { return _mm256_xor_ps(a.v, _mm256_set1_ps(-0.0f)); }
+inline F8 floorPos(F8 a) { return _mm256_cvtepi32_ps(_mm256_cvttps_epi32(a.v)); }  // 0 <= a < 2^31
+inline F8 load(const float* p) { return _mm256_loadu_ps(p); }
+inline void store(float* p, F8 a) { _mm256_storeu_ps(p, a.v); }
+inline void storeInt(int32_t* p, F8 a) { _mm256_store_si256(reinterpret_cast<__m256i*>(p), _mm256_cvttps_epi32(a.v)); }
+inline unsigned movemask(F8 a) { return unsigned(_mm256_movemask_ps(a.v)); }
+
+// Positions unit4[4 k .. 4 k + 2] of the lanes' samples k (integer-valued floats).
+inline void gatherUnit(const float* unit4, F8 k, F8* x, F8* y, F8* z) {
+  const __m256i idx = _mm256_slli_epi32(_mm256_cvttps_epi32(k.v), 2);
+  *x = _mm256_i32gather_ps(unit4, idx, 4);
+  *y = _mm256_i32gather_ps(unit4 + 1, idx, 4);
+  *z = _mm256_i32gather_ps(unit4 + 2, idx, 4);
+}
+
+// Eight rays of eight floats each (origin, direction, tmin, tmax), transposed.
+inline void loadRays(const float* p, F8* ox, F8* oy, F8* oz, F8* dx, F8* dy, F8* dz, F8* tmin, F8* tmax) {
+  __m256 r[8];
+  for (int i = 0; i < 8; ++i) r[i] = _mm256_loadu_ps(p + 8 * i);
+  const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
+  const __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
+  const __m256 t4 = _mm256_unpacklo_ps(r[4], r[5]), t5 = _mm256_unpackhi_ps(r[4], r[5]);
+  const __m256 t6 = _mm256_unpacklo_ps(r[6], r[7]), t7 = _mm256_unpackhi_ps(r[6], r[7]);
+  const __m256 u0 = _mm256_shuffle_ps(t0, t2, 0x44), u1 = _mm256_shuffle_ps(t0, t2, 0xEE);
+  const __m256 u2 = _mm256_shuffle_ps(t1, t3, 0x44), u3 = _mm256_shuffle_ps(t1, t3, 0xEE);
+  const __m256 u4 = _mm256_shuffle_ps(t4, t6, 0x44), u5 = _mm256_shuffle_ps(t4, t6, 0xEE);
+  const __m256 u6 = _mm256_shuffle_ps(t5, t7, 0x44), u7 = _mm256_shuffle_ps(t5, t7, 0xEE);
+  *ox = _mm256_permute2f128_ps(u0, u4, 0x20);
+  *oy = _mm256_permute2f128_ps(u1, u5, 0x20);
+  *oz = _mm256_permute2f128_ps(u2, u6, 0x20);
+  *dx = _mm256_permute2f128_ps(u3, u7, 0x20);
+  *dy = _mm256_permute2f128_ps(u0, u4, 0x31);
+  *dz = _mm256_permute2f128_ps(u1, u5, 0x31);
+  *tmin = _mm256_permute2f128_ps(u2, u6, 0x31);
+  *tmax = _mm256_permute2f128_ps(u3, u7, 0x31);
+}
+
+}  // namespace
+}  // namespace vff::detail
+
+#include "query_group_kernel.h"
+
+namespace vff::detail {
+
+void prepareGroupAvx2(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept {
+  prepareGroupWith<F8>(tables, rays, n, g);
+}
+
+}  // namespace vff::detail
+
+#endif

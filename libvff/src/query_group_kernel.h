@@ -1,0 +1,291 @@
+// query_group_kernel.h - the group kernel of query_group.h, written once for any SIMD width.
+//
+// Included by query_group_sse2.cpp (four lanes) and query_group_avx2.cpp (eight lanes, compiled
+// for AVX2 and called only where the CPU has it). Everything here sits in an anonymous namespace,
+// so each of those files gets its own copy compiled for its own instruction set, and no function
+// compiled for AVX2 can be shared with code that runs on a CPU without it.
+//
+// The lane type F (a float vector with +, -, *, / and the free functions used below) is defined by
+// the including file. Every line mirrors a line of FieldQuery::Impl::prepare() or of
+// fast_lookup.h with the same binary32 operations in the same order (a ? b : c becomes
+// sel(mask, b, c); no operation is fused or reordered), so that a lane computes bit for bit what
+// prepare() computes for that ray, and the two files compute the same bits.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+
+#include "fast_lookup.h"
+#include "query_group.h"
+
+namespace vff::detail {
+namespace {
+
+// std::max(a, b) as prepare() evaluates it: a < b ? b : a.
+template <class F>
+inline F maxStd(F a, F b) {
+  return sel(lt(a, b), b, a);
+}
+
+// atanUnit of fast_lookup.h, per lane.
+template <class F>
+inline F atanUnitV(F t) {
+  const F at = vabs(t);
+  const F big = gt(at, F(0.41421356f));
+  const F one(1.0f);
+  const F x = sel(big, (at - one) / (at + one), at);
+  const F y0 = band(big, F(0.78539816f));
+  const F z = x * x;
+  const F p = (((F(8.05374449538e-2f) * z - F(1.38776856032e-1f)) * z + F(1.99777106478e-1f)) * z -
+               F(3.33329491539e-1f)) * z * x + x;
+  const F r = y0 + p;
+  return sel(lt(t, F(0.0f)), vneg(r), r);
+}
+
+// The rays of a group that reach the sphere, packed: their entry points and lookup directions.
+struct Packed {
+  static constexpr size_t kSize = kGroupRays + 8;
+  float eux[kSize], euy[kSize], euz[kSize], vx[kSize], vy[kSize], vz[kSize];
+  uint32_t ray[kSize];
+  size_t count = 0;
+};
+
+// Step 1 for F::kLanes rays starting at rays[0] (all readable), lanes r0 .. of g: the sphere;
+// appends the rays that reach it to `packed`.
+template <class F>
+void sphereStep(const GroupTables& tb, const Ray* rays, Group* g, size_t r0, Packed* packed) {
+  constexpr size_t L = F::kLanes;
+  F ox, oy, oz, dx, dy, dz, tmin, tmax;
+  loadRays(reinterpret_cast<const float*>(rays), &ox, &oy, &oz, &dx, &dy, &dz, &tmin, &tmax);
+  const F zero(0.0f), one(1.0f);
+
+  // prepare(): the ray's length and unit direction.
+  const F len = vsqrt(dx * dx + dy * dy + dz * dz);
+  F live = band(gt(len, zero), le(len, F(3.40282347e38f)));
+  const F inv = one / len;
+  const F wx = dx * inv, wy = dy * inv, wz = dz * inv;
+  const F tminL = tmin * len, tmaxL = tmax * len;
+  // 1. The sphere.
+  const F cx(tb.center.x), cy(tb.center.y), cz(tb.center.z);
+  const F ex = ox - cx, ey = oy - cy, ez = oz - cz;
+  const F beta = ex * wx + ey * wy + ez * wz;
+  const F gamma = (ex * ex + ey * ey + ez * ez) - F(tb.radius * tb.radius);
+  const F disc = beta * beta - gamma;
+  live = band(live, ge(disc, zero));
+  const F sq = vsqrt(disc);
+  const F nbeta = vneg(beta);
+  const F t1 = nbeta + sq;
+  live = band(live, nlt(t1, zero));
+  const F inside = le(gamma, zero);
+  const F t0 = sel(inside, t1, maxStd(nbeta - sq, zero));
+  const F lo = sel(inside, maxStd(tminL, F(tb.insideLo)), tminL);
+  if (tb.bit1) live = bandnot(inside, live);
+  live = bandnot(bandnot(inside, gt(t0, tmaxL)), live);
+  const F vx = sel(inside, vneg(wx), wx), vy = sel(inside, vneg(wy), wy), vz = sel(inside, vneg(wz), wz);
+  const F invR(1.0f / tb.radius);
+  const F eux = ((ox + wx * t0) - cx) * invR;
+  const F euy = ((oy + wy * t0) - cy) * invR;
+  const F euz = ((oz + wz * t0) - cz) * invR;
+  store(g->t0 + r0, t0);
+  store(g->lo + r0, lo);
+  store(g->hi + r0, tmaxL);
+  store(g->len + r0, len);
+  const unsigned bits = movemask(live), in = movemask(inside);
+  for (size_t l = 0; l < L; ++l) {
+    g->live[r0 + l] = uint8_t((bits >> l) & 1u);
+    g->inside[r0 + l] = uint8_t((in >> l) & 1u);
+    g->redo[r0 + l] = 0;
+  }
+  if (bits == 0) return;
+  alignas(32) float e[6][L];
+  store(e[0], eux);
+  store(e[1], euy);
+  store(e[2], euz);
+  store(e[3], vx);
+  store(e[4], vy);
+  store(e[5], vz);
+  for (size_t l = 0; l < L; ++l) {
+    if (!((bits >> l) & 1u)) continue;
+    const size_t slot = packed->count++;
+    packed->eux[slot] = e[0][l];
+    packed->euy[slot] = e[1][l];
+    packed->euz[slot] = e[2][l];
+    packed->vx[slot] = e[3][l];
+    packed->vy[slot] = e[4][l];
+    packed->vz[slot] = e[5][l];
+    packed->ray[slot] = uint32_t(r0 + l);
+  }
+}
+
+// Steps 2 and 3 for packed rays p .. p + kLanes - 1 (all valid; the caller pads the last ones):
+// the nearest sample (octaNearestFast) and the texel (texelFast). Writes k, i, j and redo of the
+// first `lanes` of them into g.
+template <class F>
+void lookupStep(const GroupTables& tb, const Packed& pk, size_t p, size_t lanes, Group* g) {
+  constexpr size_t L = F::kLanes;
+  const F zero(0.0f), one(1.0f);
+  const F eux = load(pk.eux + p), euy = load(pk.euy + p), euz = load(pk.euz + p);
+  const F vx = load(pk.vx + p), vy = load(pk.vy + p), vz = load(pk.vz + p);
+
+  // 2. The nearest sample.
+  const float fnS = float(tb.octaN);
+  const F fn(fnS);
+  const F ax = vabs(eux), ay = vabs(euy), az = vabs(euz);
+  const F l1 = ax + ay + az;
+  F redo = bnot(band(gt(l1, zero), lt(l1, F(3.0e38f))));
+  const F pa = ax / l1 * fn, pb = ay / l1 * fn;
+  const F fa = floorPos(pa), fb = floorPos(pb);
+  const F gg(kGridGuard);
+  redo = bor(redo, bor(bor(lt(pa - fa, gg), lt((fa + one) - pa, gg)), bor(lt(pb - fb, gg), lt((fb + one) - pb, gg))));
+  const F a0 = vmin(fa, fn - one), b0 = vmin(fb, fn - one);
+  const F h = bandnot(ge(euz, zero), one);  // 0 upper, 1 lower hemisphere
+  const F negX = lt(eux, zero), negY = lt(euy, zero);
+  const F hemi(float(2 * tb.octaN * tb.octaN + 2 * tb.octaN + 1));
+  const F use = bnot(redo);
+  // The candidates any lane needs (octaCandidateMasks); lanes not in use look up sample 0.
+  unsigned needed = 0xFF;
+  if (tb.octaMasks) {
+    alignas(32) int32_t ca[L], cb[L];
+    storeInt(ca, band(use, a0));
+    storeInt(cb, band(use, b0));
+    needed = 0;
+    const unsigned useBits = movemask(use);
+    for (size_t l = 0; l < L; ++l)
+      if ((useBits >> l) & 1u) needed |= tb.octaMasks[size_t(cb[l]) * tb.octaN + size_t(ca[l])];
+  }
+  F bestD(-INFINITY), bestK(3.0e38f), bestX = zero, bestY = zero, bestZ = one;
+  F any = zero;
+  for (unsigned ci = 0; ci < 8; ++ci) {
+    if (!((needed >> ci) & 1u)) continue;
+    const F a = a0 + F(float(kOctaCandidates[ci][0])), b = b0 + F(float(kOctaCandidates[ci][1]));
+    const F aa = vabs(a), ab = vabs(b), sum = aa + ab;
+    const F valid = band(le(sum, fn), use);
+    const F i = sel(negX, vneg(a), a), j = sel(negY, vneg(b), b);
+    const F hh = bandnot(eq(sum, fn), h);
+    const F t = fn + j;
+    const F tt = t * t;
+    const F row = sel(le(j, zero), tt, tt - F(2.0f) * j * (j - one));
+    const F w = fn - vabs(j);
+    const F k = band(valid, hh * hemi + row + i + w);
+    F ux, uy, uz;
+    gatherUnit(tb.unit4, k, &ux, &uy, &uz);
+    const F d = ux * eux + uy * euy + uz * euz;
+    const F better = band(valid, bor(gt(d, bestD), band(eq(d, bestD), lt(k, bestK))));
+    bestD = sel(better, d, bestD);
+    bestK = sel(better, k, bestK);
+    bestX = sel(better, ux, bestX);
+    bestY = sel(better, uy, bestY);
+    bestZ = sel(better, uz, bestZ);
+    any = bor(any, valid);
+  }
+  redo = bor(redo, bandnot(any, use));
+
+  // 3. The texel: the sample's frame (frameFromNormal of its inward normal, as
+  // PositionSet::frame), toLocal, then texelFast.
+  const F nx = vneg(bestX), ny = vneg(bestY), nz = vneg(bestZ);
+  const F fs = sel(ge(nz, zero), one, F(-1.0f));
+  const F fA = vneg(one / (fs + nz));
+  const F fk = nx * ny * fA;
+  const F tx = one + fs * nx * nx * fA, ty = fs * fk, tz = vneg(fs) * nx;
+  const F bx = fk, by = fs + ny * ny * fA, bz = vneg(ny);
+  const F lx = vx * tx + vy * ty + vz * tz;
+  const F ly = vx * bx + vy * by + vz * bz;
+  const F lz = vx * nx + vy * ny + vz * nz;
+  const F z = vmax(lz, zero);  // std::max(0.0f, z): 0 for NaN and -0
+  F a, b;
+  if (tb.scheme == DirectionScheme::kHemiOctahedral) {
+    const F hinv = one / (vabs(lx) + vabs(ly) + z);
+    const F x = lx * hinv, y = ly * hinv;
+    a = x + y;
+    b = x - y;
+  } else {
+    const F r = vsqrt(vmax(one - z, zero));
+    const F lax = vabs(lx), lay = vabs(ly);
+    redo = bor(redo, ngt(vabs(lax - lay), F(1e-5f) * (lax + lay)));  // octant diagonals
+    const F k = r * F(4.0f / 3.14159265358979323846f);
+    const F bigX = gt(lax, lay);
+    const F s = atanUnitV(sel(bigX, ly, lx) / sel(bigX, lx, ly)) * k;
+    const F xNeg = lt(lx, zero), yNeg = lt(ly, zero);
+    a = sel(bigX, sel(xNeg, vneg(r), r), sel(yNeg, vneg(s), s));
+    b = sel(bigX, sel(xNeg, vneg(s), s), sel(yNeg, vneg(r), r));
+  }
+  const F mone(-1.0f);
+  a = vmin(vmax(a, mone), one);
+  b = vmin(vmax(b, mone), one);
+  const float fmS = float(tb.m);
+  const F fm(fmS), half(0.5f);
+  const F x = (a + one) * half * fm, y = (b + one) * half * fm;
+  const F fx = floorPos(x), fy = floorPos(y);
+  const F tg(kTexelGuard + 2e-6f * fmS);
+  redo = bor(redo, bor(bor(lt(x - fx, tg), lt((fx + one) - x, tg)), bor(lt(y - fy, tg), lt((fy + one) - y, tg))));
+  const F top(fmS - 1.0f);
+  const F ok = bnot(redo);
+  alignas(32) int32_t tk[L], ti[L], tj[L];
+  storeInt(tk, band(ok, bestK));
+  storeInt(ti, band(ok, vmin(vmax(fx, zero), top)));
+  storeInt(tj, band(ok, vmin(vmax(fy, zero), top)));
+  const unsigned redoBits = movemask(redo);
+  for (size_t l = 0; l < lanes; ++l) {
+    const uint32_t r = pk.ray[p + l];
+    g->k[r] = uint32_t(tk[l]);
+    g->i[r] = uint32_t(ti[l]);
+    g->j[r] = uint32_t(tj[l]);
+    g->redo[r] = uint8_t((redoBits >> l) & 1u);
+  }
+}
+
+// prepareGroup (query_group.h) with lanes F.
+template <class F>
+void prepareGroupWith(const GroupTables& tb, const Ray* rays, size_t n, Group* g) {
+  constexpr size_t L = F::kLanes;
+  Packed packed;
+  size_t r = 0;
+  for (; r + L <= n; r += L) sphereStep<F>(tb, rays + r, g, r, &packed);
+  if (r < n) {
+    // Zero directions are not live. (Floats, not Rays: no Ray constructor is compiled here.)
+    alignas(32) float tail[L * 8] = {};
+    std::memcpy(tail, rays + r, (n - r) * sizeof(Ray));
+    Group scratch;
+    Packed tailPacked;
+    sphereStep<F>(tb, reinterpret_cast<const Ray*>(tail), &scratch, 0, &tailPacked);
+    for (size_t l = 0; r + l < n; ++l) {
+      g->t0[r + l] = scratch.t0[l];
+      g->lo[r + l] = scratch.lo[l];
+      g->hi[r + l] = scratch.hi[l];
+      g->len[r + l] = scratch.len[l];
+      g->live[r + l] = scratch.live[l];
+      g->inside[r + l] = scratch.inside[l];
+      g->redo[r + l] = 0;
+    }
+    for (size_t l = 0; l < tailPacked.count; ++l) {
+      const size_t slot = packed.count++;
+      packed.eux[slot] = tailPacked.eux[l];
+      packed.euy[slot] = tailPacked.euy[l];
+      packed.euz[slot] = tailPacked.euz[l];
+      packed.vx[slot] = tailPacked.vx[l];
+      packed.vy[slot] = tailPacked.vy[l];
+      packed.vz[slot] = tailPacked.vz[l];
+      packed.ray[slot] = uint32_t(r + tailPacked.ray[l]);
+    }
+  }
+  if (packed.count == 0) return;
+  if (tb.octaN == 0) {  // another scheme: the reference does the rest
+    for (size_t p = 0; p < packed.count; ++p) g->redo[packed.ray[p]] = 1;
+    return;
+  }
+  // Pad the last lanes with copies of the last live ray (their answers are not stored).
+  const size_t last = packed.count - 1;
+  for (size_t p = packed.count; p % L != 0; ++p) {
+    packed.eux[p] = packed.eux[last];
+    packed.euy[p] = packed.euy[last];
+    packed.euz[p] = packed.euz[last];
+    packed.vx[p] = packed.vx[last];
+    packed.vy[p] = packed.vy[last];
+    packed.vz[p] = packed.vz[last];
+  }
+  for (size_t p = 0; p < packed.count; p += L) lookupStep<F>(tb, packed, p, packed.count - p < L ? packed.count - p : L, g);
+}
+
+}  // namespace
+}  // namespace vff::detail

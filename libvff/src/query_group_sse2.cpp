@@ -1,0 +1,87 @@
+// The group kernel (query_group_kernel.h) with four SSE2 lanes: every x86-64 CPU has them.
+#include "query_group.h"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#include <xmmintrin.h>
+
+namespace vff::detail {
+namespace {
+
+struct F4 {
+  static constexpr size_t kLanes = 4;
+  __m128 v;
+  F4() = default;
+  F4(__m128 x) : v(x) {}  // NOLINT: implicit, so that intrinsics' results are lanes
+  explicit F4(float x) : v(_mm_set1_ps(x)) {}
+};
+
+inline F4 operator+(F4 a, F4 b) { return _mm_add_ps(a.v, b.v); }
+inline F4 operator-(F4 a, F4 b) { return _mm_sub_ps(a.v, b.v); }
+inline F4 operator*(F4 a, F4 b) { return _mm_mul_ps(a.v, b.v); }
+inline F4 operator/(F4 a, F4 b) { return _mm_div_ps(a.v, b.v); }
+inline F4 vsqrt(F4 a) { return _mm_sqrt_ps(a.v); }
+inline F4 vmin(F4 a, F4 b) { return _mm_min_ps(a.v, b.v); }  // a < b ? a : b
+inline F4 vmax(F4 a, F4 b) { return _mm_max_ps(a.v, b.v); }  // a > b ? a : b
+inline F4 gt(F4 a, F4 b) { return _mm_cmpgt_ps(a.v, b.v); }
+inline F4 ge(F4 a, F4 b) { return _mm_cmpge_ps(a.v, b.v); }
+inline F4 lt(F4 a, F4 b) { return _mm_cmplt_ps(a.v, b.v); }
+inline F4 le(F4 a, F4 b) { return _mm_cmple_ps(a.v, b.v); }
+inline F4 eq(F4 a, F4 b) { return _mm_cmpeq_ps(a.v, b.v); }
+inline F4 nlt(F4 a, F4 b) { return _mm_cmpnlt_ps(a.v, b.v); }  // !(a < b): true for NaN
+inline F4 ngt(F4 a, F4 b) { return _mm_cmpngt_ps(a.v, b.v); }  // !(a > b): true for NaN
+inline F4 band(F4 a, F4 b) { return _mm_and_ps(a.v, b.v); }
+inline F4 bor(F4 a, F4 b) { return _mm_or_ps(a.v, b.v); }
+inline F4 bandnot(F4 a, F4 b) { return _mm_andnot_ps(a.v, b.v); }  // ~a & b
+inline F4 bnot(F4 a) { return _mm_xor_ps(a.v, _mm_castsi128_ps(_mm_set1_epi32(-1))); }
+inline F4 sel(F4 m, F4 a, F4 b) { return _mm_or_ps(_mm_and_ps(m.v, a.v), _mm_andnot_ps(m.v, b.v)); }
+inline F4 vabs(F4 a) { return _mm_and_ps(a.v, _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff))); }
+inline F4 vneg(F4 a) { return _mm_xor_ps(a.v, _mm_set1_ps(-0.0f)); }
+inline F4 floorPos(F4 a) { return _mm_cvtepi32_ps(_mm_cvttps_epi32(a.v)); }  // 0 <= a < 2^31
+inline F4 load(const float* p) { return _mm_loadu_ps(p); }
+inline void store(float* p, F4 a) { _mm_storeu_ps(p, a.v); }
+inline void storeInt(int32_t* p, F4 a) { _mm_store_si128(reinterpret_cast<__m128i*>(p), _mm_cvttps_epi32(a.v)); }
+inline unsigned movemask(F4 a) { return unsigned(_mm_movemask_ps(a.v)); }
+
+// Positions unit4[4 k .. 4 k + 2] of the lanes' samples k (integer-valued floats).
+inline void gatherUnit(const float* unit4, F4 k, F4* x, F4* y, F4* z) {
+  alignas(16) int32_t idx[4];
+  storeInt(idx, k);
+  __m128 r0 = _mm_loadu_ps(unit4 + 4 * size_t(idx[0])), r1 = _mm_loadu_ps(unit4 + 4 * size_t(idx[1]));
+  __m128 r2 = _mm_loadu_ps(unit4 + 4 * size_t(idx[2])), r3 = _mm_loadu_ps(unit4 + 4 * size_t(idx[3]));
+  _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+  *x = r0;
+  *y = r1;
+  *z = r2;
+}
+
+// Four rays of eight floats each (origin, direction, tmin, tmax), transposed.
+inline void loadRays(const float* p, F4* ox, F4* oy, F4* oz, F4* dx, F4* dy, F4* dz, F4* tmin, F4* tmax) {
+  __m128 a0 = _mm_loadu_ps(p), a1 = _mm_loadu_ps(p + 8), a2 = _mm_loadu_ps(p + 16), a3 = _mm_loadu_ps(p + 24);
+  _MM_TRANSPOSE4_PS(a0, a1, a2, a3);
+  __m128 b0 = _mm_loadu_ps(p + 4), b1 = _mm_loadu_ps(p + 12), b2 = _mm_loadu_ps(p + 20), b3 = _mm_loadu_ps(p + 28);
+  _MM_TRANSPOSE4_PS(b0, b1, b2, b3);
+  *ox = a0;
+  *oy = a1;
+  *oz = a2;
+  *dx = a3;
+  *dy = b0;
+  *dz = b1;
+  *tmin = b2;
+  *tmax = b3;
+}
+
+}  // namespace
+}  // namespace vff::detail
+
+#include "query_group_kernel.h"
+
+namespace vff::detail {
+
+void prepareGroupSse2(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept {
+  prepareGroupWith<F4>(tables, rays, n, g);
+}
+
+}  // namespace vff::detail
+
+#endif
