@@ -510,6 +510,8 @@ detail::GroupTables FieldQuery::Impl::groupTables(const QueryOptions& o) const n
   t.m = m;
   t.bit1 = field.distanceEncoding == DistanceEncoding::kBit1;
   t.insideLo = (o.intraBias >= 0 ? o.intraBias : defaultBias) * radius;
+  t.maps = dist.data();
+  t.encoding = field.distanceEncoding;
   return t;
 }
 
@@ -537,29 +539,49 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
   for (size_t base = 0; base < rays.size(); base += detail::kGroupRays) {
     const size_t n = std::min(detail::kGroupRays, rays.size() - base);
     detail::prepareGroup(tables, rays.data() + base, n, &g);
+    // Every ray misses unless it reaches the sphere.
+    uint64_t reached = 0;
+    for (uint32_t p = 0; p < g.count; ++p) reached |= uint64_t(1) << g.ray[p];
     for (size_t r = 0; r < n; ++r) {
-      if (g.redo[r]) {
-        Lookup l;
-        g.live[r] = prepare(rays[base + r], o, &l);
-        g.k[r] = l.k0;
-        g.i[r] = l.i;
-        g.j[r] = l.j;
-        g.t0[r] = l.t0;
-        g.lo[r] = l.lo;
-        g.hi[r] = l.hi;
-        g.len[r] = l.len;
-        g.inside[r] = l.inside;
-      }
-      if (g.live[r]) __builtin_prefetch(texelAddress(g.k[r], g.i[r], g.j[r]));
-    }
-    for (size_t r = 0; r < n; ++r) {
+      if ((reached >> r) & 1u) continue;
       if constexpr (kHitOnly) {
-        emit(base + r, g.live[r] && hitsAt(g.k[r], g.i[r], g.j[r], g.t0[r], g.inside[r] != 0, g.lo[r], g.hi[r]));
+        emit(base + r, false);
+      } else {
+        emit(base + r, QueryHit{}, 1.0f);
+      }
+    }
+    // The rays the kernel left to the reference.
+    uint64_t dead = 0;
+    for (uint64_t redo = g.redo; redo != 0; redo &= redo - 1) {
+      const uint32_t p = uint32_t(__builtin_ctzll(redo)), r = g.ray[p];
+      Lookup l;
+      if (!prepare(rays[base + r], o, &l)) {
+        dead |= uint64_t(1) << p;
+        continue;
+      }
+      g.k[p] = l.k0;
+      g.i[p] = l.i;
+      g.j[p] = l.j;
+      g.t0[r] = l.t0;
+      g.lo[r] = l.lo;
+      g.hi[r] = l.hi;
+      g.len[r] = l.len;
+      g.inside = (g.inside & ~(uint64_t(1) << r)) | (uint64_t(l.inside) << r);
+    }
+    for (uint64_t redo = g.redo; redo != 0; redo &= redo - 1) {  // the kernel prefetched the others
+      const uint32_t p = uint32_t(__builtin_ctzll(redo));
+      __builtin_prefetch(texelAddress(g.k[p], g.i[p], g.j[p]));
+    }
+    for (uint32_t p = 0; p < g.count; ++p) {
+      const uint32_t r = g.ray[p];
+      const bool live = !((dead >> p) & 1u), inside = (g.inside >> r) & 1u;
+      if constexpr (kHitOnly) {
+        emit(base + r, live && hitsAt(g.k[p], g.i[p], g.j[p], g.t0[r], inside, g.lo[r], g.hi[r]));
       } else {
         float vis = 1.0f;
-        const QueryHit h = g.live[r] ? hitAt(rays[base + r], g.k[r], g.i[r], g.j[r], g.t0[r], g.inside[r] != 0,
-                                             g.lo[r], g.hi[r], g.len[r], &vis)
-                                     : QueryHit{};
+        const QueryHit h =
+            live ? hitAt(rays[base + r], g.k[p], g.i[p], g.j[p], g.t0[r], inside, g.lo[r], g.hi[r], g.len[r], &vis)
+                 : QueryHit{};
         emit(base + r, h, vis);
       }
     }

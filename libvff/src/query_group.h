@@ -31,17 +31,25 @@ struct GroupTables {
   uint32_t m = 0;                   // map resolution
   bool bit1 = false;                // the distance encoding has no distances (rays from inside miss)
   float insideLo = 0;               // intra-object bias times the radius (QueryOptions::intraBias)
+  // The distance maps, to prefetch the texels while the group is being looked up (null: none).
+  const uint8_t* const* maps = nullptr;
+  DistanceEncoding encoding = DistanceEncoding::kInvalid;
 };
 
-// The state of up to kGroupRays rays (structure of arrays). Distances are along the unit
-// direction, as in prepare(): t = (t0 + sign * d) / len for a texel distance d.
+// The state of up to kGroupRays rays. Per ray r (bit r of the masks, entry r of the arrays): the
+// sphere. Then, packed (entry p, for p < count): the rays that reach the sphere, in order, with
+// their texels. Distances are along the unit direction, as in prepare(): a texel distance d
+// gives t = (t0 +- d) / len (minus from inside).
 struct Group {
+  static constexpr size_t kSlack = 8;  // the kernels store whole vectors past `count`
   float t0[kGroupRays], lo[kGroupRays], hi[kGroupRays], len[kGroupRays];
-  uint32_t k[kGroupRays], i[kGroupRays], j[kGroupRays];
-  uint8_t live[kGroupRays];    // the ray reaches a texel (false: it misses; final unless redo)
-  uint8_t inside[kGroupRays];  // the origin is inside the sphere (the lookup is reversed)
-  uint8_t redo[kGroupRays];    // the caller must run the reference prepare() on this ray
+  uint64_t inside = 0;  // the origin is inside the sphere (the lookup is reversed)
+  uint32_t count = 0;   // rays that reach the sphere (all others miss)
+  uint32_t ray[kGroupRays + kSlack];  // their indices
+  uint32_t k[kGroupRays + kSlack], i[kGroupRays + kSlack], j[kGroupRays + kSlack];  // their texels
+  uint64_t redo = 0;    // bit p: the caller must run the reference prepare() on packed ray p
 };
+static_assert(kGroupRays <= 64, "the masks hold one bit per ray");
 
 // True where prepareGroup is implemented (x86-64). Elsewhere the caller uses prepare().
 bool groupKernelAvailable() noexcept;

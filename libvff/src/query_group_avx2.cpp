@@ -42,8 +42,40 @@ inline F8 vneg(F8 a) { return _mm256_xor_ps(a.v, _mm256_set1_ps(-0.0f)); }
 inline F8 floorPos(F8 a) { return _mm256_cvtepi32_ps(_mm256_cvttps_epi32(a.v)); }  // 0 <= a < 2^31
 inline F8 load(const float* p) { return _mm256_loadu_ps(p); }
 inline void store(float* p, F8 a) { _mm256_storeu_ps(p, a.v); }
-inline void storeInt(int32_t* p, F8 a) { _mm256_store_si256(reinterpret_cast<__m256i*>(p), _mm256_cvttps_epi32(a.v)); }
+inline void storeInt(int32_t* p, F8 a) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), _mm256_cvttps_epi32(a.v)); }
 inline unsigned movemask(F8 a) { return unsigned(_mm256_movemask_ps(a.v)); }
+
+// For every 8-bit mask, the lanes it selects, in order, packed into the low nibbles of a word
+// (lane of position q in bits 4q .. 4q + 3).
+constexpr uint32_t packedLanes(unsigned mask) {
+  uint32_t word = 0;
+  unsigned q = 0;
+  for (unsigned l = 0; l < 8; ++l)
+    if ((mask >> l) & 1u) word |= l << (4 * q++);
+  return word;
+}
+struct LaneTable {
+  uint32_t word[256];
+  constexpr LaneTable() : word() {
+    for (unsigned m = 0; m < 256; ++m) word[m] = packedLanes(m);
+  }
+};
+constexpr LaneTable kLaneOrder{};
+
+inline __m256i lanePermutation(unsigned mask) {
+  const __m256i nibbles = _mm256_set1_epi32(int32_t(kLaneOrder.word[mask]));
+  const __m256i shifts = _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28);
+  return _mm256_and_si256(_mm256_srlv_epi32(nibbles, shifts), _mm256_set1_epi32(7));
+}
+// Stores the lanes of `a` selected by `mask`, in order, at dst[0 ..] (writes 8 floats).
+inline void compress(float* dst, F8 a, unsigned mask) {
+  _mm256_storeu_ps(dst, _mm256_permutevar8x32_ps(a.v, lanePermutation(mask)));
+}
+// Stores first + l for the lanes l selected by `mask`, in order, at dst[0 ..] (writes 8 words).
+inline void compressIndex(uint32_t* dst, uint32_t first, unsigned mask) {
+  const __m256i lanes = _mm256_add_epi32(lanePermutation(mask), _mm256_set1_epi32(int32_t(first)));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(dst), lanes);
+}
 
 // Positions unit4[4 k .. 4 k + 2] of the lanes' samples k (integer-valued floats).
 inline void gatherUnit(const float* unit4, F8 k, F8* x, F8* y, F8* z) {

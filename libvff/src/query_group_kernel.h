@@ -43,19 +43,28 @@ inline F atanUnitV(F t) {
   return sel(lt(t, F(0.0f)), vneg(r), r);
 }
 
-// The rays of a group that reach the sphere, packed: their entry points and lookup directions.
+// The byte of a distance map that holds texel (i, j) (FieldQuery::Impl::texelAddress).
+inline size_t texelByte(DistanceEncoding e, uint32_t m, uint32_t i, uint32_t j) {
+  const size_t t = size_t(j) * m + i;
+  switch (e) {
+    case DistanceEncoding::kUnorm16Diameter: return 2 * t;
+    case DistanceEncoding::kBit1: return t / 8;
+    case DistanceEncoding::kBc4Diameter: return (size_t(j >> 2) * (m >> 2) + (i >> 2)) * 8;
+    default: return t;
+  }
+}
+
+// The rays of a group that reach the sphere, packed as in Group: their entry points and lookup
+// directions.
 struct Packed {
-  static constexpr size_t kSize = kGroupRays + 8;
+  static constexpr size_t kSize = kGroupRays + Group::kSlack;
   float eux[kSize], euy[kSize], euz[kSize], vx[kSize], vy[kSize], vz[kSize];
-  uint32_t ray[kSize];
-  size_t count = 0;
 };
 
 // Step 1 for F::kLanes rays starting at rays[0] (all readable), lanes r0 .. of g: the sphere;
 // appends the rays that reach it to `packed`.
 template <class F>
 void sphereStep(const GroupTables& tb, const Ray* rays, Group* g, size_t r0, Packed* packed) {
-  constexpr size_t L = F::kLanes;
   F ox, oy, oz, dx, dy, dz, tmin, tmax;
   loadRays(reinterpret_cast<const float*>(rays), &ox, &oy, &oz, &dx, &dy, &dz, &tmin, &tmax);
   const F zero(0.0f), one(1.0f);
@@ -91,38 +100,24 @@ void sphereStep(const GroupTables& tb, const Ray* rays, Group* g, size_t r0, Pac
   store(g->lo + r0, lo);
   store(g->hi + r0, tmaxL);
   store(g->len + r0, len);
-  const unsigned bits = movemask(live), in = movemask(inside);
-  for (size_t l = 0; l < L; ++l) {
-    g->live[r0 + l] = uint8_t((bits >> l) & 1u);
-    g->inside[r0 + l] = uint8_t((in >> l) & 1u);
-    g->redo[r0 + l] = 0;
-  }
+  g->inside |= uint64_t(movemask(inside)) << r0;
+  const unsigned bits = movemask(live);
   if (bits == 0) return;
-  alignas(32) float e[6][L];
-  store(e[0], eux);
-  store(e[1], euy);
-  store(e[2], euz);
-  store(e[3], vx);
-  store(e[4], vy);
-  store(e[5], vz);
-  for (size_t l = 0; l < L; ++l) {
-    if (!((bits >> l) & 1u)) continue;
-    const size_t slot = packed->count++;
-    packed->eux[slot] = e[0][l];
-    packed->euy[slot] = e[1][l];
-    packed->euz[slot] = e[2][l];
-    packed->vx[slot] = e[3][l];
-    packed->vy[slot] = e[4][l];
-    packed->vz[slot] = e[5][l];
-    packed->ray[slot] = uint32_t(r0 + l);
-  }
+  const size_t at = g->count;
+  compress(packed->eux + at, eux, bits);
+  compress(packed->euy + at, euy, bits);
+  compress(packed->euz + at, euz, bits);
+  compress(packed->vx + at, vx, bits);
+  compress(packed->vy + at, vy, bits);
+  compress(packed->vz + at, vz, bits);
+  compressIndex(g->ray + at, uint32_t(r0), bits);
+  g->count += uint32_t(__builtin_popcount(bits));
 }
 
 // Steps 2 and 3 for packed rays p .. p + kLanes - 1 (all valid; the caller pads the last ones):
-// the nearest sample (octaNearestFast) and the texel (texelFast). Writes k, i, j and redo of the
-// first `lanes` of them into g.
+// the nearest sample (octaNearestFast) and the texel (texelFast), into g's k, i, j and redo.
 template <class F>
-void lookupStep(const GroupTables& tb, const Packed& pk, size_t p, size_t lanes, Group* g) {
+void lookupStep(const GroupTables& tb, const Packed& pk, size_t p, Group* g) {
   constexpr size_t L = F::kLanes;
   const F zero(0.0f), one(1.0f);
   const F eux = load(pk.eux + p), euy = load(pk.euy + p), euz = load(pk.euz + p);
@@ -221,18 +216,14 @@ void lookupStep(const GroupTables& tb, const Packed& pk, size_t p, size_t lanes,
   redo = bor(redo, bor(bor(lt(x - fx, tg), lt((fx + one) - x, tg)), bor(lt(y - fy, tg), lt((fy + one) - y, tg))));
   const F top(fmS - 1.0f);
   const F ok = bnot(redo);
-  alignas(32) int32_t tk[L], ti[L], tj[L];
-  storeInt(tk, band(ok, bestK));
-  storeInt(ti, band(ok, vmin(vmax(fx, zero), top)));
-  storeInt(tj, band(ok, vmin(vmax(fy, zero), top)));
-  const unsigned redoBits = movemask(redo);
-  for (size_t l = 0; l < lanes; ++l) {
-    const uint32_t r = pk.ray[p + l];
-    g->k[r] = uint32_t(tk[l]);
-    g->i[r] = uint32_t(ti[l]);
-    g->j[r] = uint32_t(tj[l]);
-    g->redo[r] = uint8_t((redoBits >> l) & 1u);
-  }
+  storeInt(reinterpret_cast<int32_t*>(g->k + p), band(ok, bestK));
+  storeInt(reinterpret_cast<int32_t*>(g->i + p), band(ok, vmin(vmax(fx, zero), top)));
+  storeInt(reinterpret_cast<int32_t*>(g->j + p), band(ok, vmin(vmax(fy, zero), top)));
+  g->redo |= uint64_t(movemask(redo)) << p;
+  // Ask for the texels now: they arrive while the rest of the group is looked up.
+  if (tb.maps)
+    for (size_t l = 0; l < L; ++l)
+      __builtin_prefetch(tb.maps[g->k[p + l]] + texelByte(tb.encoding, tb.m, g->i[p + l], g->j[p + l]));
 }
 
 // prepareGroup (query_group.h) with lanes F.
@@ -240,51 +231,35 @@ template <class F>
 void prepareGroupWith(const GroupTables& tb, const Ray* rays, size_t n, Group* g) {
   constexpr size_t L = F::kLanes;
   Packed packed;
+  g->inside = 0;
+  g->count = 0;
+  g->redo = 0;
   size_t r = 0;
   for (; r + L <= n; r += L) sphereStep<F>(tb, rays + r, g, r, &packed);
   if (r < n) {
     // Zero directions are not live. (Floats, not Rays: no Ray constructor is compiled here.)
     alignas(32) float tail[L * 8] = {};
     std::memcpy(tail, rays + r, (n - r) * sizeof(Ray));
-    Group scratch;
-    Packed tailPacked;
-    sphereStep<F>(tb, reinterpret_cast<const Ray*>(tail), &scratch, 0, &tailPacked);
-    for (size_t l = 0; r + l < n; ++l) {
-      g->t0[r + l] = scratch.t0[l];
-      g->lo[r + l] = scratch.lo[l];
-      g->hi[r + l] = scratch.hi[l];
-      g->len[r + l] = scratch.len[l];
-      g->live[r + l] = scratch.live[l];
-      g->inside[r + l] = scratch.inside[l];
-      g->redo[r + l] = 0;
-    }
-    for (size_t l = 0; l < tailPacked.count; ++l) {
-      const size_t slot = packed.count++;
-      packed.eux[slot] = tailPacked.eux[l];
-      packed.euy[slot] = tailPacked.euy[l];
-      packed.euz[slot] = tailPacked.euz[l];
-      packed.vx[slot] = tailPacked.vx[l];
-      packed.vy[slot] = tailPacked.vy[l];
-      packed.vz[slot] = tailPacked.vz[l];
-      packed.ray[slot] = uint32_t(r + tailPacked.ray[l]);
-    }
+    sphereStep<F>(tb, reinterpret_cast<const Ray*>(tail), g, r, &packed);
   }
-  if (packed.count == 0) return;
+  const size_t count = g->count;
+  if (count == 0) return;
+  const uint64_t all = count == 64 ? ~uint64_t(0) : (uint64_t(1) << count) - 1;
   if (tb.octaN == 0) {  // another scheme: the reference does the rest
-    for (size_t p = 0; p < packed.count; ++p) g->redo[packed.ray[p]] = 1;
+    g->redo = all;
     return;
   }
-  // Pad the last lanes with copies of the last live ray (their answers are not stored).
-  const size_t last = packed.count - 1;
-  for (size_t p = packed.count; p % L != 0; ++p) {
-    packed.eux[p] = packed.eux[last];
-    packed.euy[p] = packed.euy[last];
-    packed.euz[p] = packed.euz[last];
-    packed.vx[p] = packed.vx[last];
-    packed.vy[p] = packed.vy[last];
-    packed.vz[p] = packed.vz[last];
+  // Pad the last lanes with copies of the last ray (their answers are past `count`).
+  for (size_t p = count; p % L != 0; ++p) {
+    packed.eux[p] = packed.eux[count - 1];
+    packed.euy[p] = packed.euy[count - 1];
+    packed.euz[p] = packed.euz[count - 1];
+    packed.vx[p] = packed.vx[count - 1];
+    packed.vy[p] = packed.vy[count - 1];
+    packed.vz[p] = packed.vz[count - 1];
   }
-  for (size_t p = 0; p < packed.count; p += L) lookupStep<F>(tb, packed, p, packed.count - p < L ? packed.count - p : L, g);
+  for (size_t p = 0; p < count; p += L) lookupStep<F>(tb, packed, p, g);
+  g->redo &= all;
 }
 
 }  // namespace

@@ -40,8 +40,21 @@ inline F4 vneg(F4 a) { return _mm_xor_ps(a.v, _mm_set1_ps(-0.0f)); }
 inline F4 floorPos(F4 a) { return _mm_cvtepi32_ps(_mm_cvttps_epi32(a.v)); }  // 0 <= a < 2^31
 inline F4 load(const float* p) { return _mm_loadu_ps(p); }
 inline void store(float* p, F4 a) { _mm_storeu_ps(p, a.v); }
-inline void storeInt(int32_t* p, F4 a) { _mm_store_si128(reinterpret_cast<__m128i*>(p), _mm_cvttps_epi32(a.v)); }
+inline void storeInt(int32_t* p, F4 a) { _mm_storeu_si128(reinterpret_cast<__m128i*>(p), _mm_cvttps_epi32(a.v)); }
 inline unsigned movemask(F4 a) { return unsigned(_mm_movemask_ps(a.v)); }
+
+// Stores the lanes of `a` selected by `mask`, in order, at dst[0 ..].
+inline void compress(float* dst, F4 a, unsigned mask) {
+  alignas(16) float v[4];
+  _mm_store_ps(v, a.v);
+  for (int l = 0; l < 4; ++l)
+    if ((mask >> l) & 1u) *dst++ = v[l];
+}
+// Stores first + l for the lanes l selected by `mask`, in order, at dst[0 ..].
+inline void compressIndex(uint32_t* dst, uint32_t first, unsigned mask) {
+  for (uint32_t l = 0; l < 4; ++l)
+    if ((mask >> l) & 1u) *dst++ = first + l;
+}
 
 // Positions unit4[4 k .. 4 k + 2] of the lanes' samples k (integer-valued floats).
 inline void gatherUnit(const float* unit4, F4 k, F4* x, F4* y, F4* z) {
