@@ -144,6 +144,21 @@ struct FieldQuery::Impl {
                  float len, float* visibility) const noexcept;
   detail::GroupTables groupTables(const QueryOptions& o) const noexcept;
   QueryHit interpolated(const Ray& ray, const Lookup& l, float* visibility) const noexcept;
+  // interpolated() in two halves (see there).
+  struct InterpPlan {
+    struct Tap {
+      uint32_t k = 0;      // the sample
+      int ix = 0, iy = 0;  // its lower-left texel of the bilinear footprint (before clamping)
+      float fx = 0, fy = 0, weight = 0, base = 0;
+    };
+    uint32_t count = 0;
+    Tap taps[1 + kNeighbours];
+  };
+  void planInterpolated(const Ray& ray, const Lookup& l, InterpPlan* plan) const noexcept;
+  void prefetchPlan(const InterpPlan& plan) const noexcept;
+  QueryHit blendInterpolated(const Ray& ray, const Lookup& l, const InterpPlan& plan, float* visibility) const noexcept;
+  template <class Emit>
+  void batchInterpolated(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept;
   QueryHit query(const Ray& ray, const QueryOptions& o, float* visibility) const noexcept;
   // Whether the nearest lookup at texel (i, j) of map k hits within [lo, hi] (hitAt(...).hit).
   bool hitsAt(uint32_t k, uint32_t i, uint32_t j, float t0, bool inside, float lo, float hi) const noexcept {
@@ -399,13 +414,12 @@ QueryHit FieldQuery::Impl::query(const Ray& ray, const QueryOptions& o, float* v
   return interpolated(ray, l, visibility);
 }
 
-QueryHit FieldQuery::Impl::interpolated(const Ray& ray, const Lookup& l, float* visibility) const noexcept {
-  QueryHit out;
-  const Vec3 w = l.w, v = l.v, eu = l.eu;
-  const float sign = l.sign, lo = l.lo, hi = l.hi, len = l.len;
-  const uint32_t k0 = l.k0;
-  // Interpolated: the kernel's samples, each looked up along v from its own sample point
-  // (parallel rays) with miss-aware bilinear weights; each hit point is projected onto the ray.
+// Interpolated: the kernel's samples, each looked up along v from its own sample point (parallel
+// rays) with miss-aware bilinear weights; each hit point is projected onto the ray. In two halves,
+// so that a batch can fetch the texels of many rays at once: planInterpolated() finds the samples
+// and their texels, blendInterpolated() reads and blends them.
+void FieldQuery::Impl::planInterpolated(const Ray& ray, const Lookup& l, InterpPlan* plan) const noexcept {
+  const Vec3 eu = l.eu, v = l.v, w = l.w;
   auto kernel = [&](uint32_t k) {
     const Vec3 d = eu - unit[k];
     const float x = 1.0f - dot(d, d) / kernelRadius2;
@@ -414,9 +428,9 @@ QueryHit FieldQuery::Impl::interpolated(const Ray& ray, const Lookup& l, float* 
   uint32_t ks[1 + kNeighbours];
   float kw[1 + kNeighbours];
   uint32_t kc = 0;
-  ks[kc] = k0;
-  kw[kc++] = std::max(kernel(k0), 1e-6f);  // the nearest sample always contributes
-  const uint32_t* nb = &neighbours[size_t(k0) * kNeighbours];
+  ks[kc] = l.k0;
+  kw[kc++] = std::max(kernel(l.k0), 1e-6f);  // the nearest sample always contributes
+  const uint32_t* nb = &neighbours[size_t(l.k0) * kNeighbours];
   for (uint32_t c = 0; c < kNeighbours && nb[c] != UINT32_MAX; ++c) {
     const float wk = kernel(nb[c]);
     if (wk > 0) {
@@ -424,64 +438,121 @@ QueryHit FieldQuery::Impl::interpolated(const Ray& ray, const Lookup& l, float* 
       kw[kc++] = wk;
     }
   }
-  auto blend = [&]() {
-    Blend bl;
-    for (uint32_t c = 0; c < kc; ++c) {
-      const uint32_t k = ks[c];
-      const Vec3 p = samplePoint(k);
-      const Vec3 local = toLocal(frames[k], v);
-      if (local.z <= 0) continue;  // the sample does not see this direction
-      const Vec2 uv = hemisphereToSquare(field.directionScheme, local);
-      const float x = (uv.x + 1.0f) * 0.5f * float(m) - 0.5f;
-      const float y = (uv.y + 1.0f) * 0.5f * float(m) - 0.5f;
-      const float fx0 = std::floor(x), fy0 = std::floor(y);
-      const float fx = x - fx0, fy = y - fy0;
-      const int ix = int(fx0), iy = int(fy0);
-      const float base = dot(p - ray.origin, w);  // t of the sample point, projected on the ray
-      const float along = sign;                   // t per unit distance along v
-      for (int dj = 0; dj < 2; ++dj) {
-        for (int di = 0; di < 2; ++di) {
-          const float bw = kw[c] * (di ? fx : 1.0f - fx) * (dj ? fy : 1.0f - fy);
-          if (bw <= 0) continue;
-          const uint32_t ti = uint32_t(std::clamp(ix + di, 0, int(m) - 1));
-          const uint32_t tj = uint32_t(std::clamp(iy + dj, 0, int(m) - 1));
-          const Sample s = texel(k, ti, tj);
-          if (!s.hit) {
-            bl.missWeight += bw;
-            continue;
-          }
-          const float t = base + along * s.distance;
-          if (t > hi) {
-            bl.farWeight += bw;
-          } else if (t < lo) {
-            bl.nearWeight += bw;
-          } else {
-            bl.hitWeight += bw;
-            bl.tSum += bw * t;
-            if (!norm.empty()) bl.normalSum = bl.normalSum + normalAt(k, ti, tj) * bw;
-          }
+  plan->count = 0;
+  for (uint32_t c = 0; c < kc; ++c) {
+    const uint32_t k = ks[c];
+    const Vec3 local = toLocal(frames[k], v);
+    if (local.z <= 0) continue;  // the sample does not see this direction
+    const Vec2 uv = hemisphereToSquare(field.directionScheme, local);
+    const float x = (uv.x + 1.0f) * 0.5f * float(m) - 0.5f;
+    const float y = (uv.y + 1.0f) * 0.5f * float(m) - 0.5f;
+    const float fx0 = std::floor(x), fy0 = std::floor(y);
+    InterpPlan::Tap& tap = plan->taps[plan->count++];
+    tap.k = k;
+    tap.weight = kw[c];
+    tap.fx = x - fx0;
+    tap.fy = y - fy0;
+    tap.ix = int(fx0);
+    tap.iy = int(fy0);
+    tap.base = dot(samplePoint(k) - ray.origin, w);  // t of the sample point, projected on the ray
+  }
+}
+
+void FieldQuery::Impl::prefetchPlan(const InterpPlan& plan) const noexcept {
+  for (uint32_t c = 0; c < plan.count; ++c) {
+    const InterpPlan::Tap& tap = plan.taps[c];
+    const uint32_t ti = uint32_t(std::clamp(tap.ix, 0, int(m) - 1));
+    __builtin_prefetch(texelAddress(tap.k, ti, uint32_t(std::clamp(tap.iy, 0, int(m) - 1))));
+    __builtin_prefetch(texelAddress(tap.k, ti, uint32_t(std::clamp(tap.iy + 1, 0, int(m) - 1))));
+  }
+}
+
+QueryHit FieldQuery::Impl::blendInterpolated(const Ray& ray, const Lookup& l, const InterpPlan& plan,
+                                             float* visibility) const noexcept {
+  QueryHit out;
+  const float sign = l.sign, lo = l.lo, hi = l.hi;
+  Blend bl;
+  for (uint32_t c = 0; c < plan.count; ++c) {
+    const InterpPlan::Tap& tap = plan.taps[c];
+    const float along = sign;  // t per unit distance along v
+    for (int dj = 0; dj < 2; ++dj) {
+      for (int di = 0; di < 2; ++di) {
+        const float bw = tap.weight * (di ? tap.fx : 1.0f - tap.fx) * (dj ? tap.fy : 1.0f - tap.fy);
+        if (bw <= 0) continue;
+        const uint32_t ti = uint32_t(std::clamp(tap.ix + di, 0, int(m) - 1));
+        const uint32_t tj = uint32_t(std::clamp(tap.iy + dj, 0, int(m) - 1));
+        const Sample s = texel(tap.k, ti, tj);
+        if (!s.hit) {
+          bl.missWeight += bw;
+          continue;
+        }
+        const float t = tap.base + along * s.distance;
+        if (t > hi) {
+          bl.farWeight += bw;
+        } else if (t < lo) {
+          bl.nearWeight += bw;
+        } else {
+          bl.hitWeight += bw;
+          bl.tSum += bw * t;
+          if (!norm.empty()) bl.normalSum = bl.normalSum + normalAt(tap.k, ti, tj) * bw;
         }
       }
     }
-    return bl;
-  };
-  const Blend b = blend();
+  }
   // Hits before the range (the origin's own surface from inside, or surfaces behind tmin) are
   // neither occluders nor misses: leave them out of the vote.
-  const float total = b.hitWeight + b.missWeight + b.farWeight;
+  const float total = bl.hitWeight + bl.missWeight + bl.farWeight;
   if (!(total > 0)) return out;
-  if (visibility) *visibility = (b.missWeight + b.farWeight) / total;
-  if (b.hitWeight <= b.missWeight + b.farWeight) return out;
-  const float t = b.tSum / b.hitWeight;
+  if (visibility) *visibility = (bl.missWeight + bl.farWeight) / total;
+  if (bl.hitWeight <= bl.missWeight + bl.farWeight) return out;
+  const float t = bl.tSum / bl.hitWeight;
   out.hit = true;
   out.inside = l.inside;
-  out.t = t / len;
-  out.point = ray.origin + w * t;
+  out.t = t / l.len;
+  out.point = ray.origin + l.w * t;
   if (!norm.empty()) {
-    out.normal = normalize(b.normalSum);
+    out.normal = normalize(bl.normalSum);
     out.hasNormal = dot(out.normal, out.normal) > 0;
   }
   return out;
+}
+
+QueryHit FieldQuery::Impl::interpolated(const Ray& ray, const Lookup& l, float* visibility) const noexcept {
+  InterpPlan plan;
+  planInterpolated(ray, l, &plan);
+  return blendInterpolated(ray, l, plan, visibility);
+}
+
+// Batches of interpolated lookups: plan a group of rays and request all their texels, then blend.
+// Rays from inside the sphere are answered as kNearest (query()).
+template <class Emit>
+void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept {
+  constexpr size_t kGroup = 16;
+  Lookup l[kGroup];
+  InterpPlan plan[kGroup];
+  enum : uint8_t { kMiss, kNearestLookup, kBlend } how[kGroup];
+  for (size_t base = 0; base < rays.size(); base += kGroup) {
+    const size_t n = std::min(kGroup, rays.size() - base);
+    for (size_t r = 0; r < n; ++r) {
+      if (!prepare(rays[base + r], o, &l[r])) {
+        how[r] = kMiss;
+      } else if (l[r].inside) {
+        how[r] = kNearestLookup;
+        __builtin_prefetch(texelAddress(l[r].k0, l[r].i, l[r].j));
+      } else {
+        how[r] = kBlend;
+        planInterpolated(rays[base + r], l[r], &plan[r]);
+        prefetchPlan(plan[r]);
+      }
+    }
+    for (size_t r = 0; r < n; ++r) {
+      float vis = 1.0f;
+      QueryHit h;
+      if (how[r] == kNearestLookup) h = nearestHit(rays[base + r], l[r], &vis);
+      if (how[r] == kBlend) h = blendInterpolated(rays[base + r], l[r], plan[r], &vis);
+      emit(base + r, h, vis);
+    }
+  }
 }
 
 QueryHit FieldQuery::intersect(const Ray& ray, const QueryOptions& options) const noexcept {
@@ -594,7 +665,11 @@ void FieldQuery::intersect(std::span<const Ray> rays, std::span<QueryHit> out, c
     impl_->batchNearest<false>(rays.first(n), options, [&](size_t r, const QueryHit& h, float) { out[r] = h; });
     return;
   }
-  for (size_t r = 0; r < n; ++r) out[r] = intersect(rays[r], options);
+  if (impl_) {
+    impl_->batchInterpolated(rays.first(n), options, [&](size_t r, const QueryHit& h, float) { out[r] = h; });
+  } else {
+    std::fill_n(out.begin(), n, QueryHit{});
+  }
 }
 
 void FieldQuery::occluded(std::span<const Ray> rays, std::span<uint8_t> out, const QueryOptions& options) const noexcept {
@@ -603,7 +678,11 @@ void FieldQuery::occluded(std::span<const Ray> rays, std::span<uint8_t> out, con
     impl_->batchNearest<true>(rays.first(n), options, [&](size_t r, bool hit) { out[r] = hit ? 1 : 0; });
     return;
   }
-  for (size_t r = 0; r < n; ++r) out[r] = occluded(rays[r], options) ? 1 : 0;
+  if (impl_) {
+    impl_->batchInterpolated(rays.first(n), options, [&](size_t r, const QueryHit& h, float) { out[r] = h.hit ? 1 : 0; });
+  } else {
+    std::fill_n(out.begin(), n, uint8_t(0));
+  }
 }
 
 void FieldQuery::visibility(std::span<const Ray> rays, std::span<float> out, const QueryOptions& options) const noexcept {
@@ -612,7 +691,11 @@ void FieldQuery::visibility(std::span<const Ray> rays, std::span<float> out, con
     impl_->batchNearest<true>(rays.first(n), options, [&](size_t r, bool hit) { out[r] = hit ? 0.0f : 1.0f; });
     return;
   }
-  for (size_t r = 0; r < n; ++r) out[r] = visibility(rays[r], options);
+  if (impl_) {
+    impl_->batchInterpolated(rays.first(n), options, [&](size_t r, const QueryHit&, float v) { out[r] = v; });
+  } else {
+    std::fill_n(out.begin(), n, 1.0f);
+  }
 }
 
 // ---- RigidTransform and Instance ----------------------------------------------------------------
