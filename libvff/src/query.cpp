@@ -443,7 +443,7 @@ void FieldQuery::Impl::planInterpolated(const Ray& ray, const Lookup& l, InterpP
     const uint32_t k = ks[c];
     const Vec3 local = toLocal(frames[k], v);
     if (local.z <= 0) continue;  // the sample does not see this direction
-    const Vec2 uv = hemisphereToSquare(field.directionScheme, local);
+    const Vec2 uv = detail::hemisphereToSquareFast(field.directionScheme, local);
     const float x = (uv.x + 1.0f) * 0.5f * float(m) - 0.5f;
     const float y = (uv.y + 1.0f) * 0.5f * float(m) - 0.5f;
     const float fx0 = std::floor(x), fy0 = std::floor(y);

@@ -174,6 +174,25 @@ TEST(FastLookup, TexelEqualsTheReferenceWhereverItAnswers) {
   }
 }
 
+TEST(FastLookup, SquareCoordinatesAreWithinAMillionthOfTheReference) {
+  std::mt19937 rng(5);
+  std::normal_distribution<float> g;
+  std::vector<Vec3> dirs = {{0, 0, 1}, {1, 0, 0}, {0, -1, 0}, {1, 1, 0}, {-1, 1, 1}, {0, 0, -1}};
+  for (int r = 0; r < 300000; ++r) dirs.push_back({g(rng), g(rng), std::fabs(g(rng))});
+  for (Vec3& d : dirs) {
+    const float l = std::sqrt(dot3(d, d));
+    d = {d.x / l, d.y / l, d.z / l};
+  }
+  for (DirectionScheme scheme : {DirectionScheme::kConcentricEqualArea, DirectionScheme::kHemiOctahedral}) {
+    float worst = 0;
+    for (const Vec3& d : dirs) {
+      const Vec2 f = detail::hemisphereToSquareFast(scheme, d), r = hemisphereToSquare(scheme, d);
+      worst = std::max({worst, std::fabs(f.x - r.x), std::fabs(f.y - r.y)});
+    }
+    EXPECT_LT(worst, 1e-6f) << "scheme " << int(scheme);
+  }
+}
+
 // ---- The batch functions (group kernel) against a lookup written from the reference functions --
 
 struct RefHit {
