@@ -762,6 +762,62 @@ float Instance::visibility(const Ray& worldRay, const QueryOptions& options) con
   return field ? field->visibility(toObject(transform, worldRay), options) : 1.0f;
 }
 
+namespace {
+
+// Calls batch(objectRays, first) for worldRays in chunks, transformed to object space.
+template <class Batch>
+void inObjectSpace(const RigidTransform& x, std::span<const Ray> worldRays, Batch&& batch) {
+  constexpr size_t kChunk = 256;
+  Ray local[kChunk];
+  for (size_t first = 0; first < worldRays.size(); first += kChunk) {
+    const size_t n = std::min(kChunk, worldRays.size() - first);
+    for (size_t r = 0; r < n; ++r) local[r] = toObject(x, worldRays[first + r]);
+    batch(std::span<const Ray>(local, n), first);
+  }
+}
+
+}  // namespace
+
+void Instance::intersect(std::span<const Ray> worldRays, std::span<QueryHit> out, const QueryOptions& options) const noexcept {
+  const size_t n = std::min(worldRays.size(), out.size());
+  if (!field) {
+    std::fill_n(out.begin(), n, QueryHit{});
+    return;
+  }
+  inObjectSpace(transform, worldRays.first(n), [&](std::span<const Ray> rays, size_t first) {
+    field->intersect(rays, out.subspan(first, rays.size()), options);
+    for (size_t r = 0; r < rays.size(); ++r) {
+      QueryHit& h = out[first + r];
+      if (!h.hit) continue;
+      const Ray& w = worldRays[first + r];
+      h.point = w.origin + w.direction * h.t;
+      if (h.hasNormal) h.normal = normalize(transform.toWorldVector(h.normal));
+    }
+  });
+}
+
+void Instance::occluded(std::span<const Ray> worldRays, std::span<uint8_t> out, const QueryOptions& options) const noexcept {
+  const size_t n = std::min(worldRays.size(), out.size());
+  if (!field) {
+    std::fill_n(out.begin(), n, uint8_t(0));
+    return;
+  }
+  inObjectSpace(transform, worldRays.first(n), [&](std::span<const Ray> rays, size_t first) {
+    field->occluded(rays, out.subspan(first, rays.size()), options);
+  });
+}
+
+void Instance::visibility(std::span<const Ray> worldRays, std::span<float> out, const QueryOptions& options) const noexcept {
+  const size_t n = std::min(worldRays.size(), out.size());
+  if (!field) {
+    std::fill_n(out.begin(), n, 1.0f);
+    return;
+  }
+  inObjectSpace(transform, worldRays.first(n), [&](std::span<const Ray> rays, size_t first) {
+    field->visibility(rays, out.subspan(first, rays.size()), options);
+  });
+}
+
 Sphere Instance::worldSphere() const noexcept {
   if (!field) return {};
   const Sphere& s = field->field().sphere;

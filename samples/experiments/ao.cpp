@@ -3,7 +3,7 @@
 // Every plane pixel casts `rays` cosine-weighted rays (default 256) up to aoDistance * R (default
 // 2 R, see Options) and is shaded with the unoccluded fraction. The exact image tests them with rtcOccluded1;
 // the field images with Instance::occluded (kNearest, the paper's 0/1 answer) or with
-// Instance::visibility (kInterpolated, a fraction per ray). Object pixels get a constant colour, so
+// Instance::visibility (kInterpolated, a fraction per ray), one batch call per pixel. Object pixels get a constant colour, so
 // only plane AO is compared. Plane points close to the object lie inside its bounding sphere and
 // are answered by the intra-object test (spec/geometry.md 7.3), as a renderer using the field would.
 #include "common.h"
@@ -28,12 +28,17 @@ int runAo(const Options& o) {
       if (s.kind == PixelKind::kObject) return kObjectFlat;
       if (s.kind != PixelKind::kPlane) return {};
       const Vec3 origin = s.point + s.normal * eps;
-      float open = 0;
+      thread_local std::vector<vff::Ray> batch;
+      thread_local std::vector<float> shares;
+      batch.resize(size_t(rays));
+      shares.resize(size_t(rays));
       for (int i = 0; i < rays; ++i) {
         const float u1 = rng.next01(), u2 = rng.next01();
-        const vff::Ray ray{origin, cosineDirection(s.normal, u1, u2), 0.0f, tmax};
-        open += openShare(exact, field, qo, ray);
+        batch[size_t(i)] = {origin, cosineDirection(s.normal, u1, u2), 0.0f, tmax};
       }
+      openShares(exact, field, qo, batch, shares);
+      float open = 0;
+      for (int i = 0; i < rays; ++i) open += shares[size_t(i)];
       const float v = open / float(rays);
       return {v, v, v};
     };

@@ -5,7 +5,8 @@
 //          1e-4 R, cosine-weighted directions, tmax = aoDistance * R (the inter-object AO rays);
 //   aimed  origins outside the bounding sphere (1.05 R to 3 R from its centre, uniform directions),
 //          each aimed at a uniform point inside the sphere, tmax infinite.
-// Measured in one run on the same threads (rays handed out in chunks of 4096), best of --repeat:
+// Measured in one run on the same threads (rays handed out in chunks of 4096), best of --repeat
+// (the four take turns in every repetition):
 //   (a) Embree rtcOccluded1 against the mesh (world space)
 //   (b) FieldQuery::occluded, batch, kNearest (object space: the same rays, transformed beforehand)
 //   (c) FieldQuery::occluded, one ray per call, kNearest
@@ -58,14 +59,10 @@ RaySet makeAimedRays(const World& w, uint32_t count) {
   return s;
 }
 
-double bestSeconds(int repeat, const std::function<void()>& fn) {
-  double best = 1e30;
-  for (int r = 0; r < repeat; ++r) {
-    const auto t0 = std::chrono::steady_clock::now();
-    fn();
-    best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  }
-  return best;
+double seconds(const std::function<void()>& fn) {
+  const auto t0 = std::chrono::steady_clock::now();
+  fn();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 }  // namespace
@@ -109,26 +106,31 @@ int runBench(const Options& o) {
     const vff::QueryOptions qi{.reconstruction = vff::Reconstruction::kInterpolated, .intraBias = 0.0f};
     const std::span<const vff::Ray> rays(set.object);
 
-    const double ta = bestSeconds(o.repeat, [&] {
-      parallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
-        for (uint64_t i = b; i < e; ++i) ref[i] = exact->occluded(set.world[i]) ? 1 : 0;
-      });
-    });
-    const double tb = bestSeconds(o.repeat, [&] {
-      parallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
-        q.occluded(rays.subspan(b, e - b), std::span<uint8_t>(nearest).subspan(b, e - b), qn);
-      });
-    });
-    const double tc = bestSeconds(o.repeat, [&] {
-      parallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
-        for (uint64_t i = b; i < e; ++i) single[i] = q.occluded(set.object[i], qn) ? 1 : 0;
-      });
-    });
-    const double td = bestSeconds(o.repeat, [&] {
-      parallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
-        q.visibility(rays.subspan(b, e - b), std::span<float>(vis).subspan(b, e - b), qi);
-      });
-    });
+    // The four queries take turns within each repetition, so that a slow spell of the machine
+    // does not fall on one of them only.
+    double ta = 1e30, tb = 1e30, tc = 1e30, td = 1e30;
+    for (int rep = 0; rep < o.repeat; ++rep) {
+      ta = std::min(ta, seconds([&] {
+        parallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
+          for (uint64_t i = b; i < e; ++i) ref[i] = exact->occluded(set.world[i]) ? 1 : 0;
+        });
+      }));
+      tb = std::min(tb, seconds([&] {
+        parallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
+          q.occluded(rays.subspan(b, e - b), std::span<uint8_t>(nearest).subspan(b, e - b), qn);
+        });
+      }));
+      tc = std::min(tc, seconds([&] {
+        parallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
+          for (uint64_t i = b; i < e; ++i) single[i] = q.occluded(set.object[i], qn) ? 1 : 0;
+        });
+      }));
+      td = std::min(td, seconds([&] {
+        parallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
+          q.visibility(rays.subspan(b, e - b), std::span<float>(vis).subspan(b, e - b), qi);
+        });
+      }));
+    }
 
     uint64_t occA = 0, occB = 0, occC = 0, occD = 0, agreeB = 0, agreeC = 0, agreeD = 0;
     for (size_t i = 0; i < n; ++i) {

@@ -13,6 +13,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -130,13 +131,21 @@ struct BakedQuery {
   double payloadMiB() const { return double(query.payloadBytes()) / 1048576.0; }
 };
 
-// The unoccluded share of one ray: the exact answer (0 or 1) when field is null, the field's
-// occluded() (0 or 1) for kNearest, its visibility() (a fraction) for kInterpolated.
-inline float openShare(const ExactTracer& exact, const BakedQuery* field, const vff::QueryOptions& qo,
-                       const vff::Ray& ray) {
-  if (!field) return exact.occluded(ray) ? 0.0f : 1.0f;
-  if (qo.reconstruction == vff::Reconstruction::kNearest) return field->instance.occluded(ray, qo) ? 0.0f : 1.0f;
-  return field->instance.visibility(ray, qo);
+// The unoccluded share of every ray, into out (same size): the exact answer (0 or 1) when field is
+// null, the field's occluded() (0 or 1) for kNearest, its visibility() (a fraction) for
+// kInterpolated. A field answers them with one batch call, as a renderer would.
+inline void openShares(const ExactTracer& exact, const BakedQuery* field, const vff::QueryOptions& qo,
+                       std::span<const vff::Ray> rays, std::span<float> out) {
+  if (!field) {
+    for (size_t i = 0; i < rays.size(); ++i) out[i] = exact.occluded(rays[i]) ? 0.0f : 1.0f;
+  } else if (qo.reconstruction == vff::Reconstruction::kNearest) {
+    thread_local std::vector<uint8_t> occ;
+    occ.resize(rays.size());
+    field->instance.occluded(rays, occ, qo);
+    for (size_t i = 0; i < rays.size(); ++i) out[i] = occ[i] ? 0.0f : 1.0f;
+  } else {
+    field->instance.visibility(rays, out, qo);
+  }
 }
 
 // Bakes one configuration (unorm8-diameter) of the object and places it like the world's object.

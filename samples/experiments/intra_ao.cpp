@@ -26,12 +26,17 @@ int runIntraAo(const Options& o) {
       if (s.kind == PixelKind::kPlane) return kPlaneFlat;
       if (s.kind != PixelKind::kObject) return {};
       const Vec3 origin = s.point + s.normal * eps;
-      float open = 0;
+      thread_local std::vector<vff::Ray> batch;
+      thread_local std::vector<float> shares;
+      batch.resize(size_t(rays));
+      shares.resize(size_t(rays));
       for (int i = 0; i < rays; ++i) {
         const float u1 = rng.next01(), u2 = rng.next01();
-        const vff::Ray ray{origin, cosineDirection(s.normal, u1, u2)};
-        open += openShare(exact, field, qo, ray);
+        batch[size_t(i)] = {origin, cosineDirection(s.normal, u1, u2)};
       }
+      openShares(exact, field, qo, batch, shares);
+      float open = 0;
+      for (int i = 0; i < rays; ++i) open += shares[size_t(i)];
       const float v = open / float(rays);
       return {v, v, v};
     };

@@ -352,6 +352,47 @@ TEST(Query, InstanceTransformsRaysAndResults) {
   EXPECT_GT(hits, 500);
 }
 
+TEST(Query, InstanceBatchesEqualSingleRays) {
+  auto b = bakeShape("torus-knot", 8, 32, true);
+  const Instance inst{&b->query, RigidTransform::fromAxisAngle({1, 2, 3}, 0.7f, {5, -2, 1}, 2.5f)};
+  const Sphere ws = inst.worldSphere();
+  const Vec3 wc{ws.center[0], ws.center[1], ws.center[2]};
+  Rng rng(8);
+  std::vector<Ray> rays(1000);  // more than one chunk of the object-space transform
+  for (Ray& r : rays) {
+    r.origin = add(wc, mul(rng.direction(), ws.radius * 2 * rng.uniform()));  // inside and outside
+    r.direction = mul(rng.direction(), 0.37f);
+    r.tmax = ws.radius * 3 * rng.uniform() / 0.37f;
+  }
+  for (Reconstruction mode : {Reconstruction::kNearest, Reconstruction::kInterpolated}) {
+    QueryOptions o;
+    o.reconstruction = mode;
+    std::vector<QueryHit> hits(rays.size());
+    std::vector<uint8_t> occ(rays.size());
+    std::vector<float> vis(rays.size());
+    inst.intersect(rays, hits, o);
+    inst.occluded(rays, occ, o);
+    inst.visibility(rays, vis, o);
+    int hitCount = 0;
+    for (size_t r = 0; r < rays.size(); ++r) {
+      const QueryHit h = inst.intersect(rays[r], o);
+      ASSERT_EQ(hits[r].hit, h.hit);
+      ASSERT_EQ(hits[r].t, h.t);
+      ASSERT_EQ(hits[r].point.x, h.point.x);
+      ASSERT_EQ(hits[r].normal.y, h.normal.y);
+      ASSERT_EQ(occ[r] != 0, inst.occluded(rays[r], o));
+      ASSERT_EQ(vis[r], inst.visibility(rays[r], o));
+      hitCount += h.hit;
+    }
+    EXPECT_GT(hitCount, 100);
+  }
+  // No field: every ray misses.
+  const Instance empty;
+  std::vector<uint8_t> occ(3, 7);
+  empty.occluded(std::span<const Ray>(rays).first(3), occ);
+  EXPECT_EQ(occ, std::vector<uint8_t>(3, 0));
+}
+
 TEST(Query, BatchesEqualSingleRays) {
   auto b = bakeShape("bowl", 8, 16);
   const FieldDesc& f = b->field.field;

@@ -39,10 +39,11 @@
 // Threads. A FieldQuery is immutable after creation: every member function is const and may be
 // called from many threads at once. The batch functions run on the calling thread.
 //
-// Speed. Call the batch functions: they answer kNearest rays in groups, eight at a time in AVX2
-// where the CPU has it (four in SSE2 on other x86-64 CPUs), and fetch a group's texels from memory
-// together. They give bit for bit the answers of the one-ray functions. kInterpolated batches
-// answer one ray at a time.
+// Speed. Call the batch functions (FieldQuery's or Instance's): they answer kNearest rays in
+// groups, eight at a time in AVX2 where the CPU has it (four in SSE2 on other x86-64 CPUs), and
+// fetch a group's texels from memory together; kInterpolated batches fetch the texels of 16 rays
+// at once. They give bit for bit the answers of the one-ray functions, several times faster
+// (vff-experiments bench).
 #pragma once
 
 #include <cstdint>
@@ -181,6 +182,12 @@ struct Instance {
   QueryHit intersect(const Ray& worldRay, const QueryOptions& options = {}) const noexcept;
   bool occluded(const Ray& worldRay, const QueryOptions& options = {}) const noexcept;
   float visibility(const Ray& worldRay, const QueryOptions& options = {}) const noexcept;
+  // Batches of world-space rays: transformed to object space a few hundred at a time and handed to
+  // the field's batch functions (out.size() must equal worldRays.size(); extra entries are
+  // ignored). The same answers as the one-ray functions above.
+  void intersect(std::span<const Ray> worldRays, std::span<QueryHit> out, const QueryOptions& options = {}) const noexcept;
+  void occluded(std::span<const Ray> worldRays, std::span<uint8_t> out, const QueryOptions& options = {}) const noexcept;
+  void visibility(std::span<const Ray> worldRays, std::span<float> out, const QueryOptions& options = {}) const noexcept;
   // The bounding sphere in world space.
   Sphere worldSphere() const noexcept;
 };
