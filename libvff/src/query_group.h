@@ -1,12 +1,14 @@
-// query_group.h - the nearest lookup of many rays at once, four at a time in SSE2 (internal).
+// query_group.h - the nearest lookup of many rays at once, eight (AVX2) or four (SSE2) per
+// instruction (internal).
 //
 // FieldQuery's batch functions hand rays to prepareGroup() in groups of kGroupRays. It computes,
 // for every ray, what FieldQuery::Impl::prepare computes one ray at a time: the sphere entry, the
 // nearest positional sample (octa-hemi2: the candidates of PositionSet::candidates in binary32)
 // and the texel of the lookup direction in that sample's map. It performs the same binary32
-// operations in the same order as prepare(), and leaves to the caller (flag `redo`) every ray on
+// operations in the same order as prepare(), and leaves to the caller (bit `redo`) every ray on
 // which a guard of fast_lookup.h trips or whose scheme it does not handle, so that a group gives
-// exactly the texel prepare() gives (tests/unit/test_query_group.cpp checks this ray by ray).
+// exactly the texel prepare() gives (tests/unit/test_fast_lookup.cpp checks this ray by ray, with
+// every kernel). The kernel itself is query_group_kernel.h.
 #pragma once
 
 #include <cstddef>

@@ -39,6 +39,32 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         (void)q->visibility(vff::Ray{c, d}, qo);
       }
     }
+    // The batches (the SIMD group kernel) must answer exactly as the one-ray calls: 13 rays, a
+    // partial group, from outside, from the centre and from beside the sphere.
+    std::vector<vff::Ray> rays;
+    for (const vff::Vec3& d : dirs) {
+      rays.push_back({{c.x - 2 * s.radius * d.x, c.y - 2 * s.radius * d.y, c.z - 2 * s.radius * d.z}, d});
+      rays.push_back({c, d, 0.0f, s.radius * 0.5f});
+      rays.push_back({{c.x + 0.9f * s.radius * d.y, c.y - 0.9f * s.radius * d.x, c.z}, d});
+    }
+    rays.push_back({c, {0, 0, 0}});
+    for (auto r : {vff::Reconstruction::kNearest, vff::Reconstruction::kInterpolated}) {
+      vff::QueryOptions qo;
+      qo.reconstruction = r;
+      std::vector<vff::QueryHit> hits(rays.size());
+      std::vector<uint8_t> occ(rays.size());
+      std::vector<float> vis(rays.size());
+      q->intersect(rays, hits, qo);
+      q->occluded(rays, occ, qo);
+      q->visibility(rays, vis, qo);
+      for (size_t i = 0; i < rays.size(); ++i) {
+        const vff::QueryHit h = q->intersect(rays[i], qo);
+        const float v = q->visibility(rays[i], qo);
+        if (h.hit != hits[i].hit || (h.hit && !(h.t == hits[i].t)) || (occ[i] != 0) != h.hit ||
+            !(v == vis[i] || (v != v && vis[i] != vis[i])))
+          __builtin_trap();
+      }
+    }
   }
   return 0;
 }
