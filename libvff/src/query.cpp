@@ -138,6 +138,9 @@ struct FieldQuery::Impl {
     uint32_t k0 = 0, i = 0, j = 0;  // i, j: the nearest lookup's texel
   };
   bool prepare(const Ray& ray, const QueryOptions& o, Lookup* l) const noexcept;
+  // The part of prepare() after the sphere: everything but k0, i, j, from the sphere's results
+  // (the group kernel's, for interpolated batches).
+  void lookupFrom(const Ray& ray, float len, float t0, bool inside, float lo, float hi, Lookup* l) const noexcept;
   QueryHit nearestHit(const Ray& ray, const Lookup& l, float* visibility) const noexcept;
   // The answer of a nearest lookup at texel (i, j) of map k (nearestHit, from its parts).
   QueryHit hitAt(const Ray& ray, uint32_t k, uint32_t i, uint32_t j, float t0, bool inside, float lo, float hi,
@@ -338,6 +341,20 @@ uint64_t FieldQuery::payloadBytes() const noexcept { return impl_ ? impl_->paylo
 
 // The core of every query. Distances below are object-space lengths along the unit direction w;
 // the caller's t is that length divided by |direction|.
+void FieldQuery::Impl::lookupFrom(const Ray& ray, float len, float t0, bool inside, float lo, float hi,
+                                  Lookup* l) const noexcept {
+  const Vec3 w = ray.direction * (1.0f / len);
+  l->w = w;
+  l->len = len;
+  l->t0 = t0;
+  l->inside = inside;
+  l->v = inside ? -w : w;
+  l->sign = inside ? -1.0f : 1.0f;  // t of a point at distance d from the entry along v: t0 + sign d
+  l->lo = lo;
+  l->hi = hi;
+  l->eu = (ray.origin + w * t0 - center) * (1.0f / radius);
+}
+
 bool FieldQuery::Impl::prepare(const Ray& ray, const QueryOptions& o, Lookup* l) const noexcept {
   const float len = std::sqrt(dot(ray.direction, ray.direction));
   if (!(len > 0) || !std::isfinite(len)) return false;
@@ -365,15 +382,7 @@ bool FieldQuery::Impl::prepare(const Ray& ray, const QueryOptions& o, Lookup* l)
     lo = std::max(lo, bias * radius);
   }
   if (!inside && t0 > tmax) return false;  // the sphere begins beyond the range
-  l->w = w;
-  l->len = len;
-  l->t0 = t0;
-  l->inside = inside;
-  l->v = inside ? -w : w;
-  l->sign = inside ? -1.0f : 1.0f;  // t of a point at distance d from the entry along v: t0 + sign d
-  l->lo = lo;
-  l->hi = tmax;
-  l->eu = (ray.origin + w * t0 - center) * (1.0f / radius);
+  lookupFrom(ray, len, t0, inside, lo, tmax, l);
   l->k0 = nearestSample(l->eu);
   const Vec3 local = toLocal(frames[l->k0], l->v);
   if (!detail::texelFast(field.directionScheme, local, m, &l->i, &l->j))
@@ -523,34 +532,73 @@ QueryHit FieldQuery::Impl::interpolated(const Ray& ray, const Lookup& l, float* 
   return blendInterpolated(ray, l, plan, visibility);
 }
 
-// Batches of interpolated lookups: plan a group of rays and request all their texels, then blend.
-// Rays from inside the sphere are answered as kNearest (query()).
+// Batches of interpolated lookups. The group kernel finds, for 64 rays at a time, those that reach
+// the sphere and their nearest samples; then 16 at a time are planned with all their taps' texels
+// requested from memory, and blended. Rays from inside the sphere are answered as kNearest
+// (query()).
 template <class Emit>
 void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept {
-  constexpr size_t kGroup = 16;
-  Lookup l[kGroup];
-  InterpPlan plan[kGroup];
-  enum : uint8_t { kMiss, kNearestLookup, kBlend } how[kGroup];
-  for (size_t base = 0; base < rays.size(); base += kGroup) {
-    const size_t n = std::min(kGroup, rays.size() - base);
-    for (size_t r = 0; r < n; ++r) {
-      if (!prepare(rays[base + r], o, &l[r])) {
-        how[r] = kMiss;
-      } else if (l[r].inside) {
-        how[r] = kNearestLookup;
-        __builtin_prefetch(texelAddress(l[r].k0, l[r].i, l[r].j));
-      } else {
-        how[r] = kBlend;
-        planInterpolated(rays[base + r], l[r], &plan[r]);
-        prefetchPlan(plan[r]);
-      }
-    }
-    for (size_t r = 0; r < n; ++r) {
+  constexpr size_t kPlanned = 16;
+  Lookup l[kPlanned];
+  InterpPlan plan[kPlanned];
+  uint32_t which[kPlanned];
+  bool live[kPlanned];
+  auto finish = [&](size_t base, size_t count) {
+    for (size_t c = 0; c < count; ++c) {
+      const Ray& ray = rays[base + which[c]];
       float vis = 1.0f;
       QueryHit h;
-      if (how[r] == kNearestLookup) h = nearestHit(rays[base + r], l[r], &vis);
-      if (how[r] == kBlend) h = blendInterpolated(rays[base + r], l[r], plan[r], &vis);
-      emit(base + r, h, vis);
+      if (live[c]) h = l[c].inside ? nearestHit(ray, l[c], &vis) : blendInterpolated(ray, l[c], plan[c], &vis);
+      emit(base + which[c], h, vis);
+    }
+  };
+  auto start = [&](size_t base, size_t c) {
+    if (!live[c]) return;
+    if (l[c].inside) {
+      __builtin_prefetch(texelAddress(l[c].k0, l[c].i, l[c].j));
+    } else {
+      planInterpolated(rays[base + which[c]], l[c], &plan[c]);
+      prefetchPlan(plan[c]);
+    }
+  };
+  if (!detail::groupKernelAvailable()) {
+    for (size_t base = 0; base < rays.size(); base += kPlanned) {
+      const size_t n = std::min(kPlanned, rays.size() - base);
+      for (size_t r = 0; r < n; ++r) {
+        which[r] = uint32_t(r);
+        live[r] = prepare(rays[base + r], o, &l[r]);
+        start(base, r);
+      }
+      finish(base, n);
+    }
+    return;
+  }
+  const detail::GroupTables tables = groupTables(o);
+  detail::Group g;
+  for (size_t base = 0; base < rays.size(); base += detail::kGroupRays) {
+    const size_t n = std::min(detail::kGroupRays, rays.size() - base);
+    detail::prepareGroup(tables, rays.data() + base, n, &g);
+    uint64_t reached = 0;
+    for (uint32_t p = 0; p < g.count; ++p) reached |= uint64_t(1) << g.ray[p];
+    for (size_t r = 0; r < n; ++r)
+      if (!((reached >> r) & 1u)) emit(base + r, QueryHit{}, 1.0f);
+    for (uint32_t first = 0; first < g.count; first += kPlanned) {
+      const size_t count = std::min<size_t>(kPlanned, g.count - first);
+      for (size_t c = 0; c < count; ++c) {
+        const uint32_t p = first + uint32_t(c), r = g.ray[p];
+        which[c] = r;
+        if ((g.redo >> p) & 1u) {
+          live[c] = prepare(rays[base + r], o, &l[c]);
+        } else {
+          live[c] = true;
+          lookupFrom(rays[base + r], g.len[r], g.t0[r], (g.inside >> r) & 1u, g.lo[r], g.hi[r], &l[c]);
+          l[c].k0 = g.k[p];
+          l[c].i = g.i[p];
+          l[c].j = g.j[p];
+        }
+        start(base, c);
+      }
+      finish(base, count);
     }
   }
 }

@@ -334,6 +334,19 @@ void checkBatches(detail::KernelChoice) {
         }
         EXPECT_GT(hitCount, rays.size() / 10);  // the test exercises hits, not only misses
       }
+      // Interpolated batches (the group kernel finds the nearest samples) against one-ray calls.
+      QueryOptions oi = o;
+      oi.reconstruction = Reconstruction::kInterpolated;
+      std::vector<float> vis(rays.size());
+      std::vector<QueryHit> hits(rays.size());
+      q->visibility(rays, vis, oi);
+      q->intersect(rays, hits, oi);
+      for (size_t r = 0; r < rays.size(); ++r) {
+        ASSERT_EQ(vis[r], q->visibility(rays[r], oi)) << "n " << n << " ray " << r;
+        const QueryHit single = q->intersect(rays[r], oi);
+        ASSERT_EQ(hits[r].hit, single.hit) << "n " << n << " ray " << r;
+        ASSERT_EQ(hits[r].t, single.t) << "n " << n << " ray " << r;
+      }
     }
   }
 }
