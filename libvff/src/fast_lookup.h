@@ -22,8 +22,12 @@ namespace vff::detail {
 // Guard bands: far wider than the binary32 error of the quantities they protect (a few ulps of
 // values <= 1, scaled by the grid or map resolution), and narrow enough that the fallback runs
 // for well under 1% of random rays.
-inline constexpr float kGridGuard = 1e-4f;   // grid units: candidates of octa-hemi2
+inline constexpr float kGridGuard = 1e-4f;   // grid units, plus 1e-6 per unit of n: octa-hemi2 cells
 inline constexpr float kTexelGuard = 1e-4f;  // texel units, plus 2e-6 per texel of map width
+
+// The guard band of an octa-hemi2 grid of parameter n, in grid units (the query's projection is
+// about n times a value <= 1 with a relative error of a few ulps: 2.5e-4 at n = 1024).
+inline float gridGuard(uint32_t n) noexcept { return kGridGuard + 1e-6f * float(n); }
 
 // The candidates of an octa-hemi2 query in cell (a0, b0) of its quadrant (PositionSet::candidates):
 // grid vertices (a0 + da, b0 + db), those with |a| + |b| > n left out.
@@ -91,7 +95,7 @@ inline std::vector<uint8_t> octaCandidateMasks(uint32_t un) {
 // direction q (finite, non-zero, need not be unit), evaluated in binary32, then the nearest of
 // them by binary32 dot products with the float table `unit` (ties to the smallest index), as
 // FieldQuery does with the reference candidates. False when the projection of q lies within
-// kGridGuard of a grid line, where the binary64 reference could choose another cell.
+// gridGuard(n) of a grid line, where the binary64 reference could choose another cell.
 inline bool octaNearestFast(uint32_t un, const Vec3* unit, Vec3 q, uint32_t* out) noexcept {
   const int32_t n = int32_t(un);
   const float ax = std::fabs(q.x), ay = std::fabs(q.y), az = std::fabs(q.z);
@@ -102,7 +106,8 @@ inline bool octaNearestFast(uint32_t un, const Vec3* unit, Vec3 q, uint32_t* out
   const float fa = std::floor(pa), fb = std::floor(pb);
   // Near a grid line (or at the edge |i| + |j| = n, or at the clamp to n - 1) the reference,
   // which normalises in binary64 first, may land in the neighbouring cell.
-  if (pa - fa < kGridGuard || fa + 1.0f - pa < kGridGuard || pb - fb < kGridGuard || fb + 1.0f - pb < kGridGuard)
+  const float g = gridGuard(un);
+  if (pa - fa < g || fa + 1.0f - pa < g || pb - fb < g || fb + 1.0f - pb < g)
     return false;
   const int32_t a0 = std::min(int32_t(fa), n - 1), b0 = std::min(int32_t(fb), n - 1);
   const int32_t h = q.z >= 0 ? 0 : 1;

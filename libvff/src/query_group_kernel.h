@@ -131,7 +131,7 @@ void lookupStep(const GroupTables& tb, const Packed& pk, size_t p, Group* g) {
   F redo = bnot(band(gt(l1, zero), lt(l1, F(3.0e38f))));
   const F pa = ax / l1 * fn, pb = ay / l1 * fn;
   const F fa = floorPos(pa), fb = floorPos(pb);
-  const F gg(kGridGuard);
+  const F gg(kGridGuard + 1e-6f * fnS);  // gridGuard(n)
   redo = bor(redo, bor(bor(lt(pa - fa, gg), lt((fa + one) - pa, gg)), bor(lt(pb - fb, gg), lt((fb + one) - pb, gg))));
   const F a0 = vmin(fa, fn - one), b0 = vmin(fb, fn - one);
   const F h = bandnot(ge(euz, zero), one);  // 0 upper, 1 lower hemisphere

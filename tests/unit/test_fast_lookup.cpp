@@ -65,7 +65,7 @@ std::vector<Vec3> testDirections(uint32_t gridN, size_t random) {
 }
 
 TEST(FastLookup, OctaNearestEqualsTheReferenceWhereverItAnswers) {
-  for (uint32_t n : {1u, 2u, 3u, 8u, 32u, 64u, 255u}) {
+  for (uint32_t n : {1u, 2u, 3u, 8u, 32u, 64u, 255u, 1024u}) {  // 1024: the largest n
     auto ps = PositionSet::create(PositionScheme::kOctaHemi2, n);
     ASSERT_TRUE(ps);
     std::vector<Vec3> unit(ps->count());
@@ -117,8 +117,8 @@ TEST(FastLookup, CandidateMasksKeepTheNearest) {
       const float ax = std::fabs(d.x), ay = std::fabs(d.y), l1 = ax + ay + std::fabs(d.z);
       const float pa = ax / l1 * float(n), pb = ay / l1 * float(n);
       const int a0 = std::min(int(pa), int(n) - 1), b0 = std::min(int(pb), int(n) - 1);
-      if (pa - std::floor(pa) < detail::kGridGuard || std::ceil(pa) - pa < detail::kGridGuard ||
-          pb - std::floor(pb) < detail::kGridGuard || std::ceil(pb) - pb < detail::kGridGuard)
+      const float gg = detail::gridGuard(n);
+      if (pa - std::floor(pa) < gg || std::ceil(pa) - pa < gg || pb - std::floor(pb) < gg || std::ceil(pb) - pb < gg)
         continue;
       const uint32_t ref = referenceNearest(*ps, unit, d);
       // The candidate the reference chose, as an offset from the cell in the quadrant frame.
