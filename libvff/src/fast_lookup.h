@@ -187,33 +187,14 @@ inline Vec2 hemisphereToSquareFast(DirectionScheme scheme, Vec3 local) noexcept 
 // False when the direction lies within the guard band of a texel edge or of an octant diagonal of
 // the concentric map (where the reference's atan2f decides).
 inline bool texelFast(DirectionScheme scheme, Vec3 local, uint32_t m, uint32_t* i, uint32_t* j) noexcept {
-  const float fm = float(m);
-  float a, b;
-  const float z = std::max(0.0f, local.z);
-  if (scheme == DirectionScheme::kHemiOctahedral) {
-    const float inv = 1.0f / (std::fabs(local.x) + std::fabs(local.y) + z);
-    const float x = local.x * inv, y = local.y * inv;
-    a = x + y;
-    b = x - y;
-  } else {
-    const float r = std::sqrt(std::max(0.0f, 1.0f - z));
-    const float ax = std::fabs(local.x), ay = std::fabs(local.y);
+  if (scheme != DirectionScheme::kHemiOctahedral) {
     // Octant diagonals |x| = |y| (and the centre, x = y = 0): left to the reference.
+    const float ax = std::fabs(local.x), ay = std::fabs(local.y);
     if (!(std::fabs(ax - ay) > 1e-5f * (ax + ay))) return false;
-    const float k = r * (4.0f / 3.14159265358979323846f);
-    if (ax > ay) {
-      a = local.x < 0 ? -r : r;
-      const float s = atanUnit(local.y / local.x) * k;
-      b = local.x < 0 ? -s : s;
-    } else {
-      b = local.y < 0 ? -r : r;
-      const float s = atanUnit(local.x / local.y) * k;
-      a = local.y < 0 ? -s : s;
-    }
   }
-  a = std::min(std::max(a, -1.0f), 1.0f);
-  b = std::min(std::max(b, -1.0f), 1.0f);
-  const float x = (a + 1.0f) * 0.5f * fm, y = (b + 1.0f) * 0.5f * fm;
+  const Vec2 uv = hemisphereToSquareFast(scheme, local);
+  const float fm = float(m);
+  const float x = (uv.x + 1.0f) * 0.5f * fm, y = (uv.y + 1.0f) * 0.5f * fm;
   const float fx = std::floor(x), fy = std::floor(y);
   const float g = kTexelGuard + 2e-6f * fm;
   if (x - fx < g || fx + 1.0f - x < g || y - fy < g || fy + 1.0f - y < g) return false;

@@ -162,6 +162,20 @@ struct FieldQuery::Impl {
   QueryHit blendInterpolated(const Ray& ray, const Lookup& l, const InterpPlan& plan, float* visibility) const noexcept;
   template <class Emit>
   void batchInterpolated(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept;
+  // Runs the group kernel over rays, kGroupRays at a time: each(base, n, group, reached), where bit
+  // r of `reached` says whether ray base + r reaches the sphere (the others miss).
+  template <class Each>
+  void forEachGroup(std::span<const Ray> rays, const QueryOptions& o, Each&& each) const noexcept {
+    const detail::GroupTables tables = groupTables(o);
+    detail::Group g;
+    for (size_t base = 0; base < rays.size(); base += detail::kGroupRays) {
+      const size_t n = std::min(detail::kGroupRays, rays.size() - base);
+      detail::prepareGroup(tables, rays.data() + base, n, &g);
+      uint64_t reached = 0;
+      for (uint32_t p = 0; p < g.count; ++p) reached |= uint64_t(1) << g.ray[p];
+      each(base, n, g, reached);
+    }
+  }
   QueryHit query(const Ray& ray, const QueryOptions& o, float* visibility) const noexcept;
   // Whether the nearest lookup at texel (i, j) of map k hits within [lo, hi] (hitAt(...).hit).
   bool hitsAt(uint32_t k, uint32_t i, uint32_t j, float t0, bool inside, float lo, float hi) const noexcept {
@@ -573,13 +587,7 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
     }
     return;
   }
-  const detail::GroupTables tables = groupTables(o);
-  detail::Group g;
-  for (size_t base = 0; base < rays.size(); base += detail::kGroupRays) {
-    const size_t n = std::min(detail::kGroupRays, rays.size() - base);
-    detail::prepareGroup(tables, rays.data() + base, n, &g);
-    uint64_t reached = 0;
-    for (uint32_t p = 0; p < g.count; ++p) reached |= uint64_t(1) << g.ray[p];
+  forEachGroup(rays, o, [&](size_t base, size_t n, detail::Group& g, uint64_t reached) {
     for (size_t r = 0; r < n; ++r)
       if (!((reached >> r) & 1u)) emit(base + r, QueryHit{}, 1.0f);
     for (uint32_t first = 0; first < g.count; first += kPlanned) {
@@ -600,7 +608,7 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
       }
       finish(base, count);
     }
-  }
+  });
 }
 
 QueryHit FieldQuery::intersect(const Ray& ray, const QueryOptions& options) const noexcept {
@@ -653,14 +661,8 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
     }
     return;
   }
-  const detail::GroupTables tables = groupTables(o);
-  detail::Group g;
-  for (size_t base = 0; base < rays.size(); base += detail::kGroupRays) {
-    const size_t n = std::min(detail::kGroupRays, rays.size() - base);
-    detail::prepareGroup(tables, rays.data() + base, n, &g);
+  forEachGroup(rays, o, [&](size_t base, size_t n, detail::Group& g, uint64_t reached) {
     // Every ray misses unless it reaches the sphere.
-    uint64_t reached = 0;
-    for (uint32_t p = 0; p < g.count; ++p) reached |= uint64_t(1) << g.ray[p];
     for (size_t r = 0; r < n; ++r) {
       if ((reached >> r) & 1u) continue;
       if constexpr (kHitOnly) {
@@ -704,7 +706,7 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
         emit(base + r, h, vis);
       }
     }
-  }
+  });
 }
 
 void FieldQuery::intersect(std::span<const Ray> rays, std::span<QueryHit> out, const QueryOptions& options) const noexcept {

@@ -20,6 +20,13 @@ namespace {
 
 float dot3(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
+// The float positions of every sample, as FieldQuery keeps them.
+std::vector<Vec3> unitTable(const PositionSet& ps) {
+  std::vector<Vec3> unit(ps.count());
+  for (uint32_t k = 0; k < ps.count(); ++k) unit[k] = ps.position(k);
+  return unit;
+}
+
 // FieldQuery's reference choice: the reference candidates, binary32 dot products with the float
 // positions, ties to the smallest index.
 uint32_t referenceNearest(const PositionSet& ps, const std::vector<Vec3>& unit, Vec3 d) {
@@ -68,8 +75,7 @@ TEST(FastLookup, OctaNearestEqualsTheReferenceWhereverItAnswers) {
   for (uint32_t n : {1u, 2u, 3u, 8u, 32u, 64u, 255u, 1024u}) {  // 1024: the largest n
     auto ps = PositionSet::create(PositionScheme::kOctaHemi2, n);
     ASSERT_TRUE(ps);
-    std::vector<Vec3> unit(ps->count());
-    for (uint32_t k = 0; k < ps->count(); ++k) unit[k] = ps->position(k);
+    const std::vector<Vec3> unit = unitTable(*ps);
     const std::vector<Vec3> dirs = testDirections(n, 200000);
     size_t answered = 0, randomRefused = 0;
     for (size_t r = 0; r < dirs.size(); ++r) {
@@ -92,8 +98,7 @@ TEST(FastLookup, CandidateMasksKeepTheNearest) {
   for (uint32_t n : {1u, 2u, 5u, 32u, 64u, 128u}) {
     auto ps = PositionSet::create(PositionScheme::kOctaHemi2, n);
     ASSERT_TRUE(ps);
-    std::vector<Vec3> unit(ps->count());
-    for (uint32_t k = 0; k < ps->count(); ++k) unit[k] = ps->position(k);
+    const std::vector<Vec3> unit = unitTable(*ps);
     const std::vector<uint8_t> masks = detail::octaCandidateMasks(n);
     ASSERT_EQ(masks.size(), size_t(n) * n);
     size_t kept = 0;
@@ -302,8 +307,7 @@ void checkBatches(detail::KernelChoice) {
       auto q = FieldQuery::fromMaps(f, dist);
       ASSERT_TRUE(q);
       auto ps = PositionSet::fromField(f);
-      std::vector<Vec3> unit(ps->count());
-      for (uint32_t k = 0; k < ps->count(); ++k) unit[k] = ps->position(k);
+      const std::vector<Vec3> unit = unitTable(*ps);
       const std::vector<Ray> rays = testRays(f, 20000, n);
       QueryOptions o;
       o.intraBias = 0.05f;
@@ -361,8 +365,7 @@ TEST(FastLookup, OtherPositionSchemesTakeTheReferencePath) {
     auto q = FieldQuery::fromMaps(f, dist);
     ASSERT_TRUE(q);
     auto ps = PositionSet::fromField(f);
-    std::vector<Vec3> unit(ps->count());
-    for (uint32_t k = 0; k < ps->count(); ++k) unit[k] = ps->position(k);
+    const std::vector<Vec3> unit = unitTable(*ps);
     const std::vector<Ray> rays = testRays(f, 5000, 9);
     QueryOptions o;
     o.intraBias = 0.0f;
