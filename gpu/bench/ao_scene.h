@@ -88,20 +88,26 @@ inline Ray aoRay(const AoScene& s, uint32_t p, int i) {
   return Ray{o, d, 0.0f, s.tmax};
 }
 
-// The CPU image: AO per pixel with FieldQuery, on `threads` threads (rows interleaved).
+// The CPU image: AO per pixel with FieldQuery's batch calls (one per pixel), on `threads` threads
+// (rows interleaved).
 inline std::vector<float> cpuAo(const FieldQuery& q, const AoScene& s, int rays, Reconstruction r,
                                 unsigned threads = 1) {
   std::vector<float> out(size_t(s.size) * s.size);
   const QueryOptions qo{.reconstruction = r, .intraBias = 0.0f};
   auto work = [&](unsigned t0) {
+    std::vector<Ray> batch(size_t(std::max(rays, 0)));
+    std::vector<uint8_t> occ(batch.size());
+    std::vector<float> vis(batch.size());
     for (int y = int(t0); y < s.size; y += int(threads))
       for (int x = 0; x < s.size; ++x) {
         const uint32_t p = uint32_t(y * s.size + x);
+        for (int i = 0; i < rays; ++i) batch[size_t(i)] = aoRay(s, p, i);
+        if (r == Reconstruction::kNearest)
+          q.occluded(batch, occ, qo);
+        else
+          q.visibility(batch, vis, qo);
         float open = 0;
-        for (int i = 0; i < rays; ++i) {
-          const Ray ray = aoRay(s, p, i);
-          open += r == Reconstruction::kNearest ? (q.occluded(ray, qo) ? 0.0f : 1.0f) : q.visibility(ray, qo);
-        }
+        for (size_t i = 0; i < batch.size(); ++i) open += r == Reconstruction::kNearest ? (occ[i] ? 0.0f : 1.0f) : vis[i];
         out[p] = open / float(rays);
       }
   };
