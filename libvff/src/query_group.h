@@ -21,6 +21,9 @@
 namespace vff::detail {
 
 inline constexpr size_t kGroupRays = 64;
+static_assert(sizeof(Ray) == 32 && offsetof(Ray, direction) == 12 && offsetof(Ray, tmin) == 24 &&
+                  offsetof(Ray, tmax) == 28,
+              "the kernels load a Ray as eight packed floats: origin, direction, tmin, tmax");
 
 // What the kernel reads: plain tables owned by FieldQuery::Impl.
 struct GroupTables {
