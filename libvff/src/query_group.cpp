@@ -24,9 +24,10 @@ namespace {
 
 using Kernel = void (*)(const GroupTables&, const Ray*, size_t, Group*) noexcept;
 
-Kernel chooseKernel() noexcept {
+// The widest kernel this CPU runs (the override is applied per call, in prepareGroup).
+Kernel widestKernel() noexcept {
 #if defined(VFF_HAVE_AVX2_KERNEL)
-  if (kernelOverride() != KernelChoice::kSse2 && __builtin_cpu_supports("avx2")) return prepareGroupAvx2;
+  if (__builtin_cpu_supports("avx2")) return prepareGroupAvx2;
 #endif
   return prepareGroupSse2;
 }
@@ -44,7 +45,7 @@ const char* groupKernelName() noexcept {
 }
 
 void prepareGroup(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept {
-  static const Kernel kernel = chooseKernel();
+  static const Kernel kernel = widestKernel();
   if (kernelOverride() == KernelChoice::kSse2) {
     prepareGroupSse2(tables, rays, n, g);
     return;
