@@ -28,6 +28,12 @@ inline constexpr float kTexelGuard = 1e-4f;  // texel units, plus 2e-6 per texel
 // The guard band of an octa-hemi2 grid of parameter n, in grid units (the query's projection is
 // about n times a value <= 1 with a relative error of a few ulps: 2.5e-4 at n = 1024).
 inline float gridGuard(uint32_t n) noexcept { return kGridGuard + 1e-6f * float(n); }
+// The guard band of an M x M map, in texel units.
+inline float texelGuard(uint32_t m) noexcept { return kTexelGuard + 2e-6f * float(m); }
+
+// atanUnit's constants (Cephes atanf), shared with the SIMD kernel's copy of it.
+inline constexpr float kTanPi8 = 0.41421356f, kQuarterPiF = 0.78539816f;
+inline constexpr float kAtanP[4] = {8.05374449538e-2f, -1.38776856032e-1f, 1.99777106478e-1f, -3.33329491539e-1f};
 
 // The candidates of an octa-hemi2 query in cell (a0, b0) of its quadrant (PositionSet::candidates):
 // grid vertices (a0 + da, b0 + db), those with |a| + |b| > n left out.
@@ -95,8 +101,9 @@ inline std::vector<uint8_t> octaCandidateMasks(uint32_t un) {
 // direction q (finite, non-zero, need not be unit), evaluated in binary32, then the nearest of
 // them by binary32 dot products with the float table `unit` (ties to the smallest index), as
 // FieldQuery does with the reference candidates. False when the projection of q lies within
-// gridGuard(n) of a grid line, where the binary64 reference could choose another cell.
-inline bool octaNearestFast(uint32_t un, const Vec3* unit, Vec3 q, uint32_t* out) noexcept {
+// gridGuard(n) of a grid line, where the binary64 reference could choose another cell. `unit4`
+// holds 4 floats per sample: x, y, z and padding.
+inline bool octaNearestFast(uint32_t un, const float* unit4, Vec3 q, uint32_t* out) noexcept {
   const int32_t n = int32_t(un);
   const float ax = std::fabs(q.x), ay = std::fabs(q.y), az = std::fabs(q.z);
   const float l1 = ax + ay + az;
@@ -127,8 +134,8 @@ inline bool octaNearestFast(uint32_t un, const Vec3* unit, Vec3 q, uint32_t* out
     const int32_t rowStart = j <= 0 ? t * t : t * t - 2 * j * (j - 1);
     const int32_t w = n - (j < 0 ? -j : j);
     const uint32_t k = uint32_t(hh * hemi + rowStart + i + w);
-    const Vec3 u = unit[k];
-    const float d = u.x * q.x + u.y * q.y + u.z * q.z;
+    const float* u = unit4 + size_t(k) * 4;
+    const float d = u[0] * q.x + u[1] * q.y + u[2] * q.z;
     if (!any || d > bestDot || (d == bestDot && k < best)) {
       bestDot = d;
       best = k;
@@ -144,11 +151,11 @@ inline bool octaNearestFast(uint32_t un, const Vec3* unit, Vec3 q, uint32_t* out
 // polynomial; error about 2e-7).
 inline float atanUnit(float t) noexcept {
   const float at = std::fabs(t);
-  const bool big = at > 0.41421356f;
+  const bool big = at > kTanPi8;
   const float x = big ? (at - 1.0f) / (at + 1.0f) : at;
-  const float y0 = big ? 0.78539816f : 0.0f;
+  const float y0 = big ? kQuarterPiF : 0.0f;
   const float z = x * x;
-  const float p = (((8.05374449538e-2f * z - 1.38776856032e-1f) * z + 1.99777106478e-1f) * z - 3.33329491539e-1f) * z * x + x;
+  const float p = (((kAtanP[0] * z + kAtanP[1]) * z + kAtanP[2]) * z + kAtanP[3]) * z * x + x;
   const float r = y0 + p;
   return t < 0 ? -r : r;
 }
@@ -196,7 +203,7 @@ inline bool texelFast(DirectionScheme scheme, Vec3 local, uint32_t m, uint32_t* 
   const float fm = float(m);
   const float x = (uv.x + 1.0f) * 0.5f * fm, y = (uv.y + 1.0f) * 0.5f * fm;
   const float fx = std::floor(x), fy = std::floor(y);
-  const float g = kTexelGuard + 2e-6f * fm;
+  const float g = texelGuard(m);
   if (x - fx < g || fx + 1.0f - x < g || y - fy < g || fy + 1.0f - y < g) return false;
   *i = uint32_t(std::min(std::max(fx, 0.0f), fm - 1.0f));
   *j = uint32_t(std::min(std::max(fy, 0.0f), fm - 1.0f));

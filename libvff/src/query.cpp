@@ -56,9 +56,8 @@ struct FieldQuery::Impl {
   uint64_t distMapBytes = 0, normMapBytes = 0;
   std::vector<const uint8_t*> dist;  // per map
   std::vector<const uint8_t*> norm;  // per map, empty without normals
-  std::vector<Vec3> unit;            // û_k, float
   std::vector<Frame> frames;         // frame of map k (inward normal)
-  std::vector<float> unit4;          // unit, padded to 4 floats per map (the group kernel)
+  std::vector<float> unit4;          // û_k, float, padded to 4 floats per map (for the group kernel)
   std::vector<uint8_t> octaMasks;    // octa-hemi2: detail::octaCandidateMasks (the group kernel)
   static constexpr uint32_t kNeighbours = kQueryNeighbours;
   std::vector<uint32_t> neighbours;  // kNeighbours per map; UINT32_MAX pads
@@ -67,11 +66,6 @@ struct FieldQuery::Impl {
   float defaultBias = 0;             // fraction of R
   std::vector<float> chordScale;     // unorm8-chord: 2R cos(alpha) / 254 per texel (M * M)
   uint64_t payload = 0;
-
-  // bc4-diameter: the byte offset of the block that holds texel (i, j) of a map.
-  size_t bc4Block(uint32_t i, uint32_t j) const noexcept {
-    return (size_t(j >> 2) * (m >> 2) + (i >> 2)) * kBc4BlockBytes;
-  }
 
   Sample texel(uint32_t k, uint32_t i, uint32_t j) const noexcept {
     const uint8_t* map = dist[k];
@@ -92,7 +86,7 @@ struct FieldQuery::Impl {
       case DistanceEncoding::kBit1:
         return {((map[t / 8] >> (t % 8)) & 1u) != 0, 0.0f};
       case DistanceEncoding::kBc4Diameter: {
-        const uint32_t c = bc4Texel(map + bc4Block(i, j), (j & 3u) * 4 + (i & 3u));
+        const uint32_t c = bc4Texel(map + detail::texelByte(DistanceEncoding::kBc4Diameter, m, i, j), (j & 3u) * 4 + (i & 3u));
         return {c != 255u, float(c) * (2.0f * radius / 254.0f)};
       }
       case DistanceEncoding::kInvalid: break;
@@ -104,21 +98,22 @@ struct FieldQuery::Impl {
     return decodeNormal(norm[k] + 4 * (size_t(j) * m + i));
   }
 
-  Vec3 samplePoint(uint32_t k) const noexcept { return center + unit[k] * radius; }
+  Vec3 unit(uint32_t k) const noexcept { return {unit4[size_t(k) * 4], unit4[size_t(k) * 4 + 1], unit4[size_t(k) * 4 + 2]}; }
+  Vec3 samplePoint(uint32_t k) const noexcept { return center + unit(k) * radius; }
 
   // The nearest sample among the O(1) candidates, by binary32 dot products with the table of
   // positions (spec/positions.md section 2 allows a decoder this; it differs from the binary64
   // choice only between samples equally near to within rounding).
   uint32_t nearestSample(Vec3 d) const noexcept {
     uint32_t fast;
-    if (positions.scheme() == PositionScheme::kOctaHemi2 && detail::octaNearestFast(positions.param(), unit.data(), d, &fast))
+    if (positions.scheme() == PositionScheme::kOctaHemi2 && detail::octaNearestFast(positions.param(), unit4.data(), d, &fast))
       return fast;
     uint32_t c[PositionSet::kMaxCandidates];
     const uint32_t n = positions.candidates(d, c);
     uint32_t best = c[0];
-    float bestDot = dot(unit[best], d);
+    float bestDot = dot(unit(best), d);
     for (uint32_t i = 1; i < n; ++i) {
-      const float v = dot(unit[c[i]], d);
+      const float v = dot(unit(c[i]), d);
       if (v > bestDot || (v == bestDot && c[i] < best)) {
         bestDot = v;
         best = c[i];
@@ -133,7 +128,7 @@ struct FieldQuery::Impl {
   // decodes that texel.
   struct Lookup {
     Vec3 w, v, eu;
-    float len = 0, t0 = 0, sign = 1, lo = 0, hi = 0;
+    float len = 0, t0 = 0, lo = 0, hi = 0;
     bool inside = false;
     uint32_t k0 = 0, i = 0, j = 0;  // i, j: the nearest lookup's texel
   };
@@ -178,23 +173,20 @@ struct FieldQuery::Impl {
   }
   QueryHit query(const Ray& ray, const QueryOptions& o, float* visibility) const noexcept;
   // Whether the nearest lookup at texel (i, j) of map k hits within [lo, hi] (hitAt(...).hit).
-  bool hitsAt(uint32_t k, uint32_t i, uint32_t j, float t0, bool inside, float lo, float hi) const noexcept {
+  // *t: the hit's distance along the ray's unit direction.
+  bool hitsAt(uint32_t k, uint32_t i, uint32_t j, float t0, bool inside, float lo, float hi,
+              float* t = nullptr) const noexcept {
     const Sample s = texel(k, i, j);
     if (!s.hit) return false;
-    const float t = inside ? t0 - s.distance : t0 + s.distance;
-    return !(t < lo || t > hi);
+    const float th = inside ? t0 - s.distance : t0 + s.distance;
+    if (t) *t = th;
+    return !(th < lo || th > hi);
   }
   // kHitOnly: emit(r, bool hit); otherwise emit(r, const QueryHit&, float visibility).
   template <bool kHitOnly, class Emit>
   void batchNearest(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept;
   const uint8_t* texelAddress(uint32_t k, uint32_t i, uint32_t j) const noexcept {
-    const size_t t = size_t(j) * m + i;
-    switch (field.distanceEncoding) {
-      case DistanceEncoding::kUnorm16Diameter: return dist[k] + 2 * t;
-      case DistanceEncoding::kBit1: return dist[k] + t / 8;
-      case DistanceEncoding::kBc4Diameter: return dist[k] + bc4Block(i, j);
-      default: return dist[k] + t;
-    }
+    return dist[k] + detail::texelByte(field.distanceEncoding, m, i, j);
   }
 };
 
@@ -209,15 +201,14 @@ void FieldQuery::Impl::build() {
   center = toVec(field.sphere.center);
   radius = field.sphere.radius;
   m = field.mapResolution;
-  unit.resize(n);
   frames.resize(n);
   unit4.assign(size_t(n) * 4, 0.0f);
   for (uint32_t k = 0; k < n; ++k) {
-    unit[k] = positions.position(k);
+    const Vec3 u = positions.position(k);
+    unit4[size_t(k) * 4] = u.x;
+    unit4[size_t(k) * 4 + 1] = u.y;
+    unit4[size_t(k) * 4 + 2] = u.z;
     frames[k] = positions.frame(k);
-    unit4[size_t(k) * 4] = unit[k].x;
-    unit4[size_t(k) * 4 + 1] = unit[k].y;
-    unit4[size_t(k) * 4 + 2] = unit[k].z;
   }
   if (positions.scheme() == PositionScheme::kOctaHemi2) octaMasks = detail::octaCandidateMasks(positions.param());
   spacing = std::sqrt(4.0f * kPi / float(n));
@@ -363,7 +354,6 @@ void FieldQuery::Impl::lookupFrom(const Ray& ray, float len, float t0, bool insi
   l->t0 = t0;
   l->inside = inside;
   l->v = inside ? -w : w;
-  l->sign = inside ? -1.0f : 1.0f;  // t of a point at distance d from the entry along v: t0 + sign d
   l->lo = lo;
   l->hi = hi;
   l->eu = (ray.origin + w * t0 - center) * (1.0f / radius);
@@ -411,10 +401,8 @@ QueryHit FieldQuery::Impl::nearestHit(const Ray& ray, const Lookup& l, float* vi
 QueryHit FieldQuery::Impl::hitAt(const Ray& ray, uint32_t k, uint32_t i, uint32_t j, float t0, bool inside, float lo,
                                  float hi, float len, float* visibility) const noexcept {
   QueryHit out;
-  const Sample s = texel(k, i, j);
-  if (!s.hit) return out;
-  const float t = inside ? t0 - s.distance : t0 + s.distance;
-  if (t < lo || t > hi) return out;
+  float t = 0;
+  if (!hitsAt(k, i, j, t0, inside, lo, hi, &t)) return out;
   if (visibility) *visibility = 0.0f;
   out.hit = true;
   out.inside = inside;
@@ -444,7 +432,7 @@ QueryHit FieldQuery::Impl::query(const Ray& ray, const QueryOptions& o, float* v
 void FieldQuery::Impl::planInterpolated(const Ray& ray, const Lookup& l, InterpPlan* plan) const noexcept {
   const Vec3 eu = l.eu, v = l.v, w = l.w;
   auto kernel = [&](uint32_t k) {
-    const Vec3 d = eu - unit[k];
+    const Vec3 d = eu - unit(k);
     const float x = 1.0f - dot(d, d) / kernelRadius2;
     return x > 0 ? x * x : 0.0f;
   };
@@ -493,11 +481,11 @@ void FieldQuery::Impl::prefetchPlan(const InterpPlan& plan) const noexcept {
 QueryHit FieldQuery::Impl::blendInterpolated(const Ray& ray, const Lookup& l, const InterpPlan& plan,
                                              float* visibility) const noexcept {
   QueryHit out;
-  const float sign = l.sign, lo = l.lo, hi = l.hi;
+  const float lo = l.lo, hi = l.hi;
+  const float along = l.inside ? -1.0f : 1.0f;  // t per unit distance along v
   Blend bl;
   for (uint32_t c = 0; c < plan.count; ++c) {
     const InterpPlan::Tap& tap = plan.taps[c];
-    const float along = sign;  // t per unit distance along v
     for (int dj = 0; dj < 2; ++dj) {
       for (int di = 0; di < 2; ++di) {
         const float bw = tap.weight * (di ? tap.fx : 1.0f - tap.fx) * (dj ? tap.fy : 1.0f - tap.fy);
@@ -637,6 +625,8 @@ detail::GroupTables FieldQuery::Impl::groupTables(const QueryOptions& o) const n
   t.m = m;
   t.bit1 = field.distanceEncoding == DistanceEncoding::kBit1;
   t.insideLo = (o.intraBias >= 0 ? o.intraBias : defaultBias) * radius;
+  t.gridGuard = detail::gridGuard(t.octaN);
+  t.texelGuard = detail::texelGuard(m);
   t.maps = dist.data();
   t.encoding = field.distanceEncoding;
   return t;

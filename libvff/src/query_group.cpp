@@ -24,12 +24,15 @@ namespace {
 
 using Kernel = void (*)(const GroupTables&, const Ray*, size_t, Group*) noexcept;
 
-// The widest kernel this CPU runs (the override is applied per call, in prepareGroup).
-Kernel widestKernel() noexcept {
+// The kernel prepareGroup runs now: the override, else the widest this CPU runs (decided once).
+Kernel activeKernel() noexcept {
+  static const Kernel widest = [] {
 #if defined(VFF_HAVE_AVX2_KERNEL)
-  if (__builtin_cpu_supports("avx2")) return prepareGroupAvx2;
+    if (__builtin_cpu_supports("avx2")) return prepareGroupAvx2;
 #endif
-  return prepareGroupSse2;
+    return prepareGroupSse2;
+  }();
+  return kernelOverride() == KernelChoice::kSse2 ? prepareGroupSse2 : widest;
 }
 
 }  // namespace
@@ -37,21 +40,11 @@ Kernel widestKernel() noexcept {
 bool groupKernelAvailable() noexcept { return kernelOverride() != KernelChoice::kNone; }
 
 const char* groupKernelName() noexcept {
-  if (kernelOverride() == KernelChoice::kNone) return "scalar";
-#if defined(VFF_HAVE_AVX2_KERNEL)
-  if (kernelOverride() != KernelChoice::kSse2 && __builtin_cpu_supports("avx2")) return "avx2";
-#endif
-  return "sse2";
+  if (!groupKernelAvailable()) return "scalar";
+  return activeKernel() == prepareGroupSse2 ? "sse2" : "avx2";
 }
 
-void prepareGroup(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept {
-  static const Kernel kernel = widestKernel();
-  if (kernelOverride() == KernelChoice::kSse2) {
-    prepareGroupSse2(tables, rays, n, g);
-    return;
-  }
-  kernel(tables, rays, n, g);
-}
+void prepareGroup(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept { activeKernel()(tables, rays, n, g); }
 
 #else
 

@@ -14,6 +14,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "vff/bc4.h"
 #include "vff/direction.h"
 #include "vff/format.h"
 #include "vff/query.h"
@@ -36,6 +37,7 @@ struct GroupTables {
   uint32_t m = 0;                   // map resolution
   bool bit1 = false;                // the distance encoding has no distances (rays from inside miss)
   float insideLo = 0;               // intra-object bias times the radius (QueryOptions::intraBias)
+  float gridGuard = 0, texelGuard = 0;  // fast_lookup.h's gridGuard(octaN) and texelGuard(m)
   // The distance maps, to prefetch the texels while the group is being looked up (null: none).
   const uint8_t* const* maps = nullptr;
   DistanceEncoding encoding = DistanceEncoding::kInvalid;
@@ -55,6 +57,21 @@ struct Group {
   uint64_t redo = 0;    // bit p: the caller must run the reference prepare() on packed ray p
 };
 static_assert(kGroupRays <= 64, "the masks hold one bit per ray");
+
+namespace {  // (a copy per file: the AVX2 kernel's file must share no inline function with the rest)
+
+// The byte offset, within a distance map, of the byte that holds texel (i, j).
+inline size_t texelByte(DistanceEncoding e, uint32_t m, uint32_t i, uint32_t j) {
+  const size_t t = size_t(j) * m + i;
+  switch (e) {
+    case DistanceEncoding::kUnorm16Diameter: return 2 * t;
+    case DistanceEncoding::kBit1: return t / 8;
+    case DistanceEncoding::kBc4Diameter: return (size_t(j >> 2) * (m >> 2) + (i >> 2)) * kBc4BlockBytes;  // its block
+    default: return t;
+  }
+}
+
+}  // namespace
 
 // True where prepareGroup is implemented (x86-64). Elsewhere the caller uses prepare().
 bool groupKernelAvailable() noexcept;

@@ -32,26 +32,14 @@ inline F maxStd(F a, F b) {
 template <class F>
 inline F atanUnitV(F t) {
   const F at = vabs(t);
-  const F big = gt(at, F(0.41421356f));
+  const F big = gt(at, F(kTanPi8));
   const F one(1.0f);
   const F x = sel(big, (at - one) / (at + one), at);
-  const F y0 = band(big, F(0.78539816f));
+  const F y0 = band(big, F(kQuarterPiF));
   const F z = x * x;
-  const F p = (((F(8.05374449538e-2f) * z - F(1.38776856032e-1f)) * z + F(1.99777106478e-1f)) * z -
-               F(3.33329491539e-1f)) * z * x + x;
+  const F p = (((F(kAtanP[0]) * z + F(kAtanP[1])) * z + F(kAtanP[2])) * z + F(kAtanP[3])) * z * x + x;
   const F r = y0 + p;
   return sel(lt(t, F(0.0f)), vneg(r), r);
-}
-
-// The byte of a distance map that holds texel (i, j) (FieldQuery::Impl::texelAddress).
-inline size_t texelByte(DistanceEncoding e, uint32_t m, uint32_t i, uint32_t j) {
-  const size_t t = size_t(j) * m + i;
-  switch (e) {
-    case DistanceEncoding::kUnorm16Diameter: return 2 * t;
-    case DistanceEncoding::kBit1: return t / 8;
-    case DistanceEncoding::kBc4Diameter: return (size_t(j >> 2) * (m >> 2) + (i >> 2)) * 8;
-    default: return t;
-  }
 }
 
 // The rays of a group that reach the sphere, packed as in Group: their entry points and lookup
@@ -131,7 +119,7 @@ void lookupStep(const GroupTables& tb, const Packed& pk, size_t p, Group* g) {
   F redo = bnot(band(gt(l1, zero), lt(l1, F(3.0e38f))));
   const F pa = ax / l1 * fn, pb = ay / l1 * fn;
   const F fa = floorPos(pa), fb = floorPos(pb);
-  const F gg(kGridGuard + 1e-6f * fnS);  // gridGuard(n)
+  const F gg(tb.gridGuard);
   redo = bor(redo, bor(bor(lt(pa - fa, gg), lt((fa + one) - pa, gg)), bor(lt(pb - fb, gg), lt((fb + one) - pb, gg))));
   const F a0 = vmin(fa, fn - one), b0 = vmin(fb, fn - one);
   const F h = bandnot(ge(euz, zero), one);  // 0 upper, 1 lower hemisphere
@@ -212,7 +200,7 @@ void lookupStep(const GroupTables& tb, const Packed& pk, size_t p, Group* g) {
   const F fm(fmS), half(0.5f);
   const F x = (a + one) * half * fm, y = (b + one) * half * fm;
   const F fx = floorPos(x), fy = floorPos(y);
-  const F tg(kTexelGuard + 2e-6f * fmS);
+  const F tg(tb.texelGuard);
   redo = bor(redo, bor(bor(lt(x - fx, tg), lt((fx + one) - x, tg)), bor(lt(y - fy, tg), lt((fy + one) - y, tg))));
   const F top(fmS - 1.0f);
   const F ok = bnot(redo);

@@ -76,11 +76,13 @@ TEST(FastLookup, OctaNearestEqualsTheReferenceWhereverItAnswers) {
     auto ps = PositionSet::create(PositionScheme::kOctaHemi2, n);
     ASSERT_TRUE(ps);
     const std::vector<Vec3> unit = unitTable(*ps);
+    std::vector<float> unit4;  // the padded layout the fast path reads
+    for (const Vec3& u : unit) unit4.insert(unit4.end(), {u.x, u.y, u.z, 0.0f});
     const std::vector<Vec3> dirs = testDirections(n, 200000);
     size_t answered = 0, randomRefused = 0;
     for (size_t r = 0; r < dirs.size(); ++r) {
       uint32_t fast = 0;
-      if (!detail::octaNearestFast(n, unit.data(), dirs[r], &fast)) {
+      if (!detail::octaNearestFast(n, unit4.data(), dirs[r], &fast)) {
         randomRefused += r < 200000;
         continue;
       }

@@ -113,7 +113,7 @@ struct QueryHit {
 
 // A query-ready view of one field. Borrows its maps: from a File (which must outlive the
 // FieldQuery) or from caller memory. Holds a small table per positional sample (its position,
-// twice, tangent frame and neighbour list: 96 bytes per map), for octa-hemi2 n <= 128 one byte
+// tangent frame and neighbour list: 84 bytes per map), for octa-hemi2 n <= 128 one byte
 // per cell of the sample grid (n^2 bytes) and, for unorm8-chord, the decode scale of each texel of
 // a map (4 bytes per texel of one map).
 class FieldQuery {
