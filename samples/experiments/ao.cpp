@@ -28,17 +28,13 @@ int runAo(const Options& o) {
       if (s.kind == PixelKind::kObject) return kObjectFlat;
       if (s.kind != PixelKind::kPlane) return {};
       const Vec3 origin = s.point + s.normal * eps;
-      thread_local std::vector<vff::Ray> batch;
-      thread_local std::vector<float> shares;
-      batch.resize(size_t(rays));
-      shares.resize(size_t(rays));
-      for (int i = 0; i < rays; ++i) {
+      const std::span<vff::Ray> batch = rayBuffer(size_t(rays));
+      for (vff::Ray& ray : batch) {
         const float u1 = rng.next01(), u2 = rng.next01();
-        batch[size_t(i)] = {origin, cosineDirection(s.normal, u1, u2), 0.0f, tmax};
+        ray = {origin, cosineDirection(s.normal, u1, u2), 0.0f, tmax};
       }
-      openShares(exact, field, qo, batch, shares);
       float open = 0;
-      for (int i = 0; i < rays; ++i) open += shares[size_t(i)];
+      for (float share : openShares(exact, field, qo, batch)) open += share;
       const float v = open / float(rays);
       return {v, v, v};
     };

@@ -131,21 +131,32 @@ struct BakedQuery {
   double payloadMiB() const { return double(query.payloadBytes()) / 1048576.0; }
 };
 
-// The unoccluded share of every ray, into out (same size): the exact answer (0 or 1) when field is
-// null, the field's occluded() (0 or 1) for kNearest, its visibility() (a fraction) for
-// kInterpolated. A field answers them with one batch call, as a renderer would.
-inline void openShares(const ExactTracer& exact, const BakedQuery* field, const vff::QueryOptions& qo,
-                       std::span<const vff::Ray> rays, std::span<float> out) {
+// A buffer of n rays for one pixel's batch (one per thread, reused).
+inline std::span<vff::Ray> rayBuffer(size_t n) {
+  thread_local std::vector<vff::Ray> rays;
+  rays.resize(n);
+  return rays;
+}
+
+// The unoccluded share of every ray: the exact answer (0 or 1) when field is null, the field's
+// occluded() (0 or 1) for kNearest, its visibility() (a fraction) for kInterpolated. A field
+// answers them with one batch call, as a renderer would. The result lives until the thread's
+// next call.
+inline std::span<const float> openShares(const ExactTracer& exact, const BakedQuery* field, const vff::QueryOptions& qo,
+                                         std::span<const vff::Ray> rays) {
+  thread_local std::vector<float> out;
+  thread_local std::vector<uint8_t> occ;
+  out.resize(rays.size());
   if (!field) {
     for (size_t i = 0; i < rays.size(); ++i) out[i] = exact.occluded(rays[i]) ? 0.0f : 1.0f;
   } else if (qo.reconstruction == vff::Reconstruction::kNearest) {
-    thread_local std::vector<uint8_t> occ;
     occ.resize(rays.size());
     field->instance.occluded(rays, occ, qo);
     for (size_t i = 0; i < rays.size(); ++i) out[i] = occ[i] ? 0.0f : 1.0f;
   } else {
     field->instance.visibility(rays, out, qo);
   }
+  return out;
 }
 
 // Bakes one configuration (unorm8-diameter) of the object and places it like the world's object.

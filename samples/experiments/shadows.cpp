@@ -42,17 +42,14 @@ int runShadows(const Options& o) {
       const vff::QueryOptions qo{.reconstruction = r, .intraBias = s.kind == PixelKind::kPlane ? 0.0f : -1.0f};
       const Vec3 albedo = s.kind == PixelKind::kPlane ? Vec3{0.85f, 0.85f, 0.85f} : Vec3{0.9f, 0.85f, 0.75f};
       const Vec3 origin = s.point + s.normal * eps;
-      thread_local std::vector<vff::Ray> batch;
-      thread_local std::vector<float> shares;
-      batch.resize(size_t(rays));
-      shares.resize(size_t(rays));
+      const std::span<vff::Ray> batch = rayBuffer(size_t(rays));
       for (int i = 0; i < rays; ++i) {
         const Vec3 c = w.center + kLights[i % 3].offset * w.radius;
         const float u1 = rng.next01(), u2 = rng.next01();
         const Vec3 target = c + uniformSphere(u1, u2) * (kLightRadius * w.radius);
         batch[size_t(i)] = {origin, target - origin, 0.0f, 1.0f};
       }
-      openShares(exact, field, qo, batch, shares);
+      const std::span<const float> shares = openShares(exact, field, qo, batch);
       float open[3] = {0, 0, 0};
       int count[3] = {0, 0, 0};
       for (int i = 0; i < rays; ++i) {
