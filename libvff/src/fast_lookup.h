@@ -31,6 +31,17 @@ inline float gridGuard(uint32_t n) noexcept { return kGridGuard + 1e-6f * float(
 // The guard band of an M x M map, in texel units.
 inline float texelGuard(uint32_t m) noexcept { return kTexelGuard + 2e-6f * float(m); }
 
+// The SIMD kernel (query_group_kernel.h) scores an octa-hemi2 candidate, grid point g of the query's
+// quadrant, as g.(|q.x|, |q.y|, |q.z|) / |g|, with the reciprocal square root approximated
+// (relative error <= 1.5 * 2^-12) and refined by one Newton step; the reference scores it as
+// unit(k).q in binary32, unit(k) being the binary64 position rounded to binary32. Bounds, in
+// units of u = 2^-24 and |q|: the reference's products and sums 3 u, its rounded position u;
+// the kernel's dot product 3 u, the refined reciprocal 1.5 (1.5 * 2^-12)^2 + 4 u (about 7.4 u),
+// its last product u. Together under 16 u = 9.5e-7 |q|; kOctaScoreError allows twice that, per
+// unit of |q.x| + |q.y| + |q.z| (>= |q|). A lead of the best score over the second by more
+// than 2 kOctaScoreError (|q.x| + |q.y| + |q.z|) proves the reference picks the same sample.
+inline constexpr float kOctaScoreError = 2e-6f;
+
 // atanUnit's constants (Cephes atanf), shared with the SIMD kernel's copy of it.
 inline constexpr float kTanPi8 = 0.41421356f, kQuarterPiF = 0.78539816f;
 inline constexpr float kAtanP[4] = {8.05374449538e-2f, -1.38776856032e-1f, 1.99777106478e-1f, -3.33329491539e-1f};

@@ -55,6 +55,9 @@ struct FieldQuery::Impl {
   uint32_t m = 0;
   uint64_t distMapBytes = 0, normMapBytes = 0;
   std::vector<const uint8_t*> dist;  // per map
+  // One byte per texel, the maps back to back from dist[0], fewer than 2^31 bytes in all, m <= 4096
+  // (GroupTables::texels).
+  bool byteTexels = false;
   std::vector<const uint8_t*> norm;  // per map, empty without normals
   std::vector<Frame> frames;         // frame of map k (inward normal)
   std::vector<float> unit4;          // û_k, float, padded to 4 floats per map (for the group kernel)
@@ -140,7 +143,8 @@ struct FieldQuery::Impl {
   // The answer of a nearest lookup at texel (i, j) of map k (nearestHit, from its parts).
   QueryHit hitAt(const Ray& ray, uint32_t k, uint32_t i, uint32_t j, float t0, bool inside, float lo, float hi,
                  float len, float* visibility) const noexcept;
-  detail::GroupTables groupTables(const QueryOptions& o) const noexcept;
+  // decodeHits: also decode the hit flags in the kernel, where it can (kUnorm8Diameter).
+  detail::GroupTables groupTables(const QueryOptions& o, bool decodeHits) const noexcept;
   QueryHit interpolated(const Ray& ray, const Lookup& l, float* visibility) const noexcept;
   // interpolated() in two halves (see there).
   struct InterpPlan {
@@ -157,18 +161,15 @@ struct FieldQuery::Impl {
   QueryHit blendInterpolated(const Ray& ray, const Lookup& l, const InterpPlan& plan, float* visibility) const noexcept;
   template <class Emit>
   void batchInterpolated(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept;
-  // Runs the group kernel over rays, kGroupRays at a time: each(base, n, group, reached), where bit
-  // r of `reached` says whether ray base + r reaches the sphere (the others miss).
+  // Runs the group kernel over rays, kGroupRays at a time: each(base, n, group), where bit r of
+  // group.reached says whether ray base + r reaches the sphere (the others miss).
   template <class Each>
-  void forEachGroup(std::span<const Ray> rays, const QueryOptions& o, Each&& each) const noexcept {
-    const detail::GroupTables tables = groupTables(o);
+  void forEachGroup(std::span<const Ray> rays, const detail::GroupTables& tables, Each&& each) const noexcept {
     detail::Group g;
     for (size_t base = 0; base < rays.size(); base += detail::kGroupRays) {
       const size_t n = std::min(detail::kGroupRays, rays.size() - base);
       detail::prepareGroup(tables, rays.data() + base, n, &g);
-      uint64_t reached = 0;
-      for (uint32_t p = 0; p < g.count; ++p) reached |= uint64_t(1) << g.ray[p];
-      each(base, n, g, reached);
+      each(base, n, g);
     }
   }
   QueryHit query(const Ray& ray, const QueryOptions& o, float* visibility) const noexcept;
@@ -194,6 +195,26 @@ namespace {
 
 Vec3 toVec(const float c[3]) { return {c[0], c[1], c[2]}; }
 
+// For every byte value b, the 8 bytes (bit l of b) for l = 0 .. 7, little-endian.
+struct BitBytes {
+  uint64_t word[256];
+  constexpr BitBytes() : word() {
+    for (unsigned b = 0; b < 256; ++b)
+      for (unsigned l = 0; l < 8; ++l) word[b] |= uint64_t((b >> l) & 1u) << (8 * l);
+  }
+};
+constexpr BitBytes kBitBytes{};
+
+// out[r] = bit r of hits (0 or 1), for r < n <= 64.
+void writeHitBytes(uint64_t hits, size_t n, uint8_t* out) {
+  size_t r = 0;
+  for (; r + 8 <= n; r += 8) {
+    const uint64_t w = kBitBytes.word[(hits >> r) & 0xFFu];
+    for (unsigned l = 0; l < 8; ++l) out[r + l] = uint8_t(w >> (8 * l));  // one 8-byte store
+  }
+  for (; r < n; ++r) out[r] = uint8_t((hits >> r) & 1u);
+}
+
 }  // namespace
 
 void FieldQuery::Impl::build() {
@@ -201,6 +222,11 @@ void FieldQuery::Impl::build() {
   center = toVec(field.sphere.center);
   radius = field.sphere.radius;
   m = field.mapResolution;
+  const uint64_t planeBytes = uint64_t(n) * distMapBytes;
+  byteTexels = (field.distanceEncoding == DistanceEncoding::kUnorm8Diameter ||
+                field.distanceEncoding == DistanceEncoding::kUnorm8Chord) &&
+               m <= 4096 && n > 0 && planeBytes >= 4 && planeBytes < (uint64_t(1) << 31);
+  for (uint32_t k = 0; k < n && byteTexels; ++k) byteTexels = dist[k] == dist[0] + size_t(k) * distMapBytes;
   frames.resize(n);
   unit4.assign(size_t(n) * 4, 0.0f);
   for (uint32_t k = 0; k < n; ++k) {
@@ -210,7 +236,10 @@ void FieldQuery::Impl::build() {
     unit4[size_t(k) * 4 + 2] = u.z;
     frames[k] = positions.frame(k);
   }
-  if (positions.scheme() == PositionScheme::kOctaHemi2) octaMasks = detail::octaCandidateMasks(positions.param());
+  if (positions.scheme() == PositionScheme::kOctaHemi2) {
+    octaMasks = detail::octaCandidateMasks(positions.param());
+    if (!octaMasks.empty()) octaMasks.resize(octaMasks.size() + 3, 0);  // GroupTables::octaMasks' padding
+  }
   spacing = std::sqrt(4.0f * kPi / float(n));
   // The kernel reaches 1.3 mean spacings (ground AO under the bunny: 1.0 and 1.6 are worse or
   // slower; vff-experiments ao).
@@ -575,9 +604,9 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
     }
     return;
   }
-  forEachGroup(rays, o, [&](size_t base, size_t n, detail::Group& g, uint64_t reached) {
+  forEachGroup(rays, groupTables(o, false), [&](size_t base, size_t n, detail::Group& g) {
     for (size_t r = 0; r < n; ++r)
-      if (!((reached >> r) & 1u)) emit(base + r, QueryHit{}, 1.0f);
+      if (!((g.reached >> r) & 1u)) emit(base + r, QueryHit{}, 1.0f);
     for (uint32_t first = 0; first < g.count; first += kPlanned) {
       const size_t count = std::min<size_t>(kPlanned, g.count - first);
       for (size_t c = 0; c < count; ++c) {
@@ -614,7 +643,7 @@ float FieldQuery::visibility(const Ray& ray, const QueryOptions& options) const 
   return v;
 }
 
-detail::GroupTables FieldQuery::Impl::groupTables(const QueryOptions& o) const noexcept {
+detail::GroupTables FieldQuery::Impl::groupTables(const QueryOptions& o, bool decodeHits) const noexcept {
   detail::GroupTables t;
   t.center = center;
   t.radius = radius;
@@ -629,37 +658,48 @@ detail::GroupTables FieldQuery::Impl::groupTables(const QueryOptions& o) const n
   t.texelGuard = detail::texelGuard(m);
   t.maps = dist.data();
   t.encoding = field.distanceEncoding;
+  if (byteTexels) {
+    t.texels = dist[0];
+    t.mapBytes = int32_t(distMapBytes);
+  }
+  t.decodeHits = decodeHits && byteTexels && field.distanceEncoding == DistanceEncoding::kUnorm8Diameter;
+  t.distanceScale = 2.0f * radius / 254.0f;
   return t;
 }
 
 // Batches of nearest lookups run in groups: the group kernel (query_group.h) prepares every ray
 // of a group, prepare() redoes the few rays the kernel leaves to it, the texels of the group are
-// requested from memory together, and then decoded. The scattered texel reads of a group overlap
-// instead of waiting one after the other.
+// requested from memory together, and then decoded (by the kernel itself where it can). The
+// scattered texel reads of a group overlap instead of waiting one after the other.
+//
+// kHitOnly: emit(base, n, hits) for each run of n <= 64 rays from base, bit r of `hits` saying
+// whether ray base + r hits. Otherwise: emit(r, const QueryHit&, float visibility) per ray.
 template <bool kHitOnly, class Emit>
 void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept {
   if (!detail::groupKernelAvailable()) {
-    for (size_t r = 0; r < rays.size(); ++r) {
-      float vis = 1.0f;
-      Lookup l;
-      const QueryHit h = prepare(rays[r], o, &l) ? nearestHit(rays[r], l, &vis) : QueryHit{};
-      if constexpr (kHitOnly) {
-        emit(r, h.hit);
-      } else {
-        emit(r, h, vis);
+    for (size_t base = 0; base < rays.size(); base += detail::kGroupRays) {
+      const size_t n = std::min(detail::kGroupRays, rays.size() - base);
+      uint64_t hits = 0;
+      for (size_t r = 0; r < n; ++r) {
+        float vis = 1.0f;
+        Lookup l;
+        const QueryHit h = prepare(rays[base + r], o, &l) ? nearestHit(rays[base + r], l, &vis) : QueryHit{};
+        if constexpr (kHitOnly) {
+          hits |= uint64_t(h.hit) << r;
+        } else {
+          emit(base + r, h, vis);
+        }
       }
+      if constexpr (kHitOnly) emit(base, n, hits);
     }
     return;
   }
-  forEachGroup(rays, o, [&](size_t base, size_t n, detail::Group& g, uint64_t reached) {
+  const detail::GroupTables tables = groupTables(o, kHitOnly);
+  forEachGroup(rays, tables, [&](size_t base, size_t n, detail::Group& g) {
     // Every ray misses unless it reaches the sphere.
-    for (size_t r = 0; r < n; ++r) {
-      if ((reached >> r) & 1u) continue;
-      if constexpr (kHitOnly) {
-        emit(base + r, false);
-      } else {
-        emit(base + r, QueryHit{}, 1.0f);
-      }
+    if constexpr (!kHitOnly) {
+      for (size_t r = 0; r < n; ++r)
+        if (!((g.reached >> r) & 1u)) emit(base + r, QueryHit{}, 1.0f);
     }
     // The rays the kernel left to the reference.
     uint64_t dead = 0;
@@ -683,16 +723,22 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
       const uint32_t p = uint32_t(__builtin_ctzll(redo));
       __builtin_prefetch(texelAddress(g.k[p], g.i[p], g.j[p]));
     }
-    for (uint32_t p = 0; p < g.count; ++p) {
-      const uint32_t r = g.ray[p];
-      const bool live = !((dead >> p) & 1u), inside = (g.inside >> r) & 1u;
-      if constexpr (kHitOnly) {
-        emit(base + r, live && hitsAt(g.k[p], g.i[p], g.j[p], g.t0[r], inside, g.lo[r], g.hi[r]));
-      } else {
+    if constexpr (kHitOnly) {
+      // The kernel decoded all but the redone rays, or none of them.
+      uint64_t hits = tables.decodeHits ? g.hits : 0;
+      const uint64_t left = tables.decodeHits ? g.redo : g.count == 64 ? ~uint64_t(0) : (uint64_t(1) << g.count) - 1;
+      for (uint64_t todo = left & ~dead; todo != 0; todo &= todo - 1) {
+        const uint32_t p = uint32_t(__builtin_ctzll(todo)), r = g.ray[p];
+        if (hitsAt(g.k[p], g.i[p], g.j[p], g.t0[r], (g.inside >> r) & 1u, g.lo[r], g.hi[r])) hits |= uint64_t(1) << r;
+      }
+      emit(base, n, hits);
+    } else {
+      for (uint32_t p = 0; p < g.count; ++p) {
+        const uint32_t r = g.ray[p];
         float vis = 1.0f;
-        const QueryHit h =
-            live ? hitAt(rays[base + r], g.k[p], g.i[p], g.j[p], g.t0[r], inside, g.lo[r], g.hi[r], g.len[r], &vis)
-                 : QueryHit{};
+        const QueryHit h = (dead >> p) & 1u ? QueryHit{}
+                                            : hitAt(rays[base + r], g.k[p], g.i[p], g.j[p], g.t0[r], (g.inside >> r) & 1u,
+                                                    g.lo[r], g.hi[r], g.len[r], &vis);
         emit(base + r, h, vis);
       }
     }
@@ -715,7 +761,8 @@ void FieldQuery::intersect(std::span<const Ray> rays, std::span<QueryHit> out, c
 void FieldQuery::occluded(std::span<const Ray> rays, std::span<uint8_t> out, const QueryOptions& options) const noexcept {
   const size_t n = std::min(rays.size(), out.size());
   if (impl_ && options.reconstruction == Reconstruction::kNearest) {
-    impl_->batchNearest<true>(rays.first(n), options, [&](size_t r, bool hit) { out[r] = hit ? 1 : 0; });
+    impl_->batchNearest<true>(rays.first(n), options,
+                              [&](size_t base, size_t count, uint64_t hits) { writeHitBytes(hits, count, &out[base]); });
     return;
   }
   if (impl_) {
@@ -728,7 +775,9 @@ void FieldQuery::occluded(std::span<const Ray> rays, std::span<uint8_t> out, con
 void FieldQuery::visibility(std::span<const Ray> rays, std::span<float> out, const QueryOptions& options) const noexcept {
   const size_t n = std::min(rays.size(), out.size());
   if (impl_ && options.reconstruction == Reconstruction::kNearest) {
-    impl_->batchNearest<true>(rays.first(n), options, [&](size_t r, bool hit) { out[r] = hit ? 0.0f : 1.0f; });
+    impl_->batchNearest<true>(rays.first(n), options, [&](size_t base, size_t count, uint64_t hits) {
+      for (size_t r = 0; r < count; ++r) out[base + r] = (hits >> r) & 1u ? 0.0f : 1.0f;
+    });
     return;
   }
   if (impl_) {

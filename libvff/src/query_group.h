@@ -3,12 +3,15 @@
 //
 // FieldQuery's batch functions hand rays to prepareGroup() in groups of kGroupRays. It computes,
 // for every ray, what FieldQuery::Impl::prepare computes one ray at a time: the sphere entry, the
-// nearest positional sample (octa-hemi2: the candidates of PositionSet::candidates in binary32)
-// and the texel of the lookup direction in that sample's map. It performs the same binary32
-// operations in the same order as prepare(), and leaves to the caller (bit `redo`) every ray on
-// which a guard of fast_lookup.h trips or whose scheme it does not handle, so that a group gives
-// exactly the texel prepare() gives (tests/unit/test_fast_lookup.cpp checks this ray by ray, with
-// every kernel). The kernel itself is query_group_kernel.h.
+// nearest positional sample (octa-hemi2: the candidates of PositionSet::candidates, scored
+// without reading their positions, fast_lookup.h's kOctaScoreError) and the texel of the lookup
+// direction in that sample's map; for occlusion batches over one-byte maps it also reads the
+// texels and decodes the hit flags. Where it computes what prepare() computes it performs the
+// same binary32 operations in the same order, and it leaves to the caller (bit `redo`) every ray
+// on which a guard of fast_lookup.h trips, whose two best candidates score too close to call, or
+// whose scheme it does not handle, so that a group gives exactly the texel and the answer
+// prepare() and hitsAt() give (tests/unit/test_fast_lookup.cpp checks this ray by ray, with every
+// kernel). The kernel itself is query_group_kernel.h.
 #pragma once
 
 #include <cstddef>
@@ -32,7 +35,9 @@ struct GroupTables {
   float radius = 0;
   uint32_t octaN = 0;               // octa-hemi2 parameter n; 0: another scheme (every hit ray is redone)
   const float* unit4 = nullptr;     // 4 floats per map: the unit position x, y, z and 0
-  const uint8_t* octaMasks = nullptr;  // octaCandidateMasks(octaN) (fast_lookup.h); null: all eight
+  // octaCandidateMasks(octaN) (fast_lookup.h), then 3 readable bytes (the AVX2 kernel reads the
+  // masks 4 bytes at a time); null: all eight.
+  const uint8_t* octaMasks = nullptr;
   DirectionScheme scheme = DirectionScheme::kInvalid;
   uint32_t m = 0;                   // map resolution
   bool bit1 = false;                // the distance encoding has no distances (rays from inside miss)
@@ -41,6 +46,15 @@ struct GroupTables {
   // The distance maps, to prefetch the texels while the group is being looked up (null: none).
   const uint8_t* const* maps = nullptr;
   DistanceEncoding encoding = DistanceEncoding::kInvalid;
+  // Where the maps hold one byte per texel (kUnorm8Diameter, kUnorm8Chord), back to back, fewer
+  // than 2^31 bytes and at least 4 in all, and m <= 4096 (so that j m + i is exact in binary32):
+  // texels = maps[0], mapBytes = m * m. The kernel then fills Group::t. Null otherwise.
+  const uint8_t* texels = nullptr;
+  int32_t mapBytes = 0;
+  // Also decode the hit flags (Group::hits), as FieldQuery::Impl::hitsAt does: kUnorm8Diameter
+  // maps with `texels` only, whose distance is code * distanceScale (code 255: a miss).
+  bool decodeHits = false;
+  float distanceScale = 0;  // 2 R / 254, as FieldQuery::Impl::texel computes it
 };
 
 // The state of up to kGroupRays rays. Per ray r (bit r of the masks, entry r of the arrays): the
@@ -50,11 +64,16 @@ struct GroupTables {
 struct Group {
   static constexpr size_t kSlack = 8;  // the kernels store whole vectors past `count`
   float t0[kGroupRays], lo[kGroupRays], hi[kGroupRays], len[kGroupRays];
-  uint64_t inside = 0;  // the origin is inside the sphere (the lookup is reversed)
-  uint32_t count = 0;   // rays that reach the sphere (all others miss)
+  uint64_t inside = 0;   // the origin is inside the sphere (the lookup is reversed)
+  uint64_t reached = 0;  // the ray reaches the sphere (all others miss)
+  uint32_t count = 0;    // rays that reach the sphere
   uint32_t ray[kGroupRays + kSlack];  // their indices
   uint32_t k[kGroupRays + kSlack], i[kGroupRays + kSlack], j[kGroupRays + kSlack];  // their texels
+  int32_t t[kGroupRays + kSlack];  // with GroupTables::texels: the texel's byte there, k m^2 + j m + i
   uint64_t redo = 0;    // bit p: the caller must run the reference prepare() on packed ray p
+  // With GroupTables::decodeHits, bit r: ray r hits within its range (hitsAt). Not set for the
+  // rays in `redo`.
+  uint64_t hits = 0;
 };
 static_assert(kGroupRays <= 64, "the masks hold one bit per ray");
 

@@ -23,6 +23,7 @@ inline F8 operator-(F8 a, F8 b) { return _mm256_sub_ps(a.v, b.v); }
 inline F8 operator*(F8 a, F8 b) { return _mm256_mul_ps(a.v, b.v); }
 inline F8 operator/(F8 a, F8 b) { return _mm256_div_ps(a.v, b.v); }
 inline F8 vsqrt(F8 a) { return _mm256_sqrt_ps(a.v); }
+inline F8 vrsqrt(F8 a) { return _mm256_rsqrt_ps(a.v); }  // relative error <= 1.5 * 2^-12
 inline F8 vmin(F8 a, F8 b) { return _mm256_min_ps(a.v, b.v); }  // a < b ? a : b, as SSE2
 inline F8 vmax(F8 a, F8 b) { return _mm256_max_ps(a.v, b.v); }  // a > b ? a : b, as SSE2
 inline F8 gt(F8 a, F8 b) { return _mm256_cmp_ps(a.v, b.v, _CMP_GT_OQ); }
@@ -83,6 +84,50 @@ inline void gatherUnit(const float* unit4, F8 k, F8* x, F8* y, F8* z) {
   *x = _mm256_i32gather_ps(unit4, idx, 4);
   *y = _mm256_i32gather_ps(unit4 + 1, idx, 4);
   *z = _mm256_i32gather_ps(unit4 + 2, idx, 4);
+}
+
+// The union of the bytes table[idx] over the lanes in `use` (idx: integer-valued floats; reads
+// 4 bytes at table + idx).
+inline unsigned maskUnion(const uint8_t* table, F8 idx, F8 use) {
+  const __m256i words = _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), reinterpret_cast<const int*>(table),
+                                                    _mm256_cvttps_epi32(idx.v), _mm256_castps_si256(use.v), 1);
+  __m128i x = _mm_or_si128(_mm256_castsi256_si128(words), _mm256_extracti128_si256(words, 1));
+  x = _mm_or_si128(x, _mm_shuffle_epi32(x, 0x4E));
+  x = _mm_or_si128(x, _mm_shuffle_epi32(x, 0xB1));
+  return unsigned(_mm_cvtsi128_si32(x)) & 0xFFu;
+}
+
+// k * mapBytes + t for the lanes' samples k and texel bytes t (integer-valued floats), into dst.
+inline void storeTexelIndex(int32_t* dst, F8 k, F8 t, int32_t mapBytes) {
+  const __m256i at = _mm256_add_epi32(_mm256_mullo_epi32(_mm256_cvttps_epi32(k.v), _mm256_set1_epi32(mapBytes)),
+                                      _mm256_cvttps_epi32(t.v));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(dst), at);
+}
+// The bytes base[at[l]] as floats. Reads 4 bytes per lane, ending at the byte (or, for the first 3
+// bytes, starting at base): never outside [base, base + 4) and the bytes up to the one read.
+inline F8 gatherBytes(const uint8_t* base, const int32_t* at) {
+  const __m256i idx = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(at));
+  const __m256i back = _mm256_min_epi32(idx, _mm256_set1_epi32(3));  // bytes read before the wanted one
+  const __m256i words = _mm256_i32gather_epi32(reinterpret_cast<const int*>(base), _mm256_sub_epi32(idx, back), 1);
+  const __m256i bytes = _mm256_and_si256(_mm256_srlv_epi32(words, _mm256_slli_epi32(back, 3)), _mm256_set1_epi32(0xFF));
+  return _mm256_cvtepi32_ps(bytes);
+}
+// Bit ray[l] for every lane l set in `bits` (ray[l] < 64).
+inline uint64_t rayBits(const uint32_t* ray, unsigned bits) {
+  const __m256i lane = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+  const __m256i on = _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(int32_t(bits)), lane), lane);
+  const __m256i r = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(ray));
+  const __m256i one = _mm256_set1_epi32(1);
+  // sllv gives 0 for shifts of 32 or more: the low word takes rays 0 .. 31, the high 32 .. 63.
+  const __m256i lo = _mm256_and_si256(on, _mm256_sllv_epi32(one, r));
+  const __m256i hi = _mm256_and_si256(on, _mm256_sllv_epi32(one, _mm256_sub_epi32(r, _mm256_set1_epi32(32))));
+  auto orLanes = [](__m256i v) {
+    __m128i x = _mm_or_si128(_mm256_castsi256_si128(v), _mm256_extracti128_si256(v, 1));
+    x = _mm_or_si128(x, _mm_shuffle_epi32(x, 0x4E));
+    x = _mm_or_si128(x, _mm_shuffle_epi32(x, 0xB1));
+    return uint32_t(_mm_cvtsi128_si32(x));
+  };
+  return uint64_t(orLanes(lo)) | (uint64_t(orLanes(hi)) << 32);
 }
 
 // Eight rays of eight floats each (origin, direction, tmin, tmax), transposed.

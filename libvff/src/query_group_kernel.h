@@ -6,10 +6,13 @@
 // compiled for AVX2 can be shared with code that runs on a CPU without it.
 //
 // The lane type F (a float vector with +, -, *, / and the free functions used below) is defined by
-// the including file. Every line mirrors a line of FieldQuery::Impl::prepare() or of
-// fast_lookup.h with the same binary32 operations in the same order (a ? b : c becomes
-// sel(mask, b, c); no operation is fused or reordered), so that a lane computes bit for bit what
-// prepare() computes for that ray, and the two files compute the same bits.
+// the including file. Every line that computes a quantity prepare() also computes mirrors a line
+// of FieldQuery::Impl::prepare() or of fast_lookup.h with the same binary32 operations in the
+// same order (a ? b : c becomes sel(mask, b, c); no operation is fused or reordered), so that a
+// lane computes bit for bit what prepare() computes for that ray. The one quantity of its own, a
+// candidate's score, uses the CPU's approximate reciprocal square root, which differs between
+// CPU makers: it only decides which sample wins when the lead is beyond its error bound, so the
+// answers are the same everywhere, and only which rays are redone can differ.
 #pragma once
 
 #include <cstddef>
@@ -47,6 +50,7 @@ inline F atanUnitV(F t) {
 struct Packed {
   static constexpr size_t kSize = kGroupRays + Group::kSlack;
   float eux[kSize], euy[kSize], euz[kSize], vx[kSize], vy[kSize], vz[kSize];
+  float t0[kSize], lo[kSize], hi[kSize], inside[kSize];  // for decodeStep (GroupTables::decodeHits)
 };
 
 // Step 1 for F::kLanes rays starting at rays[0] (all readable), lanes r0 .. of g: the sphere;
@@ -91,6 +95,7 @@ void sphereStep(const GroupTables& tb, const Ray* rays, Group* g, size_t r0, Pac
   g->inside |= uint64_t(movemask(inside)) << r0;
   const unsigned bits = movemask(live);
   if (bits == 0) return;
+  g->reached |= uint64_t(bits) << r0;
   const size_t at = g->count;
   compress(packed->eux + at, eux, bits);
   compress(packed->euy + at, euy, bits);
@@ -98,6 +103,12 @@ void sphereStep(const GroupTables& tb, const Ray* rays, Group* g, size_t r0, Pac
   compress(packed->vx + at, vx, bits);
   compress(packed->vy + at, vy, bits);
   compress(packed->vz + at, vz, bits);
+  if (tb.decodeHits) {
+    compress(packed->t0 + at, t0, bits);
+    compress(packed->lo + at, lo, bits);
+    compress(packed->hi + at, tmaxL, bits);
+    compress(packed->inside + at, inside, bits);
+  }
   compressIndex(g->ray + at, uint32_t(r0), bits);
   g->count += uint32_t(__builtin_popcount(bits));
 }
@@ -124,45 +135,44 @@ void lookupStep(const GroupTables& tb, const Packed& pk, size_t p, Group* g) {
   const F a0 = vmin(fa, fn - one), b0 = vmin(fb, fn - one);
   const F h = bandnot(ge(euz, zero), one);  // 0 upper, 1 lower hemisphere
   const F negX = lt(eux, zero), negY = lt(euy, zero);
-  const F hemi(float(2 * tb.octaN * tb.octaN + 2 * tb.octaN + 1));
   const F use = bnot(redo);
   // The candidates any lane needs (octaCandidateMasks); lanes not in use look up sample 0.
-  unsigned needed = 0xFF;
-  if (tb.octaMasks) {
-    alignas(32) int32_t ca[L], cb[L];
-    storeInt(ca, band(use, a0));
-    storeInt(cb, band(use, b0));
-    needed = 0;
-    const unsigned useBits = movemask(use);
-    for (size_t l = 0; l < L; ++l)
-      if ((useBits >> l) & 1u) needed |= tb.octaMasks[size_t(cb[l]) * tb.octaN + size_t(ca[l])];
-  }
-  F bestD(-INFINITY), bestK(3.0e38f), bestX = zero, bestY = zero, bestZ = one;
-  F any = zero;
+  const unsigned needed = tb.octaMasks ? maskUnion(tb.octaMasks, b0 * fn + a0, use) : 0xFFu;
+  // Each candidate is scored without its table position: in the quadrant frame it is the grid
+  // point g = (a, b, n - |a| - |b|), and its score g.(|x|, |y|, |z|) / |g| is the reference's
+  // unit(k).eu (octaNearestFast) to within kOctaScoreError l1 (fast_lookup.h). The best score
+  // wins when it leads the second best by more than twice that; otherwise the lane is redone. No
+  // position is read until the winner is known.
+  F best(-INFINITY), second(-INFINITY), bestA = zero, bestB = zero;
+  const F nrHalf(0.5f), nrThreeHalves(1.5f), minusInf(-INFINITY);
   for (unsigned ci = 0; ci < 8; ++ci) {
     if (!((needed >> ci) & 1u)) continue;
     const F a = a0 + F(float(kOctaCandidates[ci][0])), b = b0 + F(float(kOctaCandidates[ci][1]));
-    const F aa = vabs(a), ab = vabs(b), sum = aa + ab;
-    const F valid = band(le(sum, fn), use);
-    const F i = sel(negX, vneg(a), a), j = sel(negY, vneg(b), b);
-    const F hh = bandnot(eq(sum, fn), h);
-    const F t = fn + j;
-    const F tt = t * t;
-    const F row = sel(le(j, zero), tt, tt - F(2.0f) * j * (j - one));
-    const F w = fn - vabs(j);
-    const F k = band(valid, hh * hemi + row + i + w);
-    F ux, uy, uz;
-    gatherUnit(tb.unit4, k, &ux, &uy, &uz);
-    const F d = ux * eux + uy * euy + uz * euz;
-    const F better = band(valid, bor(gt(d, bestD), band(eq(d, bestD), lt(k, bestK))));
-    bestD = sel(better, d, bestD);
-    bestK = sel(better, k, bestK);
-    bestX = sel(better, ux, bestX);
-    bestY = sel(better, uy, bestY);
-    bestZ = sel(better, uz, bestZ);
-    any = bor(any, valid);
+    const F sum = vabs(a) + vabs(b);
+    const F c = fn - sum;
+    const F len2 = (a * a + b * b) + c * c;
+    const F y0 = vrsqrt(len2);
+    const F y = y0 * (nrThreeHalves - nrHalf * len2 * y0 * y0);  // 1 / |g|: one Newton step
+    const F d = sel(le(sum, fn), ((a * ax + b * ay) + c * az) * y, minusInf);
+    second = vmax(second, vmin(d, best));
+    const F better = gt(d, best);
+    best = vmax(best, d);
+    bestA = sel(better, a, bestA);
+    bestB = sel(better, b, bestB);
   }
-  redo = bor(redo, bandnot(any, use));
+  // No valid candidate (best - second is NaN) or a near tie: the reference decides.
+  redo = bor(redo, ngt(best - second, F(2.0f * kOctaScoreError) * l1));
+  // The winner's index (octaIndex, as octaNearestFast) and table position.
+  const F hemi(float(2 * tb.octaN * tb.octaN + 2 * tb.octaN + 1));
+  const F i = sel(negX, vneg(bestA), bestA), j = sel(negY, vneg(bestB), bestB);
+  const F hh = bandnot(eq(vabs(bestA) + vabs(bestB), fn), h);
+  const F t = fn + j;
+  const F tt = t * t;
+  const F row = sel(le(j, zero), tt, tt - F(2.0f) * j * (j - one));
+  const F w = fn - vabs(j);
+  const F bestK = band(bnot(redo), hh * hemi + row + i + w);
+  F bestX, bestY, bestZ;
+  gatherUnit(tb.unit4, bestK, &bestX, &bestY, &bestZ);
 
   // 3. The texel: the sample's frame (frameFromNormal of its inward normal, as
   // PositionSet::frame), toLocal, then texelFast.
@@ -204,14 +214,33 @@ void lookupStep(const GroupTables& tb, const Packed& pk, size_t p, Group* g) {
   redo = bor(redo, bor(bor(lt(x - fx, tg), lt((fx + one) - x, tg)), bor(lt(y - fy, tg), lt((fy + one) - y, tg))));
   const F top(fmS - 1.0f);
   const F ok = bnot(redo);
+  const F ti = band(ok, vmin(vmax(fx, zero), top)), tj = band(ok, vmin(vmax(fy, zero), top));
   storeInt(reinterpret_cast<int32_t*>(g->k + p), band(ok, bestK));
-  storeInt(reinterpret_cast<int32_t*>(g->i + p), band(ok, vmin(vmax(fx, zero), top)));
-  storeInt(reinterpret_cast<int32_t*>(g->j + p), band(ok, vmin(vmax(fy, zero), top)));
+  storeInt(reinterpret_cast<int32_t*>(g->i + p), ti);
+  storeInt(reinterpret_cast<int32_t*>(g->j + p), tj);
   g->redo |= uint64_t(movemask(redo)) << p;
   // Ask for the texels now: they arrive while the rest of the group is looked up.
-  if (tb.maps)
+  if (tb.texels) {
+    storeTexelIndex(g->t + p, band(ok, bestK), tj * fm + ti, tb.mapBytes);
+    for (size_t l = 0; l < L; ++l) __builtin_prefetch(tb.texels + g->t[p + l]);
+  } else if (tb.maps) {
     for (size_t l = 0; l < L; ++l)
       __builtin_prefetch(tb.maps[g->k[p + l]] + texelByte(tb.encoding, tb.m, g->i[p + l], g->j[p + l]));
+  }
+}
+
+// Step 4 (GroupTables::decodeHits) for packed rays p .. p + kLanes - 1, those of `keep` only:
+// whether each texel holds a hit within the ray's range, as FieldQuery::Impl::hitsAt decodes a
+// kUnorm8Diameter texel, into g->hits (by ray). The texels were requested by lookupStep.
+template <class F>
+void decodeStep(const GroupTables& tb, const Packed& pk, size_t p, unsigned keep, Group* g) {
+  const F c = gatherBytes(tb.texels, g->t + p);
+  const F d = c * F(tb.distanceScale);
+  const F t0 = load(pk.t0 + p);
+  const F th = sel(load(pk.inside + p), t0 - d, t0 + d);
+  // texel(): a hit unless the code is 255; hitsAt(): !(th < lo || th > hi).
+  const F hit = band(bnot(eq(c, F(255.0f))), band(nlt(th, load(pk.lo + p)), ngt(th, load(pk.hi + p))));
+  g->hits |= rayBits(g->ray + p, movemask(hit) & keep);
 }
 
 // prepareGroup (query_group.h) with lanes F.
@@ -220,8 +249,10 @@ void prepareGroupWith(const GroupTables& tb, const Ray* rays, size_t n, Group* g
   constexpr size_t L = F::kLanes;
   Packed packed;
   g->inside = 0;
+  g->reached = 0;
   g->count = 0;
   g->redo = 0;
+  g->hits = 0;
   size_t r = 0;
   for (; r + L <= n; r += L) sphereStep<F>(tb, rays + r, g, r, &packed);
   if (r < n) {
@@ -245,9 +276,20 @@ void prepareGroupWith(const GroupTables& tb, const Ray* rays, size_t n, Group* g
     packed.vx[p] = packed.vx[count - 1];
     packed.vy[p] = packed.vy[count - 1];
     packed.vz[p] = packed.vz[count - 1];
+    if (tb.decodeHits) {
+      packed.t0[p] = packed.t0[count - 1];
+      packed.lo[p] = packed.lo[count - 1];
+      packed.hi[p] = packed.hi[count - 1];
+      packed.inside[p] = packed.inside[count - 1];
+    }
   }
   for (size_t p = 0; p < count; p += L) lookupStep<F>(tb, packed, p, g);
   g->redo &= all;
+  if (tb.decodeHits) {
+    // Not the padded lanes, nor the redone rays (the caller's).
+    const uint64_t keep = all & ~g->redo;
+    for (size_t p = 0; p < count; p += L) decodeStep<F>(tb, packed, p, unsigned(keep >> p) & ((1u << L) - 1), g);
+  }
 }
 
 }  // namespace

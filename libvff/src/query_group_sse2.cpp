@@ -21,6 +21,7 @@ inline F4 operator-(F4 a, F4 b) { return _mm_sub_ps(a.v, b.v); }
 inline F4 operator*(F4 a, F4 b) { return _mm_mul_ps(a.v, b.v); }
 inline F4 operator/(F4 a, F4 b) { return _mm_div_ps(a.v, b.v); }
 inline F4 vsqrt(F4 a) { return _mm_sqrt_ps(a.v); }
+inline F4 vrsqrt(F4 a) { return _mm_rsqrt_ps(a.v); }  // relative error <= 1.5 * 2^-12
 inline F4 vmin(F4 a, F4 b) { return _mm_min_ps(a.v, b.v); }  // a < b ? a : b
 inline F4 vmax(F4 a, F4 b) { return _mm_max_ps(a.v, b.v); }  // a > b ? a : b
 inline F4 gt(F4 a, F4 b) { return _mm_cmpgt_ps(a.v, b.v); }
@@ -66,6 +67,36 @@ inline void gatherUnit(const float* unit4, F4 k, F4* x, F4* y, F4* z) {
   *x = r0;
   *y = r1;
   *z = r2;
+}
+
+// The union of the bytes table[idx] over the lanes in `use` (idx: integer-valued floats).
+inline unsigned maskUnion(const uint8_t* table, F4 idx, F4 use) {
+  alignas(16) int32_t at[4];
+  storeInt(at, idx);
+  const unsigned bits = movemask(use);
+  unsigned u = 0;
+  for (int l = 0; l < 4; ++l)
+    if ((bits >> l) & 1u) u |= table[at[l]];
+  return u;
+}
+
+// k * mapBytes + t for the lanes' samples k and texel bytes t (integer-valued floats), into dst.
+inline void storeTexelIndex(int32_t* dst, F4 k, F4 t, int32_t mapBytes) {
+  alignas(16) int32_t ki[4], ti[4];
+  storeInt(ki, k);
+  storeInt(ti, t);
+  for (int l = 0; l < 4; ++l) dst[l] = ki[l] * mapBytes + ti[l];
+}
+// The bytes base[at[l]] as floats.
+inline F4 gatherBytes(const uint8_t* base, const int32_t* at) {
+  return _mm_cvtepi32_ps(_mm_setr_epi32(base[at[0]], base[at[1]], base[at[2]], base[at[3]]));
+}
+// Bit ray[l] for every lane l set in `bits` (ray[l] < 64).
+inline uint64_t rayBits(const uint32_t* ray, unsigned bits) {
+  uint64_t out = 0;
+  for (int l = 0; l < 4; ++l)
+    if ((bits >> l) & 1u) out |= uint64_t(1) << ray[l];
+  return out;
 }
 
 // Four rays of eight floats each (origin, direction, tmin, tmax), transposed.
