@@ -55,9 +55,8 @@ struct FieldQuery::Impl {
   uint32_t m = 0;
   uint64_t distMapBytes = 0, normMapBytes = 0;
   std::vector<const uint8_t*> dist;  // per map
-  // One byte per texel, the maps back to back from dist[0], fewer than 2^31 bytes in all, m <= 4096
-  // (GroupTables::texels).
-  bool byteTexels = false;
+  // GroupTables::byteTexels, and whether the maps lie back to back (GroupTables::texels).
+  bool byteTexels = false, contiguous = false;
   std::vector<const uint8_t*> norm;  // per map, empty without normals
   std::vector<Frame> frames;         // frame of map k (inward normal)
   std::vector<float> unit4;          // û_k, float, padded to 4 floats per map (for the group kernel)
@@ -225,8 +224,9 @@ void FieldQuery::Impl::build() {
   const uint64_t planeBytes = uint64_t(n) * distMapBytes;
   byteTexels = (field.distanceEncoding == DistanceEncoding::kUnorm8Diameter ||
                 field.distanceEncoding == DistanceEncoding::kUnorm8Chord) &&
-               m <= 4096 && n > 0 && planeBytes >= 4 && planeBytes < (uint64_t(1) << 31);
-  for (uint32_t k = 0; k < n && byteTexels; ++k) byteTexels = dist[k] == dist[0] + size_t(k) * distMapBytes;
+               m <= 4096 && n > 0;
+  contiguous = byteTexels && planeBytes >= 4 && planeBytes < (uint64_t(1) << 31);
+  for (uint32_t k = 0; k < n && contiguous; ++k) contiguous = dist[k] == dist[0] + size_t(k) * distMapBytes;
   frames.resize(n);
   unit4.assign(size_t(n) * 4, 0.0f);
   for (uint32_t k = 0; k < n; ++k) {
@@ -658,7 +658,8 @@ detail::GroupTables FieldQuery::Impl::groupTables(const QueryOptions& o, bool de
   t.texelGuard = detail::texelGuard(m);
   t.maps = dist.data();
   t.encoding = field.distanceEncoding;
-  if (byteTexels) {
+  t.byteTexels = byteTexels;
+  if (contiguous) {
     t.texels = dist[0];
     t.mapBytes = int32_t(distMapBytes);
   }

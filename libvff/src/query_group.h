@@ -46,13 +46,15 @@ struct GroupTables {
   // The distance maps, to prefetch the texels while the group is being looked up (null: none).
   const uint8_t* const* maps = nullptr;
   DistanceEncoding encoding = DistanceEncoding::kInvalid;
-  // Where the maps hold one byte per texel (kUnorm8Diameter, kUnorm8Chord), back to back, fewer
-  // than 2^31 bytes and at least 4 in all, and m <= 4096 (so that j m + i is exact in binary32):
-  // texels = maps[0], mapBytes = m * m. The kernel then fills Group::t. Null otherwise.
+  // The maps hold one byte per texel (kUnorm8Diameter, kUnorm8Chord) and m <= 4096 (so that
+  // j m + i is exact in binary32): the kernel fills Group::t.
+  bool byteTexels = false;
+  // With byteTexels, where the maps lie back to back from maps[0], fewer than 2^31 bytes and at
+  // least 4 in all: texels = maps[0], mapBytes = m * m (Group::t then counts from texels). Else null.
   const uint8_t* texels = nullptr;
   int32_t mapBytes = 0;
   // Also decode the hit flags (Group::hits), as FieldQuery::Impl::hitsAt does: kUnorm8Diameter
-  // maps with `texels` only, whose distance is code * distanceScale (code 255: a miss).
+  // maps with byteTexels only, whose distance is code * distanceScale (code 255: a miss).
   bool decodeHits = false;
   float distanceScale = 0;  // 2 R / 254, as FieldQuery::Impl::texel computes it
 };
@@ -69,7 +71,9 @@ struct Group {
   uint32_t count = 0;    // rays that reach the sphere
   uint32_t ray[kGroupRays + kSlack];  // their indices
   uint32_t k[kGroupRays + kSlack], i[kGroupRays + kSlack], j[kGroupRays + kSlack];  // their texels
-  int32_t t[kGroupRays + kSlack];  // with GroupTables::texels: the texel's byte there, k m^2 + j m + i
+  // With GroupTables::byteTexels, the texel's byte: j m + i in its map, or k m^2 + j m + i from
+  // GroupTables::texels where that is set.
+  int32_t t[kGroupRays + kSlack];
   uint64_t redo = 0;    // bit p: the caller must run the reference prepare() on packed ray p
   // With GroupTables::decodeHits, bit r: ray r hits within its range (hitsAt). Not set for the
   // rays in `redo`.

@@ -42,6 +42,7 @@ inline F8 vabs(F8 a) { return _mm256_and_ps(a.v, _mm256_castsi256_ps(_mm256_set1
 inline F8 vneg(F8 a) { return _mm256_xor_ps(a.v, _mm256_set1_ps(-0.0f)); }
 inline F8 floorPos(F8 a) { return _mm256_cvtepi32_ps(_mm256_cvttps_epi32(a.v)); }  // 0 <= a < 2^31
 inline F8 load(const float* p) { return _mm256_loadu_ps(p); }
+inline F8 loadInt(const int32_t* p) { return _mm256_cvtepi32_ps(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p))); }
 inline void store(float* p, F8 a) { _mm256_storeu_ps(p, a.v); }
 inline void storeInt(int32_t* p, F8 a) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), _mm256_cvttps_epi32(a.v)); }
 inline unsigned movemask(F8 a) { return unsigned(_mm256_movemask_ps(a.v)); }

@@ -223,6 +223,9 @@ void lookupStep(const GroupTables& tb, const Packed& pk, size_t p, Group* g) {
   if (tb.texels) {
     storeTexelIndex(g->t + p, band(ok, bestK), tj * fm + ti, tb.mapBytes);
     for (size_t l = 0; l < L; ++l) __builtin_prefetch(tb.texels + g->t[p + l]);
+  } else if (tb.byteTexels) {
+    storeInt(g->t + p, tj * fm + ti);
+    for (size_t l = 0; l < L; ++l) __builtin_prefetch(tb.maps[g->k[p + l]] + g->t[p + l]);
   } else if (tb.maps) {
     for (size_t l = 0; l < L; ++l)
       __builtin_prefetch(tb.maps[g->k[p + l]] + texelByte(tb.encoding, tb.m, g->i[p + l], g->j[p + l]));
@@ -234,7 +237,14 @@ void lookupStep(const GroupTables& tb, const Packed& pk, size_t p, Group* g) {
 // kUnorm8Diameter texel, into g->hits (by ray). The texels were requested by lookupStep.
 template <class F>
 void decodeStep(const GroupTables& tb, const Packed& pk, size_t p, unsigned keep, Group* g) {
-  const F c = gatherBytes(tb.texels, g->t + p);
+  F c;
+  if (tb.texels) {
+    c = gatherBytes(tb.texels, g->t + p);
+  } else {
+    alignas(32) int32_t code[F::kLanes];
+    for (size_t l = 0; l < F::kLanes; ++l) code[l] = tb.maps[g->k[p + l]][g->t[p + l]];
+    c = loadInt(code);
+  }
   const F d = c * F(tb.distanceScale);
   const F t0 = load(pk.t0 + p);
   const F th = sel(load(pk.inside + p), t0 - d, t0 + d);

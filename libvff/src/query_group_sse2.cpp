@@ -40,6 +40,7 @@ inline F4 vabs(F4 a) { return _mm_and_ps(a.v, _mm_castsi128_ps(_mm_set1_epi32(0x
 inline F4 vneg(F4 a) { return _mm_xor_ps(a.v, _mm_set1_ps(-0.0f)); }
 inline F4 floorPos(F4 a) { return _mm_cvtepi32_ps(_mm_cvttps_epi32(a.v)); }  // 0 <= a < 2^31
 inline F4 load(const float* p) { return _mm_loadu_ps(p); }
+inline F4 loadInt(const int32_t* p) { return _mm_cvtepi32_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p))); }
 inline void store(float* p, F4 a) { _mm_storeu_ps(p, a.v); }
 inline void storeInt(int32_t* p, F4 a) { _mm_storeu_si128(reinterpret_cast<__m128i*>(p), _mm_cvttps_epi32(a.v)); }
 inline unsigned movemask(F4 a) { return unsigned(_mm_movemask_ps(a.v)); }

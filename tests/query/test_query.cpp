@@ -428,10 +428,13 @@ TEST(Query, FilesAnswerLikeTheirMaps) {
   const Vec3 c = centerOf(b->field.field);
   const float R = b->field.field.sphere.radius;
   for (Ray& r : rays) r = Ray{add(c, mul(rng.direction(), 1.5f * R)), rng.direction()};
-  for (Codec codec : {Codec::kStored, Codec::kZstd}) {
+  // One block (the maps back to back) and a block per 7 maps (compressed: maps in separate buffers).
+  for (Codec codec : {Codec::kStored, Codec::kZstd}) for (uint32_t perBlock : {0u, 7u}) {
     WriteOptions w;
     w.codec = codec;
-    const std::string path = (dir / (std::string("query-") + (codec == Codec::kZstd ? "zstd" : "stored") + ".vff")).string();
+    w.mapsPerBlock = perBlock;
+    const std::string path = (dir / (std::string("query-") + (codec == Codec::kZstd ? "zstd" : "stored") +
+                                     std::to_string(perBlock) + ".vff")).string();
     ASSERT_TRUE(writeFile(path, b->field.field, b->field.distance, b->field.normals, w).ok());
     auto file = File::open(path);
     ASSERT_TRUE(file.ok());
@@ -444,6 +447,7 @@ TEST(Query, FilesAnswerLikeTheirMaps) {
       ASSERT_EQ(a.t, e.t);
       ASSERT_EQ(a.normal.x, e.normal.x);
     }
+    EXPECT_GT(expectBatchesEqualSingleRays(*q, rays), 300);
   }
 }
 
