@@ -1,5 +1,5 @@
-// The group kernel's dispatch (query_group.h): eight AVX2 lanes where the CPU has them, four SSE2
-// lanes on every other x86-64 CPU, none elsewhere (the batches then call prepare() per ray).
+// The group kernel's dispatch (query_group.h): AVX2 where the CPU has it, SSE2 on every other
+// x86-64 CPU, none elsewhere (the batches then call prepare() per ray).
 #include "query_group.h"
 
 #include <atomic>

@@ -1,5 +1,5 @@
-// query_group.h - the nearest lookup of many rays at once, eight (AVX2) or four (SSE2) per
-// instruction (internal).
+// query_group.h - the nearest lookup of many rays at once, 32 at a time in AVX2 vectors or 8 in
+// SSE2 vectors (internal).
 //
 // FieldQuery's batch functions hand rays to prepareGroup() in groups of kGroupRays. It computes,
 // for every ray, what FieldQuery::Impl::prepare computes one ray at a time: the sphere entry, the
@@ -64,7 +64,7 @@ struct GroupTables {
 // their texels. Distances are along the unit direction, as in prepare(): a texel distance d
 // gives t = (t0 +- d) / len (minus from inside).
 struct Group {
-  static constexpr size_t kSlack = 8;  // the kernels store whole vectors past `count`
+  static constexpr size_t kSlack = 32;  // the kernels store whole vectors (up to 32 lanes) past `count`
   float t0[kGroupRays], lo[kGroupRays], hi[kGroupRays], len[kGroupRays];
   uint64_t inside = 0;   // the origin is inside the sphere (the lookup is reversed)
   uint64_t reached = 0;  // the ray reaches the sphere (all others miss)
@@ -98,12 +98,12 @@ inline size_t texelByte(DistanceEncoding e, uint32_t m, uint32_t i, uint32_t j) 
 
 // True where prepareGroup is implemented (x86-64). Elsewhere the caller uses prepare().
 bool groupKernelAvailable() noexcept;
-// The kernel prepareGroup runs: "avx2" (eight lanes, where the CPU has AVX2), "sse2" (four) or
+// The kernel prepareGroup runs: "avx2" (32 lanes, where the CPU has AVX2), "sse2" (8) or
 // "scalar" (none: prepare() per ray).
 const char* groupKernelName() noexcept;
 
 // For tests: force a kernel for the whole process. kAuto (the default) takes the widest the CPU
-// has; kSse2 the four-lane one; kNone makes groupKernelAvailable() false.
+// has; kSse2 the SSE2 one; kNone makes groupKernelAvailable() false.
 enum class KernelChoice : uint8_t { kAuto = 0, kSse2 = 1, kNone = 2 };
 void forceGroupKernel(KernelChoice choice) noexcept;
 KernelChoice kernelOverride() noexcept;

@@ -1,4 +1,4 @@
-// The group kernel (query_group_kernel.h) with eight AVX2 lanes. This file alone is compiled with
+// The group kernel (query_group_kernel.h) on 32 lanes: four vectors of eight AVX2 lanes. This file alone is compiled with
 // -mavx2 (not -mfma: no operation may be fused); query_group.cpp calls it only on a CPU with AVX2.
 // It constructs no object of a type declared outside it, so that no inline function compiled here
 // can stand in for the baseline copy used elsewhere.
@@ -16,6 +16,12 @@ struct F8 {
   F8() = default;
   F8(__m256 x) : v(x) {}  // NOLINT: implicit, so that intrinsics' results are lanes
   explicit F8(float x) : v(_mm256_set1_ps(x)) {}
+  // (Static: they take no lanes to choose an overload by.)
+  static F8 load(const float* p);
+  static F8 loadInt(const int32_t* p);
+  static F8 gatherBytes(const uint8_t* base, const int32_t* at);
+  static void compressIndex(uint32_t* dst, uint32_t first, unsigned mask);
+  static uint64_t rayBits(const uint32_t* ray, unsigned bits);
 };
 
 inline F8 operator+(F8 a, F8 b) { return _mm256_add_ps(a.v, b.v); }
@@ -41,8 +47,8 @@ inline F8 sel(F8 m, F8 a, F8 b) { return _mm256_blendv_ps(b.v, a.v, m.v); }  // 
 inline F8 vabs(F8 a) { return _mm256_and_ps(a.v, _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff))); }
 inline F8 vneg(F8 a) { return _mm256_xor_ps(a.v, _mm256_set1_ps(-0.0f)); }
 inline F8 floorPos(F8 a) { return _mm256_cvtepi32_ps(_mm256_cvttps_epi32(a.v)); }  // 0 <= a < 2^31
-inline F8 load(const float* p) { return _mm256_loadu_ps(p); }
-inline F8 loadInt(const int32_t* p) { return _mm256_cvtepi32_ps(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p))); }
+inline F8 F8::load(const float* p) { return _mm256_loadu_ps(p); }
+inline F8 F8::loadInt(const int32_t* p) { return _mm256_cvtepi32_ps(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p))); }
 inline void store(float* p, F8 a) { _mm256_storeu_ps(p, a.v); }
 inline void storeInt(int32_t* p, F8 a) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), _mm256_cvttps_epi32(a.v)); }
 inline unsigned movemask(F8 a) { return unsigned(_mm256_movemask_ps(a.v)); }
@@ -74,7 +80,7 @@ inline void compress(float* dst, F8 a, unsigned mask) {
   _mm256_storeu_ps(dst, _mm256_permutevar8x32_ps(a.v, lanePermutation(mask)));
 }
 // Stores first + l for the lanes l selected by `mask`, in order, at dst[0 ..] (writes 8 words).
-inline void compressIndex(uint32_t* dst, uint32_t first, unsigned mask) {
+inline void F8::compressIndex(uint32_t* dst, uint32_t first, unsigned mask) {
   const __m256i lanes = _mm256_add_epi32(lanePermutation(mask), _mm256_set1_epi32(int32_t(first)));
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(dst), lanes);
 }
@@ -106,7 +112,7 @@ inline void storeTexelIndex(int32_t* dst, F8 k, F8 t, int32_t mapBytes) {
 }
 // The bytes base[at[l]] as floats. Reads 4 bytes per lane, ending at the byte (or, for the first 3
 // bytes, starting at base): never outside [base, base + 4) and the bytes up to the one read.
-inline F8 gatherBytes(const uint8_t* base, const int32_t* at) {
+inline F8 F8::gatherBytes(const uint8_t* base, const int32_t* at) {
   const __m256i idx = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(at));
   const __m256i back = _mm256_min_epi32(idx, _mm256_set1_epi32(3));  // bytes read before the wanted one
   const __m256i words = _mm256_i32gather_epi32(reinterpret_cast<const int*>(base), _mm256_sub_epi32(idx, back), 1);
@@ -114,7 +120,7 @@ inline F8 gatherBytes(const uint8_t* base, const int32_t* at) {
   return _mm256_cvtepi32_ps(bytes);
 }
 // Bit ray[l] for every lane l set in `bits` (ray[l] < 64).
-inline uint64_t rayBits(const uint32_t* ray, unsigned bits) {
+inline uint64_t F8::rayBits(const uint32_t* ray, unsigned bits) {
   const __m256i lane = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
   const __m256i on = _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(int32_t(bits)), lane), lane);
   const __m256i r = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(ray));
@@ -161,7 +167,7 @@ inline void loadRays(const float* p, F8* ox, F8* oy, F8* oz, F8* dx, F8* dy, F8*
 namespace vff::detail {
 
 void prepareGroupAvx2(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept {
-  prepareGroupWith<F8>(tables, rays, n, g);
+  prepareGroupWith<Pair<Pair<F8>>>(tables, rays, n, g);  // 32 lanes (query_group_kernel.h)
 }
 
 }  // namespace vff::detail

@@ -1,4 +1,5 @@
-// The group kernel (query_group_kernel.h) with four SSE2 lanes: every x86-64 CPU has them.
+// The group kernel (query_group_kernel.h) on 8 lanes: two vectors of four SSE2 lanes, which every
+// x86-64 CPU has.
 #include "query_group.h"
 
 #if defined(__SSE2__)
@@ -14,6 +15,12 @@ struct F4 {
   F4() = default;
   F4(__m128 x) : v(x) {}  // NOLINT: implicit, so that intrinsics' results are lanes
   explicit F4(float x) : v(_mm_set1_ps(x)) {}
+  // (Static: they take no lanes to choose an overload by.)
+  static F4 load(const float* p);
+  static F4 loadInt(const int32_t* p);
+  static F4 gatherBytes(const uint8_t* base, const int32_t* at);
+  static void compressIndex(uint32_t* dst, uint32_t first, unsigned mask);
+  static uint64_t rayBits(const uint32_t* ray, unsigned bits);
 };
 
 inline F4 operator+(F4 a, F4 b) { return _mm_add_ps(a.v, b.v); }
@@ -39,8 +46,8 @@ inline F4 sel(F4 m, F4 a, F4 b) { return _mm_or_ps(_mm_and_ps(m.v, a.v), _mm_and
 inline F4 vabs(F4 a) { return _mm_and_ps(a.v, _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff))); }
 inline F4 vneg(F4 a) { return _mm_xor_ps(a.v, _mm_set1_ps(-0.0f)); }
 inline F4 floorPos(F4 a) { return _mm_cvtepi32_ps(_mm_cvttps_epi32(a.v)); }  // 0 <= a < 2^31
-inline F4 load(const float* p) { return _mm_loadu_ps(p); }
-inline F4 loadInt(const int32_t* p) { return _mm_cvtepi32_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p))); }
+inline F4 F4::load(const float* p) { return _mm_loadu_ps(p); }
+inline F4 F4::loadInt(const int32_t* p) { return _mm_cvtepi32_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p))); }
 inline void store(float* p, F4 a) { _mm_storeu_ps(p, a.v); }
 inline void storeInt(int32_t* p, F4 a) { _mm_storeu_si128(reinterpret_cast<__m128i*>(p), _mm_cvttps_epi32(a.v)); }
 inline unsigned movemask(F4 a) { return unsigned(_mm_movemask_ps(a.v)); }
@@ -53,7 +60,7 @@ inline void compress(float* dst, F4 a, unsigned mask) {
     if ((mask >> l) & 1u) *dst++ = v[l];
 }
 // Stores first + l for the lanes l selected by `mask`, in order, at dst[0 ..].
-inline void compressIndex(uint32_t* dst, uint32_t first, unsigned mask) {
+inline void F4::compressIndex(uint32_t* dst, uint32_t first, unsigned mask) {
   for (uint32_t l = 0; l < 4; ++l)
     if ((mask >> l) & 1u) *dst++ = first + l;
 }
@@ -89,11 +96,11 @@ inline void storeTexelIndex(int32_t* dst, F4 k, F4 t, int32_t mapBytes) {
   for (int l = 0; l < 4; ++l) dst[l] = ki[l] * mapBytes + ti[l];
 }
 // The bytes base[at[l]] as floats.
-inline F4 gatherBytes(const uint8_t* base, const int32_t* at) {
+inline F4 F4::gatherBytes(const uint8_t* base, const int32_t* at) {
   return _mm_cvtepi32_ps(_mm_setr_epi32(base[at[0]], base[at[1]], base[at[2]], base[at[3]]));
 }
 // Bit ray[l] for every lane l set in `bits` (ray[l] < 64).
-inline uint64_t rayBits(const uint32_t* ray, unsigned bits) {
+inline uint64_t F4::rayBits(const uint32_t* ray, unsigned bits) {
   uint64_t out = 0;
   for (int l = 0; l < 4; ++l)
     if ((bits >> l) & 1u) out |= uint64_t(1) << ray[l];
@@ -124,7 +131,7 @@ inline void loadRays(const float* p, F4* ox, F4* oy, F4* oz, F4* dx, F4* dy, F4*
 namespace vff::detail {
 
 void prepareGroupSse2(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept {
-  prepareGroupWith<F4>(tables, rays, n, g);
+  prepareGroupWith<Pair<F4>>(tables, rays, n, g);  // 8 lanes (query_group_kernel.h)
 }
 
 }  // namespace vff::detail

@@ -1,6 +1,6 @@
 // The query's fast paths against their references: the binary32 octa-hemi2 nearest sample and the
-// atan2-free texel mapping (libvff/src/fast_lookup.h), and the four-ray group kernel behind the
-// batch functions (libvff/src/query_group.cpp), which must answer every ray exactly as a lookup
+// atan2-free texel mapping (libvff/src/fast_lookup.h), and the group kernel behind the batch
+// functions (libvff/src/query_group_kernel.h), which must answer every ray exactly as a lookup
 // written here from the reference functions does.
 #include <gtest/gtest.h>
 

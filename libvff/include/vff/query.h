@@ -40,10 +40,11 @@
 // called from many threads at once. The batch functions run on the calling thread.
 //
 // Speed. Call the batch functions (FieldQuery's or Instance's): they answer kNearest rays in
-// groups, eight at a time in AVX2 where the CPU has it (four in SSE2 on other x86-64 CPUs), and
-// fetch a group's texels from memory together; kInterpolated batches fetch the texels of 16 rays
-// at once. They give bit for bit the answers of the one-ray functions, several times faster
-// (vff-experiments bench).
+// groups, 32 at a time in AVX2 vectors where the CPU has them (8 in SSE2 vectors on other x86-64
+// CPUs), and fetch a group's texels from memory together; kInterpolated batches fetch the texels
+// of 16 rays at once. They give bit for bit the answers of the one-ray functions, several times
+// faster (vff-experiments bench). occluded() and visibility() with kNearest are fastest on
+// kUnorm8Diameter fields, whose hit flags the group kernel decodes as well.
 #pragma once
 
 #include <cstdint>
