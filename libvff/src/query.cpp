@@ -161,14 +161,27 @@ struct FieldQuery::Impl {
   template <class Emit>
   void batchInterpolated(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept;
   // Runs the group kernel over rays, kGroupRays at a time: each(base, n, group), where bit r of
-  // group.reached says whether ray base + r reaches the sphere (the others miss).
+  // group.reached says whether ray base + r reaches the sphere (the others miss). Each group is
+  // handed over (and decoded, with tables.decodeHits) after the next one is prepared, so that its
+  // texels have the next group's time to arrive from memory.
   template <class Each>
   void forEachGroup(std::span<const Ray> rays, const detail::GroupTables& tables, Each&& each) const noexcept {
-    detail::Group g;
-    for (size_t base = 0; base < rays.size(); base += detail::kGroupRays) {
+    detail::Group g[2];
+    size_t pending = 0, pendingBase = 0;  // pending: the ray count of the group not yet handed over
+    for (size_t base = 0, which = 0; base < rays.size(); base += detail::kGroupRays, which ^= 1) {
       const size_t n = std::min(detail::kGroupRays, rays.size() - base);
-      detail::prepareGroup(tables, rays.data() + base, n, &g);
-      each(base, n, g);
+      detail::prepareGroup(tables, rays.data() + base, n, &g[which]);
+      if (pending) {
+        detail::decodeGroup(tables, &g[which ^ 1]);
+        each(pendingBase, pending, g[which ^ 1]);
+      }
+      pending = n;
+      pendingBase = base;
+    }
+    if (pending) {
+      detail::Group& last = g[(rays.size() - 1) / detail::kGroupRays % 2];
+      detail::decodeGroup(tables, &last);
+      each(pendingBase, pending, last);
     }
   }
   QueryHit query(const Ray& ray, const QueryOptions& o, float* visibility) const noexcept;

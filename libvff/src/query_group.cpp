@@ -16,8 +16,10 @@ KernelChoice kernelOverride() noexcept { return KernelChoice(gOverride.load(std:
 #if defined(__x86_64__) || defined(_M_X64)
 
 void prepareGroupSse2(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept;
+void decodeGroupSse2(const GroupTables& tables, Group* g) noexcept;
 #if defined(VFF_HAVE_AVX2_KERNEL)
 void prepareGroupAvx2(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept;
+void decodeGroupAvx2(const GroupTables& tables, Group* g) noexcept;
 #endif
 
 namespace {
@@ -46,11 +48,19 @@ const char* groupKernelName() noexcept {
 
 void prepareGroup(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept { activeKernel()(tables, rays, n, g); }
 
+void decodeGroup(const GroupTables& tables, Group* g) noexcept {
+#if defined(VFF_HAVE_AVX2_KERNEL)
+  if (activeKernel() == prepareGroupAvx2) return decodeGroupAvx2(tables, g);
+#endif
+  decodeGroupSse2(tables, g);
+}
+
 #else
 
 bool groupKernelAvailable() noexcept { return false; }
 const char* groupKernelName() noexcept { return "scalar"; }
 void prepareGroup(const GroupTables&, const Ray*, size_t, Group*) noexcept {}
+void decodeGroup(const GroupTables&, Group*) noexcept {}
 
 #endif
 

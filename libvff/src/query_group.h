@@ -74,9 +74,12 @@ struct Group {
   // With GroupTables::byteTexels, the texel's byte: j m + i in its map, or k m^2 + j m + i from
   // GroupTables::texels where that is set.
   int32_t t[kGroupRays + kSlack];
+  // With GroupTables::decodeHits, the packed rays' t0, lo, hi and inside (a float mask), for
+  // decodeGroup.
+  float pt0[kGroupRays + kSlack], plo[kGroupRays + kSlack], phi[kGroupRays + kSlack], pinside[kGroupRays + kSlack];
   uint64_t redo = 0;    // bit p: the caller must run the reference prepare() on packed ray p
-  // With GroupTables::decodeHits, bit r: ray r hits within its range (hitsAt). Not set for the
-  // rays in `redo`.
+  // decodeGroup's answer, bit r: ray r hits within its range (hitsAt). Not set for the rays in
+  // `redo`.
   uint64_t hits = 0;
 };
 static_assert(kGroupRays <= 64, "the masks hold one bit per ray");
@@ -108,7 +111,11 @@ enum class KernelChoice : uint8_t { kAuto = 0, kSse2 = 1, kNone = 2 };
 void forceGroupKernel(KernelChoice choice) noexcept;
 KernelChoice kernelOverride() noexcept;
 
-// Fills g for rays[0, n), n <= kGroupRays.
+// Fills g for rays[0, n), n <= kGroupRays, and requests the texels from memory.
 void prepareGroup(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept;
+// With tables.decodeHits, reads the texels of a prepared group and fills g->hits (else sets it to
+// 0). Best called some time after prepareGroup (FieldQuery prepares the next group first), so
+// that the texels have arrived.
+void decodeGroup(const GroupTables& tables, Group* g) noexcept;
 
 }  // namespace vff::detail

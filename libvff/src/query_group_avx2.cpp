@@ -170,6 +170,8 @@ void prepareGroupAvx2(const GroupTables& tables, const Ray* rays, size_t n, Grou
   prepareGroupWith<Pair<Pair<F8>>>(tables, rays, n, g);  // 32 lanes (query_group_kernel.h)
 }
 
+void decodeGroupAvx2(const GroupTables& tables, Group* g) noexcept { decodeGroupWith<Pair<Pair<F8>>>(tables, g); }
+
 }  // namespace vff::detail
 
 #endif

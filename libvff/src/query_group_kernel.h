@@ -151,7 +151,6 @@ inline F atanUnitV(F t) {
 struct Packed {
   static constexpr size_t kSize = kGroupRays + Group::kSlack;
   float eux[kSize], euy[kSize], euz[kSize], vx[kSize], vy[kSize], vz[kSize];
-  float t0[kSize], lo[kSize], hi[kSize], inside[kSize];  // for decodeStep (GroupTables::decodeHits)
 };
 
 // Step 1 for F::kLanes rays starting at rays[0] (all readable), lanes r0 .. of g: the sphere;
@@ -205,10 +204,10 @@ void sphereStep(const GroupTables& tb, const Ray* rays, Group* g, size_t r0, Pac
   compress(packed->vy + at, vy, bits);
   compress(packed->vz + at, vz, bits);
   if (tb.decodeHits) {
-    compress(packed->t0 + at, t0, bits);
-    compress(packed->lo + at, lo, bits);
-    compress(packed->hi + at, tmaxL, bits);
-    compress(packed->inside + at, inside, bits);
+    compress(g->pt0 + at, t0, bits);
+    compress(g->plo + at, lo, bits);
+    compress(g->phi + at, tmaxL, bits);
+    compress(g->pinside + at, inside, bits);
   }
   F::compressIndex(g->ray + at, uint32_t(r0), bits);
   g->count += uint32_t(__builtin_popcount(bits));
@@ -333,11 +332,11 @@ void lookupStep(const GroupTables& tb, const Packed& pk, size_t p, Group* g) {
   }
 }
 
-// Step 4 (GroupTables::decodeHits) for packed rays p .. p + kLanes - 1, those of `keep` only:
-// whether each texel holds a hit within the ray's range, as FieldQuery::Impl::hitsAt decodes a
-// kUnorm8Diameter texel, into g->hits (by ray). The texels were requested by lookupStep.
+// decodeGroup (query_group.h) for packed rays p .. p + kLanes - 1, those of `keep` only: whether
+// each texel holds a hit within the ray's range, as FieldQuery::Impl::hitsAt decodes a
+// kUnorm8Diameter texel, into g->hits (by ray).
 template <class F>
-void decodeStep(const GroupTables& tb, const Packed& pk, size_t p, unsigned keep, Group* g) {
+void decodeStep(const GroupTables& tb, size_t p, unsigned keep, Group* g) {
   F c;
   if (tb.texels) {
     c = F::gatherBytes(tb.texels, g->t + p);
@@ -347,11 +346,25 @@ void decodeStep(const GroupTables& tb, const Packed& pk, size_t p, unsigned keep
     c = F::loadInt(code);
   }
   const F d = c * F(tb.distanceScale);
-  const F t0 = F::load(pk.t0 + p);
-  const F th = sel(F::load(pk.inside + p), t0 - d, t0 + d);
+  const F t0 = F::load(g->pt0 + p);
+  const F th = sel(F::load(g->pinside + p), t0 - d, t0 + d);
   // texel(): a hit unless the code is 255; hitsAt(): !(th < lo || th > hi).
-  const F hit = band(bnot(eq(c, F(255.0f))), band(nlt(th, F::load(pk.lo + p)), ngt(th, F::load(pk.hi + p))));
+  const F hit = band(bnot(eq(c, F(255.0f))), band(nlt(th, F::load(g->plo + p)), ngt(th, F::load(g->phi + p))));
   g->hits |= F::rayBits(g->ray + p, movemask(hit) & keep);
+}
+
+// decodeGroup (query_group.h) with lanes F.
+template <class F>
+void decodeGroupWith(const GroupTables& tb, Group* g) {
+  constexpr size_t L = F::kLanes;
+  g->hits = 0;
+  const size_t count = g->count;
+  if (!tb.decodeHits || tb.octaN == 0 || count == 0) return;
+  // Not the padded lanes, nor the redone rays (the caller's).
+  const uint64_t all = count == 64 ? ~uint64_t(0) : (uint64_t(1) << count) - 1;
+  const uint64_t keep = all & ~g->redo, laneBits = L >= 64 ? ~uint64_t(0) : (uint64_t(1) << L) - 1;
+  for (size_t p = count; p % L != 0; ++p) g->k[p] = g->t[p] = 0;  // whatever kernel padded them
+  for (size_t p = 0; p < count; p += L) decodeStep<F>(tb, p, unsigned((keep >> p) & laneBits), g);
 }
 
 // prepareGroup (query_group.h) with lanes F.
@@ -388,19 +401,14 @@ void prepareGroupWith(const GroupTables& tb, const Ray* rays, size_t n, Group* g
     packed.vy[p] = packed.vy[count - 1];
     packed.vz[p] = packed.vz[count - 1];
     if (tb.decodeHits) {
-      packed.t0[p] = packed.t0[count - 1];
-      packed.lo[p] = packed.lo[count - 1];
-      packed.hi[p] = packed.hi[count - 1];
-      packed.inside[p] = packed.inside[count - 1];
+      g->pt0[p] = g->pt0[count - 1];
+      g->plo[p] = g->plo[count - 1];
+      g->phi[p] = g->phi[count - 1];
+      g->pinside[p] = g->pinside[count - 1];
     }
   }
   for (size_t p = 0; p < count; p += L) lookupStep<F>(tb, packed, p, g);
   g->redo &= all;
-  if (tb.decodeHits) {
-    // Not the padded lanes, nor the redone rays (the caller's).
-    const uint64_t keep = all & ~g->redo, laneBits = (uint64_t(1) << L) - 1;
-    for (size_t p = 0; p < count; p += L) decodeStep<F>(tb, packed, p, unsigned((keep >> p) & laneBits), g);
-  }
 }
 
 }  // namespace

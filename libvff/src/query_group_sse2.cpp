@@ -134,6 +134,8 @@ void prepareGroupSse2(const GroupTables& tables, const Ray* rays, size_t n, Grou
   prepareGroupWith<Pair<F4>>(tables, rays, n, g);  // 8 lanes (query_group_kernel.h)
 }
 
+void decodeGroupSse2(const GroupTables& tables, Group* g) noexcept { decodeGroupWith<Pair<F4>>(tables, g); }
+
 }  // namespace vff::detail
 
 #endif
