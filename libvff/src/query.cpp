@@ -170,6 +170,12 @@ struct FieldQuery::Impl {
     size_t pending = 0, pendingBase = 0;  // pending: the ray count of the group not yet handed over
     for (size_t base = 0, which = 0; base < rays.size(); base += detail::kGroupRays, which ^= 1) {
       const size_t n = std::min(detail::kGroupRays, rays.size() - base);
+      // Request the rays two groups ahead (2 KiB): the kernel waited for them even with the CPU's
+      // own prefetching (vff-experiments bench: 1.06x).
+      if (base + 3 * detail::kGroupRays <= rays.size()) {
+        const char* ahead = reinterpret_cast<const char*>(rays.data() + base + 2 * detail::kGroupRays);
+        for (size_t b = 0; b < detail::kGroupRays * sizeof(Ray); b += 64) __builtin_prefetch(ahead + b);
+      }
       detail::prepareGroup(tables, rays.data() + base, n, &g[which]);
       if (pending) {
         detail::decodeGroup(tables, &g[which ^ 1]);
