@@ -319,7 +319,8 @@ void lookupStep(const GroupTables& tb, const Packed& pk, size_t p, Group* g) {
   storeInt(reinterpret_cast<int32_t*>(g->i + p), ti);
   storeInt(reinterpret_cast<int32_t*>(g->j + p), tj);
   g->redo |= uint64_t(movemask(redo)) << p;
-  // Ask for the texels now: they arrive while the rest of the group is looked up.
+  // Ask for the texels now: they arrive while the rest of this group and the next one are prepared
+  // (FieldQuery decodes a group one group late).
   if (tb.texels) {
     storeTexelIndex(g->t + p, band(ok, bestK), tj * fm + ti, tb.mapBytes);
     for (size_t l = 0; l < L; ++l) __builtin_prefetch(tb.texels + g->t[p + l]);
@@ -363,7 +364,11 @@ void decodeGroupWith(const GroupTables& tb, Group* g) {
   // Not the padded lanes, nor the redone rays (the caller's).
   const uint64_t all = count == 64 ? ~uint64_t(0) : (uint64_t(1) << count) - 1;
   const uint64_t keep = all & ~g->redo, laneBits = L >= 64 ? ~uint64_t(0) : (uint64_t(1) << L) - 1;
-  for (size_t p = count; p % L != 0; ++p) g->k[p] = g->t[p] = 0;  // whatever kernel padded them
+  for (size_t p = count; p % L != 0; ++p) {  // lanes past `count`: read, then left out of `keep`
+    g->k[p] = 0;
+    g->t[p] = 0;
+    g->pt0[p] = g->plo[p] = g->phi[p] = g->pinside[p] = 0.0f;
+  }
   for (size_t p = 0; p < count; p += L) decodeStep<F>(tb, p, unsigned((keep >> p) & laneBits), g);
 }
 
@@ -376,7 +381,6 @@ void prepareGroupWith(const GroupTables& tb, const Ray* rays, size_t n, Group* g
   g->reached = 0;
   g->count = 0;
   g->redo = 0;
-  g->hits = 0;
   size_t r = 0;
   for (; r + L <= n; r += L) sphereStep<F>(tb, rays + r, g, r, &packed);
   if (r < n) {
@@ -400,12 +404,6 @@ void prepareGroupWith(const GroupTables& tb, const Ray* rays, size_t n, Group* g
     packed.vx[p] = packed.vx[count - 1];
     packed.vy[p] = packed.vy[count - 1];
     packed.vz[p] = packed.vz[count - 1];
-    if (tb.decodeHits) {
-      g->pt0[p] = g->pt0[count - 1];
-      g->plo[p] = g->plo[count - 1];
-      g->phi[p] = g->phi[count - 1];
-      g->pinside[p] = g->pinside[count - 1];
-    }
   }
   for (size_t p = 0; p < count; p += L) lookupStep<F>(tb, packed, p, g);
   g->redo &= all;
