@@ -5,8 +5,8 @@
 // for every ray, what FieldQuery::Impl::prepare computes one ray at a time: the sphere entry, the
 // nearest positional sample (octa-hemi2: the candidates of PositionSet::candidates, scored
 // without reading their positions, fast_lookup.h's kOctaScoreError) and the texel of the lookup
-// direction in that sample's map; for occlusion batches over one-byte maps it also reads the
-// texels and decodes the hit flags. Where it computes what prepare() computes it performs the
+// direction in that sample's map; for occlusion batches over one-byte maps, decodeGroup() then
+// reads the texels and decodes the hit flags. Where it computes what prepare() computes it performs the
 // same binary32 operations in the same order, and it leaves to the caller (bit `redo`) every ray
 // on which a guard of fast_lookup.h trips, whose two best candidates score too close to call, or
 // whose scheme it does not handle, so that a group gives exactly the texel and the answer
@@ -78,8 +78,8 @@ struct Group {
   // decodeGroup.
   float pt0[kGroupRays + kSlack], plo[kGroupRays + kSlack], phi[kGroupRays + kSlack], pinside[kGroupRays + kSlack];
   uint64_t redo = 0;    // bit p: the caller must run the reference prepare() on packed ray p
-  // decodeGroup's answer, bit r: ray r hits within its range (hitsAt). Not set for the rays in
-  // `redo`.
+  // decodeGroup's answer, bit r: ray r hits within its range (hitsAt). Left unset for the rays
+  // in `redo`, which the caller answers.
   uint64_t hits = 0;
 };
 static_assert(kGroupRays <= 64, "the masks hold one bit per ray");
