@@ -96,18 +96,14 @@ inline std::vector<float> cpuAo(const FieldQuery& q, const AoScene& s, int rays,
   const QueryOptions qo{.reconstruction = r, .intraBias = 0.0f};
   auto work = [&](unsigned t0) {
     std::vector<Ray> batch(size_t(std::max(rays, 0)));
-    std::vector<uint8_t> occ(batch.size());
-    std::vector<float> vis(batch.size());
+    std::vector<float> vis(batch.size());  // kNearest: 0 or 1, as !occluded()
     for (int y = int(t0); y < s.size; y += int(threads))
       for (int x = 0; x < s.size; ++x) {
         const uint32_t p = uint32_t(y * s.size + x);
         for (int i = 0; i < rays; ++i) batch[size_t(i)] = aoRay(s, p, i);
-        if (r == Reconstruction::kNearest)
-          q.occluded(batch, occ, qo);
-        else
-          q.visibility(batch, vis, qo);
+        q.visibility(batch, vis, qo);
         float open = 0;
-        for (size_t i = 0; i < batch.size(); ++i) open += r == Reconstruction::kNearest ? (occ[i] ? 0.0f : 1.0f) : vis[i];
+        for (float v : vis) open += v;
         out[p] = open / float(rays);
       }
   };

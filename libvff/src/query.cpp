@@ -167,8 +167,9 @@ struct FieldQuery::Impl {
   template <class Each>
   void forEachGroup(std::span<const Ray> rays, const detail::GroupTables& tables, Each&& each) const noexcept {
     detail::Group g[2];
+    size_t which = 0;                     // the group prepared next
     size_t pending = 0, pendingBase = 0;  // pending: the ray count of the group not yet handed over
-    for (size_t base = 0, which = 0; base < rays.size(); base += detail::kGroupRays, which ^= 1) {
+    for (size_t base = 0; base < rays.size(); base += detail::kGroupRays, which ^= 1) {
       const size_t n = std::min(detail::kGroupRays, rays.size() - base);
       // Request the rays two groups ahead (2 KiB): the kernel waited for them even with the CPU's
       // own prefetching (vff-experiments bench: 1.06x).
@@ -185,9 +186,8 @@ struct FieldQuery::Impl {
       pendingBase = base;
     }
     if (pending) {
-      detail::Group& last = g[(rays.size() - 1) / detail::kGroupRays % 2];
-      detail::decodeGroup(tables, &last);
-      each(pendingBase, pending, last);
+      detail::decodeGroup(tables, &g[which ^ 1]);
+      each(pendingBase, pending, g[which ^ 1]);
     }
   }
   QueryHit query(const Ray& ray, const QueryOptions& o, float* visibility) const noexcept;
@@ -201,7 +201,8 @@ struct FieldQuery::Impl {
     if (t) *t = th;
     return !(th < lo || th > hi);
   }
-  // kHitOnly: emit(r, bool hit); otherwise emit(r, const QueryHit&, float visibility).
+  // kHitOnly: emit(base, n, hits) per run of rays; otherwise emit(r, const QueryHit&, float
+  // visibility) per ray (see the definition).
   template <bool kHitOnly, class Emit>
   void batchNearest(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept;
   const uint8_t* texelAddress(uint32_t k, uint32_t i, uint32_t j) const noexcept {
@@ -746,7 +747,7 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
     if constexpr (kHitOnly) {
       // The kernel decoded all but the redone rays, or none of them.
       uint64_t hits = tables.decodeHits ? g.hits : 0;
-      const uint64_t left = tables.decodeHits ? g.redo : g.count == 64 ? ~uint64_t(0) : (uint64_t(1) << g.count) - 1;
+      const uint64_t left = tables.decodeHits ? g.redo : detail::packedBits(g.count);
       for (uint64_t todo = left & ~dead; todo != 0; todo &= todo - 1) {
         const uint32_t p = uint32_t(__builtin_ctzll(todo)), r = g.ray[p];
         if (hitsAt(g.k[p], g.i[p], g.j[p], g.t0[r], (g.inside >> r) & 1u, g.lo[r], g.hi[r])) hits |= uint64_t(1) << r;
@@ -853,13 +854,21 @@ Ray toObject(const RigidTransform& x, const Ray& r) {
 
 }  // namespace
 
+namespace {
+
+// The field's answer to toObject(x, worldRay), in world space (both rays share t).
+void toWorld(const RigidTransform& x, const Ray& worldRay, QueryHit* h) {
+  if (!h->hit) return;
+  h->point = worldRay.origin + worldRay.direction * h->t;
+  if (h->hasNormal) h->normal = normalize(x.toWorldVector(h->normal));
+}
+
+}  // namespace
+
 QueryHit Instance::intersect(const Ray& worldRay, const QueryOptions& options) const noexcept {
   if (!field) return {};
   QueryHit h = field->intersect(toObject(transform, worldRay), options);
-  if (h.hit) {
-    h.point = worldRay.origin + worldRay.direction * h.t;
-    if (h.hasNormal) h.normal = normalize(transform.toWorldVector(h.normal));
-  }
+  toWorld(transform, worldRay, &h);
   return h;
 }
 
@@ -895,13 +904,7 @@ void Instance::intersect(std::span<const Ray> worldRays, std::span<QueryHit> out
   }
   inObjectSpace(transform, worldRays.first(n), [&](std::span<const Ray> rays, size_t first) {
     field->intersect(rays, out.subspan(first, rays.size()), options);
-    for (size_t r = 0; r < rays.size(); ++r) {
-      QueryHit& h = out[first + r];
-      if (!h.hit) continue;
-      const Ray& w = worldRays[first + r];
-      h.point = w.origin + w.direction * h.t;
-      if (h.hasNormal) h.normal = normalize(transform.toWorldVector(h.normal));
-    }
+    for (size_t r = 0; r < rays.size(); ++r) toWorld(transform, worldRays[first + r], &out[first + r]);
   });
 }
 

@@ -86,6 +86,9 @@ static_assert(kGroupRays <= 64, "the masks hold one bit per ray");
 
 namespace {  // (a copy per file: the AVX2 kernel's file must share no inline function with the rest)
 
+// The bits of packed rays 0 .. count - 1 (count <= 64).
+inline uint64_t packedBits(size_t count) { return count >= 64 ? ~uint64_t(0) : (uint64_t(1) << count) - 1; }
+
 // The byte offset, within a distance map, of the byte that holds texel (i, j).
 inline size_t texelByte(DistanceEncoding e, uint32_t m, uint32_t i, uint32_t j) {
   const size_t t = size_t(j) * m + i;

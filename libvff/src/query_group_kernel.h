@@ -362,8 +362,8 @@ void decodeGroupWith(const GroupTables& tb, Group* g) {
   const size_t count = g->count;
   if (!tb.decodeHits || tb.octaN == 0 || count == 0) return;
   // Not the padded lanes, nor the redone rays (the caller's).
-  const uint64_t all = count == 64 ? ~uint64_t(0) : (uint64_t(1) << count) - 1;
-  const uint64_t keep = all & ~g->redo, laneBits = L >= 64 ? ~uint64_t(0) : (uint64_t(1) << L) - 1;
+  const uint64_t all = packedBits(count);
+  const uint64_t keep = all & ~g->redo, laneBits = packedBits(L);
   for (size_t p = count; p % L != 0; ++p) {  // lanes past `count`: read, then left out of `keep`
     g->k[p] = 0;
     g->t[p] = 0;
@@ -391,7 +391,7 @@ void prepareGroupWith(const GroupTables& tb, const Ray* rays, size_t n, Group* g
   }
   const size_t count = g->count;
   if (count == 0) return;
-  const uint64_t all = count == 64 ? ~uint64_t(0) : (uint64_t(1) << count) - 1;
+  const uint64_t all = packedBits(count);
   if (tb.octaN == 0) {  // another scheme: the reference does the rest
     g->redo = all;
     return;

@@ -2,8 +2,8 @@
 //
 // Every plane pixel casts `rays` cosine-weighted rays (default 256) up to aoDistance * R (default
 // 2 R, see Options) and is shaded with the unoccluded fraction. The exact image tests them with rtcOccluded1;
-// the field images with Instance::occluded (kNearest, the paper's 0/1 answer) or with
-// Instance::visibility (kInterpolated, a fraction per ray), one batch call per pixel. Object pixels get a constant colour, so
+// the field images with Instance::visibility, one batch call per pixel: 0 or 1 per ray for kNearest
+// (the paper's answer, !occluded()), a fraction for kInterpolated. Object pixels get a constant colour, so
 // only plane AO is compared. Plane points close to the object lie inside its bounding sphere and
 // are answered by the intra-object test (spec/geometry.md 7.3), as a renderer using the field would.
 #include "common.h"

@@ -138,23 +138,18 @@ inline std::span<vff::Ray> rayBuffer(size_t n) {
   return rays;
 }
 
-// The unoccluded share of every ray: the exact answer (0 or 1) when field is null, the field's
-// occluded() (0 or 1) for kNearest, its visibility() (a fraction) for kInterpolated. A field
-// answers them with one batch call, as a renderer would. The result lives until the thread's
-// next call.
+// The unoccluded share of every ray: the exact answer (0 or 1) when field is null, else the
+// field's visibility(): 0 or 1 (not occluded()) for kNearest, a fraction for kInterpolated. A
+// field answers them with one batch call, as a renderer would. The result lives until the
+// thread's next call.
 inline std::span<const float> openShares(const ExactTracer& exact, const BakedQuery* field, const vff::QueryOptions& qo,
                                          std::span<const vff::Ray> rays) {
   thread_local std::vector<float> out;
-  thread_local std::vector<uint8_t> occ;
   out.resize(rays.size());
-  if (!field) {
-    for (size_t i = 0; i < rays.size(); ++i) out[i] = exact.occluded(rays[i]) ? 0.0f : 1.0f;
-  } else if (qo.reconstruction == vff::Reconstruction::kNearest) {
-    occ.resize(rays.size());
-    field->instance.occluded(rays, occ, qo);
-    for (size_t i = 0; i < rays.size(); ++i) out[i] = occ[i] ? 0.0f : 1.0f;
-  } else {
+  if (field) {
     field->instance.visibility(rays, out, qo);
+  } else {
+    for (size_t i = 0; i < rays.size(); ++i) out[i] = exact.occluded(rays[i]) ? 0.0f : 1.0f;
   }
   return out;
 }
