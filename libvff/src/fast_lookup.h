@@ -33,7 +33,8 @@ inline float texelGuard(uint32_t m) noexcept { return kTexelGuard + 2e-6f * floa
 
 // The SIMD kernel (query_group_kernel.h) scores an octa-hemi2 candidate, grid point g of the query's
 // quadrant, as g.(|q.x|, |q.y|, |q.z|) / |g|, with the reciprocal square root approximated
-// (relative error <= 1.5 * 2^-12) and refined by one Newton step; the reference scores it as
+// (relative error <= 1.5 * 2^-12: rsqrtps; AVX-512's rsqrt14ps, 2^-14, is within it) and refined
+// by one Newton step; the reference scores it as
 // unit(k).q in binary32, unit(k) being the binary64 position rounded to binary32. Bounds, in
 // units of u = 2^-24 and |q|: the reference's products and sums 3 u, its rounded position u;
 // the kernel's dot product 3 u, the refined reciprocal 1.5 (1.5 * 2^-12)^2 + 4 u (about 7.4 u),

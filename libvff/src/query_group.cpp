@@ -1,5 +1,5 @@
-// The group kernel's dispatch (query_group.h): AVX2 where the CPU has it, SSE2 on every other
-// x86-64 CPU, none elsewhere (the batches then call prepare() per ray).
+// The group kernel's dispatch (query_group.h): AVX-512 or AVX2 where the CPU has it, SSE2 on
+// every other x86-64 CPU, none elsewhere (the batches then call prepare() per ray).
 #include "query_group.h"
 
 #include <atomic>
@@ -21,43 +21,89 @@ void decodeGroupSse2(const GroupTables& tables, Group* g) noexcept;
 void prepareGroupAvx2(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept;
 void decodeGroupAvx2(const GroupTables& tables, Group* g) noexcept;
 #endif
+#if defined(VFF_HAVE_AVX512_KERNEL)
+void prepareGroupAvx512(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept;
+void decodeGroupAvx512(const GroupTables& tables, Group* g) noexcept;
+#endif
 
 namespace {
 
-using Kernel = void (*)(const GroupTables&, const Ray*, size_t, Group*) noexcept;
+struct Kernel {
+  const char* name;
+  void (*prepare)(const GroupTables&, const Ray*, size_t, Group*) noexcept;
+  void (*decode)(const GroupTables&, Group*) noexcept;
+};
 
-// The kernel prepareGroup runs now: the override, else the widest this CPU runs (decided once).
-Kernel activeKernel() noexcept {
-  static const Kernel widest = [] {
+constexpr Kernel kSse2{"sse2", prepareGroupSse2, decodeGroupSse2};
 #if defined(VFF_HAVE_AVX2_KERNEL)
-    if (__builtin_cpu_supports("avx2")) return prepareGroupAvx2;
+constexpr Kernel kAvx2{"avx2", prepareGroupAvx2, decodeGroupAvx2};
 #endif
-    return prepareGroupSse2;
+#if defined(VFF_HAVE_AVX512_KERNEL)
+constexpr Kernel kAvx512{"avx512", prepareGroupAvx512, decodeGroupAvx512};
+#endif
+
+// The kernels this CPU runs (decided once): null where it has not the instructions (or this
+// build not the kernel).
+struct Available {
+  const Kernel* avx2 = nullptr;
+  const Kernel* avx512 = nullptr;
+};
+const Available& available() noexcept {
+  static const Available a = [] {
+    Available r;
+#if defined(VFF_HAVE_AVX2_KERNEL)
+    if (__builtin_cpu_supports("avx2")) r.avx2 = &kAvx2;
+#endif
+#if defined(VFF_HAVE_AVX512_KERNEL)
+    // (libgcc's and compiler-rt's checks include the OS's support for the AVX-512 registers.)
+    if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+        __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw"))
+      r.avx512 = &kAvx512;
+#endif
+    return r;
   }();
-  return kernelOverride() == KernelChoice::kSse2 ? prepareGroupSse2 : widest;
+  return a;
+}
+
+// The kernel prepareGroup runs now: the override where this CPU runs it, else the widest.
+const Kernel& activeKernel() noexcept {
+  const Available& a = available();
+  switch (kernelOverride()) {
+    case KernelChoice::kSse2: return kSse2;
+    case KernelChoice::kAvx2:
+      if (a.avx2) return *a.avx2;
+      break;
+    default: break;
+  }
+  if (a.avx512) return *a.avx512;
+  if (a.avx2) return *a.avx2;
+  return kSse2;
 }
 
 }  // namespace
 
 bool groupKernelAvailable() noexcept { return kernelOverride() != KernelChoice::kNone; }
 
-const char* groupKernelName() noexcept {
-  if (!groupKernelAvailable()) return "scalar";
-  return activeKernel() == prepareGroupSse2 ? "sse2" : "avx2";
+bool groupKernelRuns(KernelChoice choice) noexcept {
+  switch (choice) {
+    case KernelChoice::kAvx2: return available().avx2 != nullptr;
+    case KernelChoice::kAvx512: return available().avx512 != nullptr;
+    default: return true;
+  }
 }
 
-void prepareGroup(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept { activeKernel()(tables, rays, n, g); }
+const char* groupKernelName() noexcept { return groupKernelAvailable() ? activeKernel().name : "scalar"; }
 
-void decodeGroup(const GroupTables& tables, Group* g) noexcept {
-#if defined(VFF_HAVE_AVX2_KERNEL)
-  if (activeKernel() == prepareGroupAvx2) return decodeGroupAvx2(tables, g);
-#endif
-  decodeGroupSse2(tables, g);
+void prepareGroup(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept {
+  activeKernel().prepare(tables, rays, n, g);
 }
+
+void decodeGroup(const GroupTables& tables, Group* g) noexcept { activeKernel().decode(tables, g); }
 
 #else
 
 bool groupKernelAvailable() noexcept { return false; }
+bool groupKernelRuns(KernelChoice choice) noexcept { return choice == KernelChoice::kNone; }
 const char* groupKernelName() noexcept { return "scalar"; }
 void prepareGroup(const GroupTables&, const Ray*, size_t, Group*) noexcept {}
 void decodeGroup(const GroupTables&, Group*) noexcept {}

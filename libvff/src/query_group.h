@@ -1,5 +1,5 @@
-// query_group.h - the nearest lookup of many rays at once, 32 at a time in AVX2 vectors or 8 in
-// SSE2 vectors (internal).
+// query_group.h - the nearest lookup of many rays at once, 32 at a time in AVX-512 or AVX2
+// vectors or 8 in SSE2 vectors (internal).
 //
 // FieldQuery's batch functions hand rays to prepareGroup() in groups of kGroupRays. It computes,
 // for every ray, what FieldQuery::Impl::prepare computes one ray at a time: the sphere entry, the
@@ -104,15 +104,19 @@ inline size_t texelByte(DistanceEncoding e, uint32_t m, uint32_t i, uint32_t j) 
 
 // True where prepareGroup is implemented (x86-64). Elsewhere the caller uses prepare().
 bool groupKernelAvailable() noexcept;
-// The kernel prepareGroup runs: "avx2" (32 lanes, where the CPU has AVX2), "sse2" (8) or
+// The kernel prepareGroup runs: "avx512" (32 lanes in two AVX-512 vectors, where the CPU has
+// AVX-512 F, DQ, VL and BW), "avx2" (32 lanes in four vectors, where it has AVX2), "sse2" (8) or
 // "scalar" (none: prepare() per ray).
 const char* groupKernelName() noexcept;
 
 // For tests: force a kernel for the whole process. kAuto (the default) takes the widest the CPU
-// has; kSse2 the SSE2 one; kNone makes groupKernelAvailable() false.
-enum class KernelChoice : uint8_t { kAuto = 0, kSse2 = 1, kNone = 2 };
+// has; kSse2, kAvx2 and kAvx512 that kernel where the CPU runs it (else the widest); kNone makes
+// groupKernelAvailable() false.
+enum class KernelChoice : uint8_t { kAuto = 0, kSse2 = 1, kNone = 2, kAvx2 = 3, kAvx512 = 4 };
 void forceGroupKernel(KernelChoice choice) noexcept;
 KernelChoice kernelOverride() noexcept;
+// Whether this build and CPU run that kernel (kAuto, kSse2 and kNone: on x86-64, always).
+bool groupKernelRuns(KernelChoice choice) noexcept;
 
 // Fills g for rays[0, n), n <= kGroupRays, and requests the texels from memory.
 void prepareGroup(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept;

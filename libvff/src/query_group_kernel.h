@@ -1,22 +1,24 @@
 // query_group_kernel.h - the group kernel of query_group.h, written once for any SIMD width.
 //
-// Included by query_group_sse2.cpp (four-lane vectors) and query_group_avx2.cpp (eight-lane
-// vectors, compiled for AVX2 and called only where the CPU has it). Everything here sits in an
-// anonymous namespace, so each of those files gets its own copy compiled for its own instruction
-// set, and no function compiled for AVX2 can be shared with code that runs on a CPU without it.
+// Included by query_group_sse2.cpp (four-lane vectors), query_group_avx2.cpp (eight-lane vectors)
+// and query_group_avx512.cpp (sixteen-lane vectors), each compiled for its instruction set and
+// called only where the CPU has it. Everything here sits in an anonymous namespace, so each of
+// those files gets its own copy compiled for its own instruction set, and no function compiled
+// for AVX2 or AVX-512 can be shared with code that runs on a CPU without it.
 //
 // The vector type H (a float vector with +, -, *, / and the free functions used below, and static
 // load, loadInt, gatherBytes, compressIndex and rayBits) is defined by the including file, which
 // runs the kernel on lanes F = Pair<H> or Pair<Pair<H>>: two or four vectors side by side, so
 // that the CPU overlaps their long dependency chains (the nearest sample, then the frame, then
 // the texel). With eight-lane vectors, 32 lanes run 1.2-1.3x faster than 8 on the aimed rays of
-// vff-experiments bench and 1.1x on its AO rays; with four-lane vectors 8 lanes beat 4 and 16.
+// vff-experiments bench and 1.1x on its AO rays; with four-lane vectors 8 lanes beat 4 and 16;
+// with sixteen-lane vectors 32 lanes beat 16 by about 1.1x.
 // Every line that computes a quantity prepare() also computes mirrors a line
 // of FieldQuery::Impl::prepare() or of fast_lookup.h with the same binary32 operations in the
 // same order (a ? b : c becomes sel(mask, b, c); no operation is fused or reordered), so that a
 // lane computes bit for bit what prepare() computes for that ray. The one quantity of its own, a
 // candidate's score, uses the CPU's approximate reciprocal square root, which differs between
-// CPU makers: it only decides which sample wins when the lead is beyond its error bound, so the
+// CPU makers and between rsqrtps and AVX-512's rsqrt14ps: it only decides which sample wins when the lead is beyond its error bound, so the
 // answers are the same everywhere, and only which rays are redone can differ.
 #pragma once
 

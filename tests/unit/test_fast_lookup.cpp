@@ -368,13 +368,29 @@ struct KernelScope {
   ~KernelScope() { detail::forceGroupKernel(detail::KernelChoice::kAuto); }
 };
 
-// Every kernel this CPU can run: the widest (AVX2 where present), SSE2, and none (per-ray prepare).
+// Every kernel this CPU can run: the widest, AVX-512 and AVX2 (each where present), SSE2, and none
+// (per-ray prepare).
 void checkBatches(detail::KernelChoice choice);
 
 TEST(FastLookup, BatchesAnswerLikeTheReferenceLookup) {
   const KernelScope scope(detail::KernelChoice::kAuto);
   std::printf("group kernel: %s\n", detail::groupKernelName());
   checkBatches(detail::KernelChoice::kAuto);
+}
+
+TEST(FastLookup, BatchesAnswerLikeTheReferenceLookupWithAvx512Lanes) {
+  if (!detail::groupKernelRuns(detail::KernelChoice::kAvx512))
+    GTEST_SKIP() << "this build or CPU has no AVX-512 kernel (AVX-512 F, DQ, VL and BW)";
+  const KernelScope scope(detail::KernelChoice::kAvx512);
+  EXPECT_STREQ(detail::groupKernelName(), "avx512");
+  checkBatches(detail::KernelChoice::kAvx512);
+}
+
+TEST(FastLookup, BatchesAnswerLikeTheReferenceLookupWithAvx2Lanes) {
+  if (!detail::groupKernelRuns(detail::KernelChoice::kAvx2)) GTEST_SKIP() << "this build or CPU has no AVX2 kernel";
+  const KernelScope scope(detail::KernelChoice::kAvx2);
+  EXPECT_STREQ(detail::groupKernelName(), "avx2");
+  checkBatches(detail::KernelChoice::kAvx2);
 }
 
 TEST(FastLookup, BatchesAnswerLikeTheReferenceLookupWithSse2Lanes) {

@@ -1,0 +1,171 @@
+// The group kernel (query_group_kernel.h) on 32 lanes: two vectors of sixteen AVX-512 lanes. This
+// file alone is compiled with -mavx512f -mavx512dq -mavx512vl -mavx512bw (not -mfma: no operation
+// may be fused); query_group.cpp calls it only on a CPU (and OS) with those. Against the AVX2
+// kernel it runs half the instructions, and its 32 vector registers hold what the AVX2 kernel
+// spills to the stack (vff-experiments bench). It constructs no object of a type declared outside
+// it, so that no inline function compiled here can stand in for the baseline copy used elsewhere.
+#include "query_group.h"
+
+#if defined(__AVX512F__) && defined(__AVX512DQ__) && defined(__AVX512VL__) && defined(__AVX512BW__)
+#if defined(__GNUC__) && !defined(__clang__) && __GNUC__ < 13
+// GCC 12's AVX-512 intrinsics start from _mm512_undefined_ps() and warn that it is uninitialized
+// wherever they are inlined (GCC bug 105593, fixed in GCC 13).
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+#include <immintrin.h>
+
+namespace vff::detail {
+namespace {
+
+// Sixteen lanes. Masks are vectors, as in the other kernels: all-ones or zero per lane.
+struct F16 {
+  static constexpr size_t kLanes = 16;
+  __m512 v;
+  F16() = default;
+  F16(__m512 x) : v(x) {}  // NOLINT: implicit, so that intrinsics' results are lanes
+  explicit F16(float x) : v(_mm512_set1_ps(x)) {}
+  // (Static: they take no lanes to choose an overload by.)
+  static F16 load(const float* p);
+  static F16 loadInt(const int32_t* p);
+  static F16 gatherBytes(const uint8_t* base, const int32_t* at);
+  static void compressIndex(uint32_t* dst, uint32_t first, unsigned mask);
+  static uint64_t rayBits(const uint32_t* ray, unsigned bits);
+};
+
+inline __m512 maskVector(__mmask16 k) { return _mm512_castsi512_ps(_mm512_movm_epi32(k)); }
+inline __mmask16 laneMask(F16 m) { return _mm512_movepi32_mask(_mm512_castps_si512(m.v)); }
+
+inline F16 operator+(F16 a, F16 b) { return _mm512_add_ps(a.v, b.v); }
+inline F16 operator-(F16 a, F16 b) { return _mm512_sub_ps(a.v, b.v); }
+inline F16 operator*(F16 a, F16 b) { return _mm512_mul_ps(a.v, b.v); }
+inline F16 operator/(F16 a, F16 b) { return _mm512_div_ps(a.v, b.v); }
+inline F16 vsqrt(F16 a) { return _mm512_sqrt_ps(a.v); }
+inline F16 vrsqrt(F16 a) { return _mm512_rsqrt14_ps(a.v); }  // relative error <= 2^-14
+inline F16 vmin(F16 a, F16 b) { return _mm512_min_ps(a.v, b.v); }  // a < b ? a : b, as SSE2
+inline F16 vmax(F16 a, F16 b) { return _mm512_max_ps(a.v, b.v); }  // a > b ? a : b, as SSE2
+inline F16 gt(F16 a, F16 b) { return maskVector(_mm512_cmp_ps_mask(a.v, b.v, _CMP_GT_OQ)); }
+inline F16 ge(F16 a, F16 b) { return maskVector(_mm512_cmp_ps_mask(a.v, b.v, _CMP_GE_OQ)); }
+inline F16 lt(F16 a, F16 b) { return maskVector(_mm512_cmp_ps_mask(a.v, b.v, _CMP_LT_OQ)); }
+inline F16 le(F16 a, F16 b) { return maskVector(_mm512_cmp_ps_mask(a.v, b.v, _CMP_LE_OQ)); }
+inline F16 eq(F16 a, F16 b) { return maskVector(_mm512_cmp_ps_mask(a.v, b.v, _CMP_EQ_OQ)); }
+inline F16 nlt(F16 a, F16 b) { return maskVector(_mm512_cmp_ps_mask(a.v, b.v, _CMP_NLT_UQ)); }  // !(a < b): true for NaN
+inline F16 ngt(F16 a, F16 b) { return maskVector(_mm512_cmp_ps_mask(a.v, b.v, _CMP_NGT_UQ)); }  // !(a > b): true for NaN
+inline F16 band(F16 a, F16 b) { return _mm512_and_ps(a.v, b.v); }
+inline F16 bor(F16 a, F16 b) { return _mm512_or_ps(a.v, b.v); }
+inline F16 bandnot(F16 a, F16 b) { return _mm512_andnot_ps(a.v, b.v); }  // ~a & b
+inline F16 bnot(F16 a) {
+  const __m512i x = _mm512_castps_si512(a.v);
+  return _mm512_castsi512_ps(_mm512_ternarylogic_epi32(x, x, x, 0x55));  // ~a
+}
+// m ? a : b bit by bit (masks are all-ones or zero per lane).
+inline F16 sel(F16 m, F16 a, F16 b) {
+  return _mm512_castsi512_ps(
+      _mm512_ternarylogic_epi32(_mm512_castps_si512(m.v), _mm512_castps_si512(a.v), _mm512_castps_si512(b.v), 0xCA));
+}
+inline F16 vabs(F16 a) { return _mm512_abs_ps(a.v); }
+inline F16 vneg(F16 a) { return _mm512_xor_ps(a.v, _mm512_set1_ps(-0.0f)); }
+inline F16 floorPos(F16 a) { return _mm512_cvtepi32_ps(_mm512_cvttps_epi32(a.v)); }  // 0 <= a < 2^31
+inline F16 F16::load(const float* p) { return _mm512_loadu_ps(p); }
+inline F16 F16::loadInt(const int32_t* p) { return _mm512_cvtepi32_ps(_mm512_loadu_si512(p)); }
+inline void store(float* p, F16 a) { _mm512_storeu_ps(p, a.v); }
+inline void storeInt(int32_t* p, F16 a) { _mm512_storeu_si512(p, _mm512_cvttps_epi32(a.v)); }
+inline unsigned movemask(F16 a) { return unsigned(laneMask(a)); }
+
+// Stores the lanes of `a` selected by `mask`, in order, at dst[0 ..] (writes 16 floats).
+inline void compress(float* dst, F16 a, unsigned mask) {
+  _mm512_storeu_ps(dst, _mm512_maskz_compress_ps(__mmask16(mask), a.v));
+}
+// Stores first + l for the lanes l selected by `mask`, in order, at dst[0 ..] (writes 16 words).
+inline void F16::compressIndex(uint32_t* dst, uint32_t first, unsigned mask) {
+  const __m512i lanes =
+      _mm512_add_epi32(_mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15), _mm512_set1_epi32(int32_t(first)));
+  _mm512_storeu_si512(dst, _mm512_maskz_compress_epi32(__mmask16(mask), lanes));
+}
+
+// Positions unit4[4 k .. 4 k + 2] of the lanes' samples k (integer-valued floats).
+inline void gatherUnit(const float* unit4, F16 k, F16* x, F16* y, F16* z) {
+  const __m512i idx = _mm512_slli_epi32(_mm512_cvttps_epi32(k.v), 2);
+  *x = _mm512_i32gather_ps(idx, unit4, 4);
+  *y = _mm512_i32gather_ps(idx, unit4 + 1, 4);
+  *z = _mm512_i32gather_ps(idx, unit4 + 2, 4);
+}
+
+// The union of the bytes table[idx] over the lanes in `use` (idx: integer-valued floats; reads
+// 4 bytes at table + idx).
+inline unsigned maskUnion(const uint8_t* table, F16 idx, F16 use) {
+  const __mmask16 k = laneMask(use);
+  const __m512i words = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), k, _mm512_cvttps_epi32(idx.v), table, 1);
+  return unsigned(_mm512_mask_reduce_or_epi32(k, words)) & 0xFFu;
+}
+
+// k * mapBytes + t for the lanes' samples k and texel bytes t (integer-valued floats), into dst.
+inline void storeTexelIndex(int32_t* dst, F16 k, F16 t, int32_t mapBytes) {
+  const __m512i at = _mm512_add_epi32(_mm512_mullo_epi32(_mm512_cvttps_epi32(k.v), _mm512_set1_epi32(mapBytes)),
+                                      _mm512_cvttps_epi32(t.v));
+  _mm512_storeu_si512(dst, at);
+}
+// The bytes base[at[l]] as floats. Reads 4 bytes per lane, ending at the byte (or, for the first 3
+// bytes, starting at base): never outside [base, base + 4) and the bytes up to the one read.
+inline F16 F16::gatherBytes(const uint8_t* base, const int32_t* at) {
+  const __m512i idx = _mm512_loadu_si512(at);
+  const __m512i back = _mm512_min_epi32(idx, _mm512_set1_epi32(3));  // bytes read before the wanted one
+  const __m512i words = _mm512_i32gather_epi32(_mm512_sub_epi32(idx, back), base, 1);
+  const __m512i bytes = _mm512_and_si512(_mm512_srlv_epi32(words, _mm512_slli_epi32(back, 3)), _mm512_set1_epi32(0xFF));
+  return _mm512_cvtepi32_ps(bytes);
+}
+// Bit ray[l] for every lane l set in `bits` (ray[l] < 64).
+inline uint64_t F16::rayBits(const uint32_t* ray, unsigned bits) {
+  const __m512i one = _mm512_set1_epi64(1);
+  const __m512i lo = _mm512_sllv_epi64(one, _mm512_cvtepu32_epi64(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(ray))));
+  const __m512i hi = _mm512_sllv_epi64(one, _mm512_cvtepu32_epi64(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(ray + 8))));
+  return uint64_t(_mm512_mask_reduce_or_epi64(__mmask8(bits & 0xFFu), lo)) |
+         uint64_t(_mm512_mask_reduce_or_epi64(__mmask8(bits >> 8), hi));
+}
+
+// Eight rays of eight floats each (origin, direction, tmin, tmax), transposed into eight-lane vectors.
+inline void transpose8(const float* p, __m256 out[8]) {
+  __m256 r[8];
+  for (int i = 0; i < 8; ++i) r[i] = _mm256_loadu_ps(p + 8 * i);
+  const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
+  const __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
+  const __m256 t4 = _mm256_unpacklo_ps(r[4], r[5]), t5 = _mm256_unpackhi_ps(r[4], r[5]);
+  const __m256 t6 = _mm256_unpacklo_ps(r[6], r[7]), t7 = _mm256_unpackhi_ps(r[6], r[7]);
+  const __m256 u0 = _mm256_shuffle_ps(t0, t2, 0x44), u1 = _mm256_shuffle_ps(t0, t2, 0xEE);
+  const __m256 u2 = _mm256_shuffle_ps(t1, t3, 0x44), u3 = _mm256_shuffle_ps(t1, t3, 0xEE);
+  const __m256 u4 = _mm256_shuffle_ps(t4, t6, 0x44), u5 = _mm256_shuffle_ps(t4, t6, 0xEE);
+  const __m256 u6 = _mm256_shuffle_ps(t5, t7, 0x44), u7 = _mm256_shuffle_ps(t5, t7, 0xEE);
+  out[0] = _mm256_permute2f128_ps(u0, u4, 0x20);
+  out[1] = _mm256_permute2f128_ps(u1, u5, 0x20);
+  out[2] = _mm256_permute2f128_ps(u2, u6, 0x20);
+  out[3] = _mm256_permute2f128_ps(u3, u7, 0x20);
+  out[4] = _mm256_permute2f128_ps(u0, u4, 0x31);
+  out[5] = _mm256_permute2f128_ps(u1, u5, 0x31);
+  out[6] = _mm256_permute2f128_ps(u2, u6, 0x31);
+  out[7] = _mm256_permute2f128_ps(u3, u7, 0x31);
+}
+// Sixteen rays, transposed.
+inline void loadRays(const float* p, F16* ox, F16* oy, F16* oz, F16* dx, F16* dy, F16* dz, F16* tmin, F16* tmax) {
+  __m256 lo[8], hi[8];
+  transpose8(p, lo);
+  transpose8(p + 64, hi);
+  F16* out[8] = {ox, oy, oz, dx, dy, dz, tmin, tmax};
+  for (int i = 0; i < 8; ++i) *out[i] = _mm512_insertf32x8(_mm512_castps256_ps512(lo[i]), hi[i], 1);
+}
+
+}  // namespace
+}  // namespace vff::detail
+
+#include "query_group_kernel.h"
+
+namespace vff::detail {
+
+void prepareGroupAvx512(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept {
+  prepareGroupWith<Pair<F16>>(tables, rays, n, g);  // 32 lanes (query_group_kernel.h)
+}
+
+void decodeGroupAvx512(const GroupTables& tables, Group* g) noexcept { decodeGroupWith<Pair<F16>>(tables, g); }
+
+}  // namespace vff::detail
+
+#endif
