@@ -161,34 +161,49 @@ struct FieldQuery::Impl {
   template <class Emit>
   void batchInterpolated(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept;
   // Runs the group kernel over rays, kGroupRays at a time: each(base, n, group), where bit r of
-  // group.reached says whether ray base + r reaches the sphere (the others miss). Each group is
-  // handed over (and decoded, with tables.decodeHits) after the next one is prepared, so that its
-  // texels have the next group's time to arrive from memory.
+  // group.reached says whether ray base + r reaches the sphere (the others miss). The rays that
+  // reach it wait in a LookupQueue until a full vector of them can be looked up, so groups are
+  // looked up together. A group is handed over (and decoded, with tables.decodeHits) in order,
+  // once it was looked up before the current group's sphere step and lookups, so that its texels
+  // have had that time to arrive from memory.
   template <class Each>
   void forEachGroup(std::span<const Ray> rays, const detail::GroupTables& tables, Each&& each) const noexcept {
-    detail::Group g[2];
-    size_t which = 0;                     // the group prepared next
-    size_t pending = 0, pendingBase = 0;  // pending: the ray count of the group not yet handed over
-    for (size_t base = 0; base < rays.size(); base += detail::kGroupRays, which ^= 1) {
-      const size_t n = std::min(detail::kGroupRays, rays.size() - base);
+    constexpr size_t kRing = 4;  // groups in flight (<= LookupQueue::kMaxSegments)
+    detail::Group g[kRing];
+    size_t base[kRing] = {}, count[kRing] = {};
+    detail::LookupQueue q;
+    size_t next = 0, made = 0;  // groups handed over, groups prepared
+    auto handOver = [&] {
+      detail::Group& h = g[next % kRing];
+      detail::decodeGroup(tables, &h);
+      each(base[next % kRing], count[next % kRing], h);
+      ++next;
+    };
+    for (size_t b = 0; b < rays.size(); b += detail::kGroupRays) {
+      const size_t n = std::min(detail::kGroupRays, rays.size() - b);
       // Request the rays two groups ahead (2 KiB): the kernel waited for them even with the CPU's
       // own prefetching (vff-experiments bench: 1.06x).
-      if (base + 3 * detail::kGroupRays <= rays.size()) {
-        const char* ahead = reinterpret_cast<const char*>(rays.data() + base + 2 * detail::kGroupRays);
-        for (size_t b = 0; b < detail::kGroupRays * sizeof(Ray); b += 64) __builtin_prefetch(ahead + b);
+      if (b + 3 * detail::kGroupRays <= rays.size()) {
+        const char* ahead = reinterpret_cast<const char*>(rays.data() + b + 2 * detail::kGroupRays);
+        for (size_t o = 0; o < detail::kGroupRays * sizeof(Ray); o += 64) __builtin_prefetch(ahead + o);
       }
-      detail::prepareGroup(tables, rays.data() + base, n, &g[which]);
-      if (pending) {
-        detail::decodeGroup(tables, &g[which ^ 1]);
-        each(pendingBase, pending, g[which ^ 1]);
+      if (made - next == kRing) {  // no free slot: finish the oldest group now
+        detail::lookupQueue(tables, &q, true);
+        handOver();
       }
-      pending = n;
-      pendingBase = base;
+      const size_t slot = made % kRing;
+      detail::sphereGroup(tables, rays.data() + b, n, &g[slot], &q);
+      base[slot] = b;
+      count[slot] = n;
+      ++made;
+      // The groups looked up before this step (in order), handed over after its lookups.
+      size_t ready = next;
+      while (ready < made - 1 && g[ready % kRing].looked == g[ready % kRing].count) ++ready;
+      detail::lookupQueue(tables, &q, false);
+      while (next < ready) handOver();
     }
-    if (pending) {
-      detail::decodeGroup(tables, &g[which ^ 1]);
-      each(pendingBase, pending, g[which ^ 1]);
-    }
+    detail::lookupQueue(tables, &q, true);
+    while (next < made) handOver();
   }
   QueryHit query(const Ray& ray, const QueryOptions& o, float* visibility) const noexcept;
   // Whether the nearest lookup at texel (i, j) of map k hits within [lo, hi] (hitAt(...).hit).

@@ -15,14 +15,17 @@ KernelChoice kernelOverride() noexcept { return KernelChoice(gOverride.load(std:
 
 #if defined(__x86_64__) || defined(_M_X64)
 
-void prepareGroupSse2(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept;
+void sphereGroupSse2(const GroupTables& tables, const Ray* rays, size_t n, Group* g, LookupQueue* q) noexcept;
+void lookupQueueSse2(const GroupTables& tables, LookupQueue* q, bool flush) noexcept;
 void decodeGroupSse2(const GroupTables& tables, Group* g) noexcept;
 #if defined(VFF_HAVE_AVX2_KERNEL)
-void prepareGroupAvx2(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept;
+void sphereGroupAvx2(const GroupTables& tables, const Ray* rays, size_t n, Group* g, LookupQueue* q) noexcept;
+void lookupQueueAvx2(const GroupTables& tables, LookupQueue* q, bool flush) noexcept;
 void decodeGroupAvx2(const GroupTables& tables, Group* g) noexcept;
 #endif
 #if defined(VFF_HAVE_AVX512_KERNEL)
-void prepareGroupAvx512(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept;
+void sphereGroupAvx512(const GroupTables& tables, const Ray* rays, size_t n, Group* g, LookupQueue* q) noexcept;
+void lookupQueueAvx512(const GroupTables& tables, LookupQueue* q, bool flush) noexcept;
 void decodeGroupAvx512(const GroupTables& tables, Group* g) noexcept;
 #endif
 
@@ -30,16 +33,17 @@ namespace {
 
 struct Kernel {
   const char* name;
-  void (*prepare)(const GroupTables&, const Ray*, size_t, Group*) noexcept;
+  void (*sphere)(const GroupTables&, const Ray*, size_t, Group*, LookupQueue*) noexcept;
+  void (*lookup)(const GroupTables&, LookupQueue*, bool) noexcept;
   void (*decode)(const GroupTables&, Group*) noexcept;
 };
 
-constexpr Kernel kSse2{"sse2", prepareGroupSse2, decodeGroupSse2};
+constexpr Kernel kSse2{"sse2", sphereGroupSse2, lookupQueueSse2, decodeGroupSse2};
 #if defined(VFF_HAVE_AVX2_KERNEL)
-constexpr Kernel kAvx2{"avx2", prepareGroupAvx2, decodeGroupAvx2};
+constexpr Kernel kAvx2{"avx2", sphereGroupAvx2, lookupQueueAvx2, decodeGroupAvx2};
 #endif
 #if defined(VFF_HAVE_AVX512_KERNEL)
-constexpr Kernel kAvx512{"avx512", prepareGroupAvx512, decodeGroupAvx512};
+constexpr Kernel kAvx512{"avx512", sphereGroupAvx512, lookupQueueAvx512, decodeGroupAvx512};
 #endif
 
 // The kernels this CPU runs (decided once): null where it has not the instructions (or this
@@ -94,9 +98,11 @@ bool groupKernelRuns(KernelChoice choice) noexcept {
 
 const char* groupKernelName() noexcept { return groupKernelAvailable() ? activeKernel().name : "scalar"; }
 
-void prepareGroup(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept {
-  activeKernel().prepare(tables, rays, n, g);
+void sphereGroup(const GroupTables& tables, const Ray* rays, size_t n, Group* g, LookupQueue* q) noexcept {
+  activeKernel().sphere(tables, rays, n, g, q);
 }
+
+void lookupQueue(const GroupTables& tables, LookupQueue* q, bool flush) noexcept { activeKernel().lookup(tables, q, flush); }
 
 void decodeGroup(const GroupTables& tables, Group* g) noexcept { activeKernel().decode(tables, g); }
 
@@ -105,7 +111,8 @@ void decodeGroup(const GroupTables& tables, Group* g) noexcept { activeKernel().
 bool groupKernelAvailable() noexcept { return false; }
 bool groupKernelRuns(KernelChoice choice) noexcept { return choice == KernelChoice::kNone; }
 const char* groupKernelName() noexcept { return "scalar"; }
-void prepareGroup(const GroupTables&, const Ray*, size_t, Group*) noexcept {}
+void sphereGroup(const GroupTables&, const Ray*, size_t, Group*, LookupQueue*) noexcept {}
+void lookupQueue(const GroupTables&, LookupQueue*, bool) noexcept {}
 void decodeGroup(const GroupTables&, Group*) noexcept {}
 
 #endif

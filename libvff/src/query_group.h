@@ -81,8 +81,31 @@ struct Group {
   // decodeGroup's answer, bit r: ray r hits within its range (hitsAt). Left unset for the rays
   // in `redo`, which the caller answers.
   uint64_t hits = 0;
+  uint32_t looked = 0;  // packed rays whose texels are known (k, i, j, t, redo): all when == count
 };
 static_assert(kGroupRays <= 64, "the masks hold one bit per ray");
+
+// The rays of consecutive groups that reach the sphere and wait for their nearest sample and
+// texel, so that the kernel looks them up in full vectors whatever each group's count (AO rays:
+// about a third of a group reaches the sphere). Entries are in group order; segment s says which
+// packed rays of which group its entries are.
+struct LookupQueue {
+  // At most a vector's worth (32) left from earlier groups plus one group, and the vectors the
+  // kernels store past the end.
+  static constexpr size_t kCapacity = kGroupRays + 2 * Group::kSlack;
+  static constexpr size_t kMaxSegments = 8;
+  float eux[kCapacity], euy[kCapacity], euz[kCapacity];  // the entry point on the unit sphere
+  float vx[kCapacity], vy[kCapacity], vz[kCapacity];     // the lookup direction
+  uint32_t k[kCapacity], i[kCapacity], j[kCapacity];     // the answers, copied into the groups
+  int32_t t[kCapacity];
+  uint64_t redo[kCapacity / 64];
+  uint32_t size = 0;
+  struct Segment {
+    Group* group;
+    uint32_t first, p0, n;  // entries first .. first + n - 1 are packed rays p0 .. p0 + n - 1 of group
+  } segment[kMaxSegments];
+  uint32_t segments = 0;
+};
 
 namespace {  // (a copy per file: the AVX2 kernel's file must share no inline function with the rest)
 
@@ -118,11 +141,17 @@ KernelChoice kernelOverride() noexcept;
 // Whether this build and CPU run that kernel (kAuto, kSse2 and kNone: on x86-64, always).
 bool groupKernelRuns(KernelChoice choice) noexcept;
 
-// Fills g for rays[0, n), n <= kGroupRays, and requests the texels from memory.
-void prepareGroup(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept;
-// With tables.decodeHits, reads the texels of a prepared group and fills g->hits (else sets it to
-// 0). Best called some time after prepareGroup (FieldQuery prepares the next group first), so
-// that the texels have arrived.
+// Fills g for rays[0, n), n <= kGroupRays: the sphere, and the packed rays that reach it, whose
+// lookups it appends to q (at most LookupQueue::kMaxSegments groups may wait there at once). A
+// group is looked up when g->looked == g->count (at once where the scheme is not octa-hemi2:
+// then every packed ray is in g->redo).
+void sphereGroup(const GroupTables& tables, const Ray* rays, size_t n, Group* g, LookupQueue* q) noexcept;
+// Looks up q's entries in full vectors (with flush: all of them), copies the answers into their
+// groups and requests the texels from memory.
+void lookupQueue(const GroupTables& tables, LookupQueue* q, bool flush) noexcept;
+// With tables.decodeHits, reads the texels of a looked-up group and fills g->hits (else sets it
+// to 0). Best called some time after its lookup (FieldQuery hands a group over only after the
+// lookups of the next group), so that the texels have arrived.
 void decodeGroup(const GroupTables& tables, Group* g) noexcept;
 
 }  // namespace vff::detail

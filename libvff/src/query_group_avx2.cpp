@@ -166,8 +166,12 @@ inline void loadRays(const float* p, F8* ox, F8* oy, F8* oz, F8* dx, F8* dy, F8*
 
 namespace vff::detail {
 
-void prepareGroupAvx2(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept {
-  prepareGroupWith<Pair<Pair<F8>>>(tables, rays, n, g);  // 32 lanes (query_group_kernel.h)
+void sphereGroupAvx2(const GroupTables& tables, const Ray* rays, size_t n, Group* g, LookupQueue* q) noexcept {
+  sphereGroupWith<Pair<Pair<F8>>>(tables, rays, n, g, q);  // 32 lanes (query_group_kernel.h)
+}
+
+void lookupQueueAvx2(const GroupTables& tables, LookupQueue* q, bool flush) noexcept {
+  lookupQueueWith<Pair<Pair<F8>>>(tables, q, flush);
 }
 
 void decodeGroupAvx2(const GroupTables& tables, Group* g) noexcept { decodeGroupWith<Pair<Pair<F8>>>(tables, g); }

@@ -160,8 +160,12 @@ inline void loadRays(const float* p, F16* ox, F16* oy, F16* oz, F16* dx, F16* dy
 
 namespace vff::detail {
 
-void prepareGroupAvx512(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept {
-  prepareGroupWith<Pair<F16>>(tables, rays, n, g);  // 32 lanes (query_group_kernel.h)
+void sphereGroupAvx512(const GroupTables& tables, const Ray* rays, size_t n, Group* g, LookupQueue* q) noexcept {
+  sphereGroupWith<Pair<F16>>(tables, rays, n, g, q);  // 32 lanes (query_group_kernel.h)
+}
+
+void lookupQueueAvx512(const GroupTables& tables, LookupQueue* q, bool flush) noexcept {
+  lookupQueueWith<Pair<F16>>(tables, q, flush);
 }
 
 void decodeGroupAvx512(const GroupTables& tables, Group* g) noexcept { decodeGroupWith<Pair<F16>>(tables, g); }

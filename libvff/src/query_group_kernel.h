@@ -148,17 +148,10 @@ inline F atanUnitV(F t) {
   return sel(lt(t, F(0.0f)), vneg(r), r);
 }
 
-// The rays of a group that reach the sphere, packed as in Group: their entry points and lookup
-// directions.
-struct Packed {
-  static constexpr size_t kSize = kGroupRays + Group::kSlack;
-  float eux[kSize], euy[kSize], euz[kSize], vx[kSize], vy[kSize], vz[kSize];
-};
-
 // Step 1 for F::kLanes rays starting at rays[0] (all readable), lanes r0 .. of g: the sphere;
-// appends the rays that reach it to `packed`.
+// appends the rays that reach it to g's packed rays and their lookups to q.
 template <class F>
-void sphereStep(const GroupTables& tb, const Ray* rays, Group* g, size_t r0, Packed* packed) {
+void sphereStep(const GroupTables& tb, const Ray* rays, Group* g, size_t r0, LookupQueue* q) {
   F ox, oy, oz, dx, dy, dz, tmin, tmax;
   loadRays(reinterpret_cast<const float*>(rays), &ox, &oy, &oz, &dx, &dy, &dz, &tmin, &tmax);
   const F zero(0.0f), one(1.0f);
@@ -198,13 +191,15 @@ void sphereStep(const GroupTables& tb, const Ray* rays, Group* g, size_t r0, Pac
   const unsigned bits = movemask(live);
   if (bits == 0) return;
   g->reached |= uint64_t(bits) << r0;
+  const size_t e = q->size;
+  compress(q->eux + e, eux, bits);
+  compress(q->euy + e, euy, bits);
+  compress(q->euz + e, euz, bits);
+  compress(q->vx + e, vx, bits);
+  compress(q->vy + e, vy, bits);
+  compress(q->vz + e, vz, bits);
+  q->size += uint32_t(__builtin_popcount(bits));
   const size_t at = g->count;
-  compress(packed->eux + at, eux, bits);
-  compress(packed->euy + at, euy, bits);
-  compress(packed->euz + at, euz, bits);
-  compress(packed->vx + at, vx, bits);
-  compress(packed->vy + at, vy, bits);
-  compress(packed->vz + at, vz, bits);
   if (tb.decodeHits) {
     compress(g->pt0 + at, t0, bits);
     compress(g->plo + at, lo, bits);
@@ -215,14 +210,14 @@ void sphereStep(const GroupTables& tb, const Ray* rays, Group* g, size_t r0, Pac
   g->count += uint32_t(__builtin_popcount(bits));
 }
 
-// Steps 2 and 3 for packed rays p .. p + kLanes - 1 (all valid; the caller pads the last ones):
-// the nearest sample (octaNearestFast) and the texel (texelFast), into g's k, i, j and redo.
+// Steps 2 and 3 for queue entries p .. p + kLanes - 1 (all valid; the caller pads the last ones):
+// the nearest sample (octaNearestFast) and the texel (texelFast), into q's k, i, j, t and redo.
 template <class F>
-void lookupStep(const GroupTables& tb, const Packed& pk, size_t p, Group* g) {
+void lookupStep(const GroupTables& tb, size_t p, LookupQueue* g) {
   constexpr size_t L = F::kLanes;
   const F zero(0.0f), one(1.0f);
-  const F eux = F::load(pk.eux + p), euy = F::load(pk.euy + p), euz = F::load(pk.euz + p);
-  const F vx = F::load(pk.vx + p), vy = F::load(pk.vy + p), vz = F::load(pk.vz + p);
+  const F eux = F::load(g->eux + p), euy = F::load(g->euy + p), euz = F::load(g->euz + p);
+  const F vx = F::load(g->vx + p), vy = F::load(g->vy + p), vz = F::load(g->vz + p);
 
   // 2. The nearest sample.
   const float fnS = float(tb.octaN);
@@ -320,7 +315,7 @@ void lookupStep(const GroupTables& tb, const Packed& pk, size_t p, Group* g) {
   storeInt(reinterpret_cast<int32_t*>(g->k + p), band(ok, bestK));
   storeInt(reinterpret_cast<int32_t*>(g->i + p), ti);
   storeInt(reinterpret_cast<int32_t*>(g->j + p), tj);
-  g->redo |= uint64_t(movemask(redo)) << p;
+  g->redo[p / 64] |= uint64_t(movemask(redo)) << (p % 64);
   // Ask for the texels now: they arrive while the rest of this group and the next one are prepared
   // (FieldQuery decodes a group one group late).
   if (tb.texels) {
@@ -374,41 +369,97 @@ void decodeGroupWith(const GroupTables& tb, Group* g) {
   for (size_t p = 0; p < count; p += L) decodeStep<F>(tb, p, unsigned((keep >> p) & laneBits), g);
 }
 
-// prepareGroup (query_group.h) with lanes F.
+// sphereGroup (query_group.h) with lanes F.
 template <class F>
-void prepareGroupWith(const GroupTables& tb, const Ray* rays, size_t n, Group* g) {
+void sphereGroupWith(const GroupTables& tb, const Ray* rays, size_t n, Group* g, LookupQueue* q) {
   constexpr size_t L = F::kLanes;
-  Packed packed;
   g->inside = 0;
   g->reached = 0;
   g->count = 0;
   g->redo = 0;
+  g->looked = 0;
+  const uint32_t first = q->size;
   size_t r = 0;
-  for (; r + L <= n; r += L) sphereStep<F>(tb, rays + r, g, r, &packed);
+  for (; r + L <= n; r += L) sphereStep<F>(tb, rays + r, g, r, q);
   if (r < n) {
     // Zero directions are not live. (Floats, not Rays: no Ray constructor is compiled here.)
-    alignas(32) float tail[L * 8] = {};
+    alignas(64) float tail[L * 8] = {};
     std::memcpy(tail, rays + r, (n - r) * sizeof(Ray));
-    sphereStep<F>(tb, reinterpret_cast<const Ray*>(tail), g, r, &packed);
+    sphereStep<F>(tb, reinterpret_cast<const Ray*>(tail), g, r, q);
   }
-  const size_t count = g->count;
-  if (count == 0) return;
-  const uint64_t all = packedBits(count);
+  if (g->count == 0) return;
   if (tb.octaN == 0) {  // another scheme: the reference does the rest
-    g->redo = all;
+    q->size = first;
+    g->redo = packedBits(g->count);
+    g->looked = g->count;
     return;
   }
-  // Pad the last lanes with copies of the last ray (their answers are past `count`).
-  for (size_t p = count; p % L != 0; ++p) {
-    packed.eux[p] = packed.eux[count - 1];
-    packed.euy[p] = packed.euy[count - 1];
-    packed.euz[p] = packed.euz[count - 1];
-    packed.vx[p] = packed.vx[count - 1];
-    packed.vy[p] = packed.vy[count - 1];
-    packed.vz[p] = packed.vz[count - 1];
+  q->segment[q->segments++] = {g, first, 0, g->count};
+}
+
+// lookupQueue (query_group.h) with lanes F.
+template <class F>
+void lookupQueueWith(const GroupTables& tb, LookupQueue* q, bool flush) {
+  constexpr size_t L = F::kLanes;
+  const size_t size = q->size;
+  size_t done = size / L * L;
+  if (flush && done < size) {
+    // Pad the last lanes with copies of the last entry (their answers are left out).
+    for (size_t p = size; p % L != 0; ++p) {
+      q->eux[p] = q->eux[size - 1];
+      q->euy[p] = q->euy[size - 1];
+      q->euz[p] = q->euz[size - 1];
+      q->vx[p] = q->vx[size - 1];
+      q->vy[p] = q->vy[size - 1];
+      q->vz[p] = q->vz[size - 1];
+    }
+    done = size + (L - size % L);
   }
-  for (size_t p = 0; p < count; p += L) lookupStep<F>(tb, packed, p, g);
-  g->redo &= all;
+  if (done == 0) return;
+  for (uint64_t& w : q->redo) w = 0;
+  for (size_t p = 0; p < done; p += L) lookupStep<F>(tb, p, q);
+  done = done < size ? done : size;
+  // The answers of entries 0 .. done - 1 into their groups.
+  uint32_t s = 0;
+  for (; s < q->segments; ++s) {
+    LookupQueue::Segment& sg = q->segment[s];
+    if (sg.first >= done) break;
+    const uint32_t n = uint32_t(done - sg.first < sg.n ? done - sg.first : sg.n);
+    Group* g = sg.group;
+    std::memcpy(g->k + sg.p0, q->k + sg.first, n * sizeof(uint32_t));
+    std::memcpy(g->i + sg.p0, q->i + sg.first, n * sizeof(uint32_t));
+    std::memcpy(g->j + sg.p0, q->j + sg.first, n * sizeof(uint32_t));
+    std::memcpy(g->t + sg.p0, q->t + sg.first, n * sizeof(int32_t));
+    for (uint32_t e = 0; e < n; ++e) {
+      const uint32_t x = sg.first + e;
+      g->redo |= ((q->redo[x / 64] >> (x % 64)) & 1u) << (sg.p0 + e);
+    }
+    g->looked += n;
+    if (n < sg.n) {  // the rest waits: it moves to the front below
+      sg.p0 += n;
+      sg.n -= n;
+      sg.first = 0;
+      break;
+    }
+  }
+  // Keep the entries not looked up, and their segments, at the front.
+  const size_t left = size - done;
+  if (left) {
+    std::memmove(q->eux, q->eux + done, left * sizeof(float));
+    std::memmove(q->euy, q->euy + done, left * sizeof(float));
+    std::memmove(q->euz, q->euz + done, left * sizeof(float));
+    std::memmove(q->vx, q->vx + done, left * sizeof(float));
+    std::memmove(q->vy, q->vy + done, left * sizeof(float));
+    std::memmove(q->vz, q->vz + done, left * sizeof(float));
+  }
+  uint32_t kept = 0;
+  for (; s < q->segments; ++s) {
+    LookupQueue::Segment sg = q->segment[s];
+    if (sg.first >= done) sg.first -= uint32_t(done);
+    q->segment[kept++] = sg;
+  }
+  q->segments = kept;
+  q->size = uint32_t(left);
 }
 
 }  // namespace

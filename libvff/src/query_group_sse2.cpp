@@ -130,8 +130,12 @@ inline void loadRays(const float* p, F4* ox, F4* oy, F4* oz, F4* dx, F4* dy, F4*
 
 namespace vff::detail {
 
-void prepareGroupSse2(const GroupTables& tables, const Ray* rays, size_t n, Group* g) noexcept {
-  prepareGroupWith<Pair<F4>>(tables, rays, n, g);  // 8 lanes (query_group_kernel.h)
+void sphereGroupSse2(const GroupTables& tables, const Ray* rays, size_t n, Group* g, LookupQueue* q) noexcept {
+  sphereGroupWith<Pair<F4>>(tables, rays, n, g, q);  // 8 lanes (query_group_kernel.h)
+}
+
+void lookupQueueSse2(const GroupTables& tables, LookupQueue* q, bool flush) noexcept {
+  lookupQueueWith<Pair<F4>>(tables, q, flush);
 }
 
 void decodeGroupSse2(const GroupTables& tables, Group* g) noexcept { decodeGroupWith<Pair<F4>>(tables, g); }
