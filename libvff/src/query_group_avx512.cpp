@@ -123,34 +123,43 @@ inline uint64_t F16::rayBits(const uint32_t* ray, unsigned bits) {
          uint64_t(_mm512_mask_reduce_or_epi64(__mmask8(bits >> 8), hi));
 }
 
-// Eight rays of eight floats each (origin, direction, tmin, tmax), transposed into eight-lane vectors.
-inline void transpose8(const float* p, __m256 out[8]) {
-  __m256 r[8];
-  for (int i = 0; i < 8; ++i) r[i] = _mm256_loadu_ps(p + 8 * i);
-  const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
-  const __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
-  const __m256 t4 = _mm256_unpacklo_ps(r[4], r[5]), t5 = _mm256_unpackhi_ps(r[4], r[5]);
-  const __m256 t6 = _mm256_unpacklo_ps(r[6], r[7]), t7 = _mm256_unpackhi_ps(r[6], r[7]);
-  const __m256 u0 = _mm256_shuffle_ps(t0, t2, 0x44), u1 = _mm256_shuffle_ps(t0, t2, 0xEE);
-  const __m256 u2 = _mm256_shuffle_ps(t1, t3, 0x44), u3 = _mm256_shuffle_ps(t1, t3, 0xEE);
-  const __m256 u4 = _mm256_shuffle_ps(t4, t6, 0x44), u5 = _mm256_shuffle_ps(t4, t6, 0xEE);
-  const __m256 u6 = _mm256_shuffle_ps(t5, t7, 0x44), u7 = _mm256_shuffle_ps(t5, t7, 0xEE);
-  out[0] = _mm256_permute2f128_ps(u0, u4, 0x20);
-  out[1] = _mm256_permute2f128_ps(u1, u5, 0x20);
-  out[2] = _mm256_permute2f128_ps(u2, u6, 0x20);
-  out[3] = _mm256_permute2f128_ps(u3, u7, 0x20);
-  out[4] = _mm256_permute2f128_ps(u0, u4, 0x31);
-  out[5] = _mm256_permute2f128_ps(u1, u5, 0x31);
-  out[6] = _mm256_permute2f128_ps(u2, u6, 0x31);
-  out[7] = _mm256_permute2f128_ps(u3, u7, 0x31);
-}
-// Sixteen rays, transposed.
+// Sixteen rays of eight floats each (origin, direction, tmin, tmax), transposed: lane l of
+// component c is float c of ray l. Three rounds of eight two-vector permutations.
 inline void loadRays(const float* p, F16* ox, F16* oy, F16* oz, F16* dx, F16* dy, F16* dz, F16* tmin, F16* tmax) {
-  __m256 lo[8], hi[8];
-  transpose8(p, lo);
-  transpose8(p + 64, hi);
-  F16* out[8] = {ox, oy, oz, dx, dy, dz, tmin, tmax};
-  for (int i = 0; i < 8; ++i) *out[i] = _mm512_insertf32x8(_mm512_castps256_ps512(lo[i]), hi[i], 1);
+  // Index tables: entry e of a permutation of (a, b) takes float e' of a (e' < 16) or e' - 16 of b.
+  // Round 1, per pair of loads (rays 4 q .. 4 q + 3): components 0-3 (and 4-7) of the four rays,
+  // component-major: entry 4 c + j = component c (4 + c) of ray j.
+  alignas(64) static constexpr int32_t kLo[16] = {0, 8, 16, 24, 1, 9, 17, 25, 2, 10, 18, 26, 3, 11, 19, 27};
+  alignas(64) static constexpr int32_t kHi[16] = {4, 12, 20, 28, 5, 13, 21, 29, 6, 14, 22, 30, 7, 15, 23, 31};
+  // Round 2, two results of round 1 (rays 0-3 and 4-7 of eight): entry 8 c + j = component c
+  // (or 2 + c) of ray j.
+  alignas(64) static constexpr int32_t kFirst[16] = {0, 1, 2, 3, 16, 17, 18, 19, 4, 5, 6, 7, 20, 21, 22, 23};
+  alignas(64) static constexpr int32_t kSecond[16] = {8, 9, 10, 11, 24, 25, 26, 27, 12, 13, 14, 15, 28, 29, 30, 31};
+  // Round 3, two results of round 2 (rays 0-7 and 8-15): entry l = component 0 (or 1) of ray l.
+  alignas(64) static constexpr int32_t kC0[16] = {0, 1, 2, 3, 4, 5, 6, 7, 16, 17, 18, 19, 20, 21, 22, 23};
+  alignas(64) static constexpr int32_t kC1[16] = {8, 9, 10, 11, 12, 13, 14, 15, 24, 25, 26, 27, 28, 29, 30, 31};
+  const __m512i lo = _mm512_load_si512(kLo), hi = _mm512_load_si512(kHi);
+  const __m512i first = _mm512_load_si512(kFirst), second = _mm512_load_si512(kSecond);
+  const __m512i c0 = _mm512_load_si512(kC0), c1 = _mm512_load_si512(kC1);
+  __m512 r[8], a[4], b[4];
+  for (int i = 0; i < 8; ++i) r[i] = _mm512_loadu_ps(p + 16 * i);  // rays 2 i and 2 i + 1
+  for (int q = 0; q < 4; ++q) {
+    a[q] = _mm512_permutex2var_ps(r[2 * q], lo, r[2 * q + 1]);   // components 0-3 of rays 4 q ..
+    b[q] = _mm512_permutex2var_ps(r[2 * q], hi, r[2 * q + 1]);   // components 4-7
+  }
+  // Rays 0-7 and 8-15: components 0-1, 2-3, 4-5, 6-7.
+  const __m512 a01 = _mm512_permutex2var_ps(a[0], first, a[1]), a23 = _mm512_permutex2var_ps(a[0], second, a[1]);
+  const __m512 b01 = _mm512_permutex2var_ps(b[0], first, b[1]), b23 = _mm512_permutex2var_ps(b[0], second, b[1]);
+  const __m512 c01 = _mm512_permutex2var_ps(a[2], first, a[3]), c23 = _mm512_permutex2var_ps(a[2], second, a[3]);
+  const __m512 d01 = _mm512_permutex2var_ps(b[2], first, b[3]), d23 = _mm512_permutex2var_ps(b[2], second, b[3]);
+  *ox = _mm512_permutex2var_ps(a01, c0, c01);
+  *oy = _mm512_permutex2var_ps(a01, c1, c01);
+  *oz = _mm512_permutex2var_ps(a23, c0, c23);
+  *dx = _mm512_permutex2var_ps(a23, c1, c23);
+  *dy = _mm512_permutex2var_ps(b01, c0, d01);
+  *dz = _mm512_permutex2var_ps(b01, c1, d01);
+  *tmin = _mm512_permutex2var_ps(b23, c0, d23);
+  *tmax = _mm512_permutex2var_ps(b23, c1, d23);
 }
 
 }  // namespace

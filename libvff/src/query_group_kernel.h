@@ -443,14 +443,15 @@ void lookupQueueWith(const GroupTables& tb, LookupQueue* q, bool flush) {
     }
   }
   // Keep the entries not looked up, and their segments, at the front.
+  // (Fewer than L are left, but L are moved: a fixed-size copy compiles to a few vector moves.
+  // done + L <= kCapacity.)
   const size_t left = size - done;
   if (left) {
-    std::memmove(q->eux, q->eux + done, left * sizeof(float));
-    std::memmove(q->euy, q->euy + done, left * sizeof(float));
-    std::memmove(q->euz, q->euz + done, left * sizeof(float));
-    std::memmove(q->vx, q->vx + done, left * sizeof(float));
-    std::memmove(q->vy, q->vy + done, left * sizeof(float));
-    std::memmove(q->vz, q->vz + done, left * sizeof(float));
+    for (float* a : {q->eux, q->euy, q->euz, q->vx, q->vy, q->vz}) {
+      float moved[L];
+      std::memcpy(moved, a + done, sizeof moved);
+      std::memcpy(a, moved, sizeof moved);
+    }
   }
   uint32_t kept = 0;
   for (; s < q->segments; ++s) {
