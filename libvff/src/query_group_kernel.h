@@ -307,9 +307,11 @@ void lookupStep(const GroupTables& tb, size_t p, LookupQueue* g) {
   const F fm(fmS), half(0.5f);
   const F x = (a + one) * half * fm, y = (b + one) * half * fm;
   const F fx = floorPos(x), fy = floorPos(y);
-  const F tg(tb.texelGuard);
-  redo = bor(redo, bor(bor(lt(x - fx, tg), lt((fx + one) - x, tg)), bor(lt(y - fy, tg), lt((fy + one) - y, tg))));
-  const F top(fmS - 1.0f);
+  // The guard of texelFast: only the map's inner texel edges 1 .. m - 1 (0 <= x <= m).
+  const F tg(tb.texelGuard), top(fmS - 1.0f);
+  const F nearX = bor(band(lt(x - fx, tg), band(ge(fx, one), le(fx, top))), band(lt((fx + one) - x, tg), le(fx + one, top)));
+  const F nearY = bor(band(lt(y - fy, tg), band(ge(fy, one), le(fy, top))), band(lt((fy + one) - y, tg), le(fy + one, top)));
+  redo = bor(redo, bor(nearX, nearY));
   const F ok = bnot(redo);
   const F ti = band(ok, vmin(vmax(fx, zero), top)), tj = band(ok, vmin(vmax(fy, zero), top));
   storeInt(reinterpret_cast<int32_t*>(g->k + p), band(ok, bestK));
