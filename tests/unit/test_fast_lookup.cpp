@@ -362,6 +362,24 @@ std::vector<Ray> tieRays(const FieldDesc& f, const PositionSet& ps, const std::v
   return rays;
 }
 
+// `rays` spread out, every `every`-th of count rays, the others leaving the sphere behind them
+// (origin outside, pointing away): groups where a ray or two reach the sphere, whose lookups wait
+// in the batch's queue over many groups (and fill its ring of groups in flight).
+std::vector<Ray> sparseRays(const FieldDesc& f, const std::vector<Ray>& rays, size_t every, size_t count) {
+  const Vec3 c{f.sphere.center[0], f.sphere.center[1], f.sphere.center[2]};
+  const float r = f.sphere.radius;
+  std::vector<Ray> out;
+  for (size_t n = 0; n < count; ++n) {
+    if (n % every == 0) {
+      out.push_back(rays[(n / every) % rays.size()]);
+    } else {
+      const Vec3 d{std::cos(float(n)), std::sin(float(n)), 0.5f};
+      out.push_back({{c.x + 2 * r * d.x, c.y + 2 * r * d.y, c.z + 2 * r * d.z}, d});
+    }
+  }
+  return out;
+}
+
 // Restores the default kernel when a test ends, even a failed one.
 struct KernelScope {
   explicit KernelScope(detail::KernelChoice c) { detail::forceGroupKernel(c); }
@@ -421,6 +439,8 @@ void checkBatches(detail::KernelChoice) {
         const std::vector<Ray> ties = tieRays(f, *ps, unit, 9000, n + 7);
         rays.insert(rays.end(), ties.begin(), ties.end());
       }
+      const std::vector<Ray> sparse = sparseRays(f, rays, 37, 20000);
+      rays.insert(rays.end(), sparse.begin(), sparse.end());
       QueryOptions o;
       o.intraBias = 0.05f;
       const float biasR = o.intraBias * f.sphere.radius;
