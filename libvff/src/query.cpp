@@ -168,7 +168,8 @@ struct FieldQuery::Impl {
   // have had that time to arrive from memory.
   template <class Each>
   void forEachGroup(std::span<const Ray> rays, const detail::GroupTables& tables, Each&& each) const noexcept {
-    constexpr size_t kRing = 4;  // groups in flight (<= LookupQueue::kMaxSegments)
+    constexpr size_t kRing = 4;  // groups in flight
+    static_assert(kRing <= detail::LookupQueue::kMaxSegments, "each group in flight may wait in the queue");
     detail::Group g[kRing];
     size_t base[kRing] = {}, count[kRing] = {};
     detail::LookupQueue q;

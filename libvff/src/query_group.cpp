@@ -69,7 +69,7 @@ const Available& available() noexcept {
   return a;
 }
 
-// The kernel prepareGroup runs now: the override where this CPU runs it, else the widest.
+// The kernel that runs now: the override where this CPU runs it, else the widest.
 const Kernel& activeKernel() noexcept {
   const Available& a = available();
   switch (kernelOverride()) {

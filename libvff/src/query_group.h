@@ -1,13 +1,14 @@
 // query_group.h - the nearest lookup of many rays at once, 32 at a time in AVX-512 or AVX2
 // vectors or 8 in SSE2 vectors (internal).
 //
-// FieldQuery's batch functions hand rays to prepareGroup() in groups of kGroupRays. It computes,
-// for every ray, what FieldQuery::Impl::prepare computes one ray at a time: the sphere entry, the
-// nearest positional sample (octa-hemi2: the candidates of PositionSet::candidates, scored
-// without reading their positions, fast_lookup.h's kOctaScoreError) and the texel of the lookup
-// direction in that sample's map; for occlusion batches over one-byte maps, decodeGroup() then
-// reads the texels and decodes the hit flags. Where it computes what prepare() computes it performs the
-// same binary32 operations in the same order, and it leaves to the caller (bit `redo`) every ray
+// FieldQuery's batch functions hand rays to sphereGroup() in groups of kGroupRays, and the rays
+// that reach the sphere to lookupQueue() through a LookupQueue. Together they compute, for every
+// ray, what FieldQuery::Impl::prepare computes one ray at a time: the sphere entry, the nearest
+// positional sample (octa-hemi2: the candidates of PositionSet::candidates, scored without
+// reading their positions, fast_lookup.h's kOctaScoreError) and the texel of the lookup direction
+// in that sample's map; for occlusion batches over one-byte maps, decodeGroup() then reads the
+// texels and decodes the hit flags. Where the kernel computes what prepare() computes it performs
+// the same binary32 operations in the same order, and it leaves to the caller (bit `redo`) every ray
 // on which a guard of fast_lookup.h trips, whose two best candidates score too close to call, or
 // whose scheme it does not handle, so that a group gives exactly the texel and the answer
 // prepare() and hitsAt() give (tests/unit/test_fast_lookup.cpp checks this ray by ray, with every
@@ -125,9 +126,9 @@ inline size_t texelByte(DistanceEncoding e, uint32_t m, uint32_t i, uint32_t j) 
 
 }  // namespace
 
-// True where prepareGroup is implemented (x86-64). Elsewhere the caller uses prepare().
+// True where the group kernel is implemented (x86-64). Elsewhere the caller uses prepare().
 bool groupKernelAvailable() noexcept;
-// The kernel prepareGroup runs: "avx512" (32 lanes in two AVX-512 vectors, where the CPU has
+// The group kernel that runs: "avx512" (32 lanes in two AVX-512 vectors, where the CPU has
 // AVX-512 F, DQ, VL and BW), "avx2" (32 lanes in four vectors, where it has AVX2), "sse2" (8) or
 // "scalar" (none: prepare() per ray).
 const char* groupKernelName() noexcept;

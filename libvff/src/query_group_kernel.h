@@ -18,8 +18,9 @@
 // same order (a ? b : c becomes sel(mask, b, c); no operation is fused or reordered), so that a
 // lane computes bit for bit what prepare() computes for that ray. The one quantity of its own, a
 // candidate's score, uses the CPU's approximate reciprocal square root, which differs between
-// CPU makers and between rsqrtps and AVX-512's rsqrt14ps: it only decides which sample wins when the lead is beyond its error bound, so the
-// answers are the same everywhere, and only which rays are redone can differ.
+// CPU makers and between rsqrtps and AVX-512's rsqrt14ps: it only decides which sample wins when
+// the lead is beyond its error bound, so the answers are the same everywhere, and only which rays
+// are redone can differ.
 #pragma once
 
 #include <cstddef>
@@ -213,11 +214,11 @@ void sphereStep(const GroupTables& tb, const Ray* rays, Group* g, size_t r0, Loo
 // Steps 2 and 3 for queue entries p .. p + kLanes - 1 (all valid; the caller pads the last ones):
 // the nearest sample (octaNearestFast) and the texel (texelFast), into q's k, i, j, t and redo.
 template <class F>
-void lookupStep(const GroupTables& tb, size_t p, LookupQueue* g) {
+void lookupStep(const GroupTables& tb, size_t p, LookupQueue* q) {
   constexpr size_t L = F::kLanes;
   const F zero(0.0f), one(1.0f);
-  const F eux = F::load(g->eux + p), euy = F::load(g->euy + p), euz = F::load(g->euz + p);
-  const F vx = F::load(g->vx + p), vy = F::load(g->vy + p), vz = F::load(g->vz + p);
+  const F eux = F::load(q->eux + p), euy = F::load(q->euy + p), euz = F::load(q->euz + p);
+  const F vx = F::load(q->vx + p), vy = F::load(q->vy + p), vz = F::load(q->vz + p);
 
   // 2. The nearest sample.
   const float fnS = float(tb.octaN);
@@ -314,21 +315,21 @@ void lookupStep(const GroupTables& tb, size_t p, LookupQueue* g) {
   redo = bor(redo, bor(nearX, nearY));
   const F ok = bnot(redo);
   const F ti = band(ok, vmin(vmax(fx, zero), top)), tj = band(ok, vmin(vmax(fy, zero), top));
-  storeInt(reinterpret_cast<int32_t*>(g->k + p), band(ok, bestK));
-  storeInt(reinterpret_cast<int32_t*>(g->i + p), ti);
-  storeInt(reinterpret_cast<int32_t*>(g->j + p), tj);
-  g->redo[p / 64] |= uint64_t(movemask(redo)) << (p % 64);
-  // Ask for the texels now: they arrive while the rest of this group and the next one are prepared
-  // (FieldQuery decodes a group one group late).
+  storeInt(reinterpret_cast<int32_t*>(q->k + p), band(ok, bestK));
+  storeInt(reinterpret_cast<int32_t*>(q->i + p), ti);
+  storeInt(reinterpret_cast<int32_t*>(q->j + p), tj);
+  q->redo[p / 64] |= uint64_t(movemask(redo)) << (p % 64);
+  // Ask for the texels now: they arrive while the next group goes through the sphere and the
+  // queue (FieldQuery decodes a group only after that).
   if (tb.texels) {
-    storeTexelIndex(g->t + p, band(ok, bestK), tj * fm + ti, tb.mapBytes);
-    for (size_t l = 0; l < L; ++l) __builtin_prefetch(tb.texels + g->t[p + l]);
+    storeTexelIndex(q->t + p, band(ok, bestK), tj * fm + ti, tb.mapBytes);
+    for (size_t l = 0; l < L; ++l) __builtin_prefetch(tb.texels + q->t[p + l]);
   } else if (tb.byteTexels) {
-    storeInt(g->t + p, tj * fm + ti);
-    for (size_t l = 0; l < L; ++l) __builtin_prefetch(tb.maps[g->k[p + l]] + g->t[p + l]);
+    storeInt(q->t + p, tj * fm + ti);
+    for (size_t l = 0; l < L; ++l) __builtin_prefetch(tb.maps[q->k[p + l]] + q->t[p + l]);
   } else if (tb.maps) {
     for (size_t l = 0; l < L; ++l)
-      __builtin_prefetch(tb.maps[g->k[p + l]] + texelByte(tb.encoding, tb.m, g->i[p + l], g->j[p + l]));
+      __builtin_prefetch(tb.maps[q->k[p + l]] + texelByte(tb.encoding, tb.m, q->i[p + l], q->j[p + l]));
   }
 }
 

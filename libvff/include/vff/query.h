@@ -91,7 +91,8 @@ struct QueryOptions {
 // contacts.)
 float defaultIntraBias(const FieldDesc& field) noexcept;
 
-// The kernel the batch functions use for kNearest on this CPU: "avx2", "sse2" or "scalar".
+// The kernel the batch functions use for kNearest on this CPU: "avx512", "avx2", "sse2" or
+// "scalar".
 const char* batchKernelName() noexcept;
 
 // The neighbour lists kInterpolated blends over: for every positional sample, up to
