@@ -8,7 +8,8 @@
 // Measured in one run on the same threads (rays handed out in chunks of 4096), best of --repeat
 // (the five take turns in every repetition):
 //   (a) Embree rtcOccluded1 against the mesh (world space)
-//   (b) FieldQuery::occluded, batch, kNearest (object space: the same rays, transformed beforehand)
+//   (b) FieldQuery::occluded, batch, kNearest (object space: the same rays, transformed beforehand;
+//       --batch rays per call, 4096 by default)
 //   (c) FieldQuery::occluded, one ray per call, kNearest
 //   (d) FieldQuery::visibility, batch, kInterpolated
 //   (m) no query: one read of a random byte of the field's maps per ray, 64 requested at a time
@@ -61,6 +62,12 @@ RaySet makeAimedRays(const World& w, uint32_t count) {
   return s;
 }
 
+// fn(x, y) for [b, e) cut into runs of at most `batch`.
+template <class Fn>
+void inBatches(uint64_t b, uint64_t e, uint64_t batch, Fn&& fn) {
+  for (uint64_t x = b; x < e; x += batch) fn(x, std::min(e, x + batch));
+}
+
 double seconds(const std::function<void()>& fn) {
   const auto t0 = std::chrono::steady_clock::now();
   fn();
@@ -87,9 +94,9 @@ int runBench(const Options& o) {
   const vff::FieldQuery& q = (*field)->query;
 
   std::printf("Query benchmark: %s (%zu triangles), field %s (%.2f MiB payload, baked in %.2f s), "
-              "%u rays per set, %u threads, best of %d, batch kernel %s\n\n",
+              "%u rays per set, %u threads, best of %d, batch kernel %s, %u rays per batch call\n\n",
               o.mesh.c_str(), world->worldMesh.triangleCount(), config.name().c_str(), (*field)->payloadMiB(),
-              (*field)->bakeSeconds, o.benchRays, threads, o.repeat, vff::batchKernelName());
+              (*field)->bakeSeconds, o.benchRays, threads, o.repeat, vff::batchKernelName(), o.benchBatch);
   std::printf("| ray set | query | Mrays/s | x Embree | occluded | agreement with Embree |\n");
   std::printf("|---|---|---:|---:|---:|---:|\n");
 
@@ -125,7 +132,9 @@ int runBench(const Options& o) {
       }));
       tb = std::min(tb, seconds([&] {
         parallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
-          q.occluded(rays.subspan(b, e - b), std::span<uint8_t>(nearest).subspan(b, e - b), qn);
+          inBatches(b, e, o.benchBatch, [&](uint64_t x, uint64_t y) {
+            q.occluded(rays.subspan(x, y - x), std::span<uint8_t>(nearest).subspan(x, y - x), qn);
+          });
         });
       }));
       tc = std::min(tc, seconds([&] {
@@ -135,7 +144,9 @@ int runBench(const Options& o) {
       }));
       td = std::min(td, seconds([&] {
         parallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
-          q.visibility(rays.subspan(b, e - b), std::span<float>(vis).subspan(b, e - b), qi);
+          inBatches(b, e, o.benchBatch, [&](uint64_t x, uint64_t y) {
+            q.visibility(rays.subspan(x, y - x), std::span<float>(vis).subspan(x, y - x), qi);
+          });
         });
       }));
       tm = std::min(tm, seconds([&] {

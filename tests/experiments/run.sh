@@ -27,6 +27,15 @@ case "$case" in
     "$exp" bench --mesh knot.obj --config 1090x16x16 --bench-rays 20000 --repeat 1 >stdout.txt 2>stderr.txt \
       || { cat stderr.txt; fail "bench failed"; }
     grep -q "Embree rtcOccluded1" stdout.txt || { cat stdout.txt; fail "bench prints no baseline"; }
+    # Calls of 333 rays (groups and lookup vectors cut anywhere): the same occluded and agreement
+    # figures as calls of 4096 (tests/unit/test_fast_lookup.cpp compares the answers ray by ray).
+    "$exp" bench --mesh knot.obj --config 1090x16x16 --bench-rays 20000 --repeat 1 --batch 333 >small.txt 2>stderr.txt \
+      || { cat stderr.txt; fail "bench --batch 333 failed"; }
+    grep -q "333 rays per batch call" small.txt || { cat small.txt; fail "bench does not print its batch size"; }
+    answers() { grep -E '\((b|d)\) field' "$1" | awk -F'|' '{print $2, $3, $6, $7}'; }
+    [ "$(answers stdout.txt | wc -l)" -eq 4 ] || { cat stdout.txt; fail "bench lacks the (b) and (d) rows"; }
+    [ "$(answers stdout.txt)" = "$(answers small.txt)" ] \
+      || { answers stdout.txt; answers small.txt; fail "batch answers depend on the call size"; }
     ;;
   images_do_not_depend_on_threads)
     "$exp" ao "${small[@]}" --rays 8 -j 1 -o one >/dev/null 2>&1 || fail "ao -j 1 failed"
