@@ -39,11 +39,14 @@
 // Threads. A FieldQuery is immutable after creation: every member function is const and may be
 // called from many threads at once. The batch functions run on the calling thread.
 //
-// Speed. Call the batch functions (FieldQuery's or Instance's): they answer kNearest rays in
-// groups, 32 at a time in AVX2 vectors where the CPU has them (8 in SSE2 vectors on other x86-64
-// CPUs), and fetch a group's texels from memory together; kInterpolated batches fetch the texels
-// of 16 rays at once. They give bit for bit the answers of the one-ray functions, several times
-// faster (vff-experiments bench). occluded() and visibility() with kNearest are fastest on
+// Speed. Call the batch functions (FieldQuery's or Instance's): they answer kNearest rays 32 at a
+// time, in AVX-512 or AVX2 vectors where the CPU has them (8 in SSE2 vectors on other x86-64
+// CPUs), the rays that reach the sphere gathered from consecutive groups of 64 so that the
+// vectors are full, and fetch the texels from memory ahead of their use; kInterpolated batches
+// fetch the texels of 16 rays at once. They give bit for bit the answers of the one-ray
+// functions, several times faster (vff-experiments bench). Hand them thousands of rays per call
+// where you can: each call ends with its last rays in a part-filled vector (vff-experiments bench
+// --batch 256 against the default 4096). occluded() and visibility() with kNearest are fastest on
 // kUnorm8Diameter fields, whose hit flags the group kernel decodes as well.
 #pragma once
 
