@@ -308,11 +308,12 @@ void lookupStep(const GroupTables& tb, size_t p, LookupQueue* q) {
   const F fm(fmS), half(0.5f);
   const F x = (a + one) * half * fm, y = (b + one) * half * fm;
   const F fx = floorPos(x), fy = floorPos(y);
-  // The guard of texelFast: only the map's inner texel edges 1 .. m - 1 (0 <= x <= m).
+  // The guard of texelFast (its nearEdge): only the map's inner texel edges 1 .. m - 1 (0 <= x <= m).
   const F tg(tb.texelGuard), top(fmS - 1.0f);
-  const F nearX = bor(band(lt(x - fx, tg), band(ge(fx, one), le(fx, top))), band(lt((fx + one) - x, tg), le(fx + one, top)));
-  const F nearY = bor(band(lt(y - fy, tg), band(ge(fy, one), le(fy, top))), band(lt((fy + one) - y, tg), le(fy + one, top)));
-  redo = bor(redo, bor(nearX, nearY));
+  auto nearEdge = [&](F v, F fv) {
+    return bor(band(lt(v - fv, tg), band(ge(fv, one), le(fv, top))), band(lt((fv + one) - v, tg), le(fv + one, top)));
+  };
+  redo = bor(redo, bor(nearEdge(x, fx), nearEdge(y, fy)));
   const F ok = bnot(redo);
   const F ti = band(ok, vmin(vmax(fx, zero), top)), tj = band(ok, vmin(vmax(fy, zero), top));
   storeInt(reinterpret_cast<int32_t*>(q->k + p), band(ok, bestK));
@@ -408,20 +409,16 @@ void lookupQueueWith(const GroupTables& tb, LookupQueue* q, bool flush) {
   size_t done = size / L * L;
   if (flush && done < size) {
     // Pad the last lanes with copies of the last entry (their answers are left out).
-    for (size_t p = size; p % L != 0; ++p) {
-      q->eux[p] = q->eux[size - 1];
-      q->euy[p] = q->euy[size - 1];
-      q->euz[p] = q->euz[size - 1];
-      q->vx[p] = q->vx[size - 1];
-      q->vy[p] = q->vy[size - 1];
-      q->vz[p] = q->vz[size - 1];
-    }
     done = size + (L - size % L);
+    for (float* a : {q->eux, q->euy, q->euz, q->vx, q->vy, q->vz})
+      for (size_t p = size; p < done; ++p) a[p] = a[size - 1];
   }
   if (done == 0) return;
   for (uint64_t& w : q->redo) w = 0;
   for (size_t p = 0; p < done; p += L) lookupStep<F>(tb, p, q);
   done = done < size ? done : size;
+  static_assert(LookupQueue::kCapacity <= 128, "the queue's redo bits fit in 128 bits");
+  const unsigned __int128 queueRedo = (static_cast<unsigned __int128>(q->redo[1]) << 64) | q->redo[0];
   // The answers of entries 0 .. done - 1 into their groups.
   uint32_t s = 0;
   for (; s < q->segments; ++s) {
@@ -433,10 +430,7 @@ void lookupQueueWith(const GroupTables& tb, LookupQueue* q, bool flush) {
     std::memcpy(g->i + sg.p0, q->i + sg.first, n * sizeof(uint32_t));
     std::memcpy(g->j + sg.p0, q->j + sg.first, n * sizeof(uint32_t));
     std::memcpy(g->t + sg.p0, q->t + sg.first, n * sizeof(int32_t));
-    for (uint32_t e = 0; e < n; ++e) {
-      const uint32_t x = sg.first + e;
-      g->redo |= ((q->redo[x / 64] >> (x % 64)) & 1u) << (sg.p0 + e);
-    }
+    g->redo |= (uint64_t(queueRedo >> sg.first) & packedBits(n)) << sg.p0;
     g->looked += n;
     if (n < sg.n) {  // the rest waits: it moves to the front below
       sg.p0 += n;
