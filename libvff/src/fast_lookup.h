@@ -18,6 +18,9 @@
 #include "vff/direction.h"
 
 namespace vff::detail {
+// (Everything here has a copy per file: the SIMD kernels' files, compiled for AVX2 or AVX-512, call
+// some of these functions and must share no function with code that runs on any x86-64 CPU.)
+namespace {
 
 // Guard bands: far wider than the binary32 error of the quantities they protect (a few ulps of
 // values <= 1, scaled by the grid or map resolution), and narrow enough that the fallback runs
@@ -40,7 +43,9 @@ inline float texelGuard(uint32_t m) noexcept { return kTexelGuard + 2e-6f * floa
 // the kernel's dot product 3 u, the refined reciprocal 1.5 (1.5 * 2^-12)^2 + 4 u (about 7.4 u),
 // its last product u. Together under 16 u = 9.5e-7 |q|; kOctaScoreError allows twice that, per
 // unit of |q.x| + |q.y| + |q.z| (>= |q|). A lead of the best score over the second by more
-// than 2 kOctaScoreError (|q.x| + |q.y| + |q.z|) proves the reference picks the same sample.
+// than 2 kOctaScoreError (|q.x| + |q.y| + |q.z|) proves the reference picks the same sample;
+// with a smaller lead the kernel scores that lane's candidates as the reference does
+// (octaBestCandidate).
 inline constexpr float kOctaScoreError = 2e-6f;
 
 // atanUnit's constants (Cephes atanf), shared with the SIMD kernel's copy of it.
@@ -109,12 +114,49 @@ inline std::vector<uint8_t> octaCandidateMasks(uint32_t un) {
   return masks;
 }
 
+// The nearest of the octa-hemi2 candidates of cell (a0, b0) of q's quadrant (kOctaCandidates,
+// those with |a| + |b| <= n) by binary32 dot products of q with the float table `unit4` (4 floats
+// per sample: x, y, z and padding), ties to the smallest index, as FieldQuery does with the
+// reference candidates: its index in *k and its grid point in the quadrant frame in (*a, *b).
+// False when no candidate lies on the grid.
+inline bool octaBestCandidate(int32_t n, const float* unit4, float qx, float qy, float qz, int32_t a0, int32_t b0,
+                              uint32_t* k, int32_t* a, int32_t* b) noexcept {
+  const int32_t h = qz >= 0 ? 0 : 1;
+  const int32_t si = qx < 0 ? -1 : 1, sj = qy < 0 ? -1 : 1;
+  const int32_t hemi = 2 * n * n + 2 * n + 1;
+  float bestDot = -INFINITY;
+  bool any = false;
+  *k = 0;
+  *a = a0;
+  *b = b0;
+  for (const auto& c : kOctaCandidates) {
+    const int32_t ca = a0 + c[0], cb = b0 + c[1];
+    const int32_t aa = ca < 0 ? -ca : ca, ab = cb < 0 ? -cb : cb;
+    if (aa + ab > n) continue;
+    const int32_t i = si * ca, j = sj * cb;
+    const int32_t hh = aa + ab == n ? 0 : h;  // an equator point is its hemisphere-0 copy
+    // octaIndex: row j starts at (n + j)^2, less 2 j (j - 1) for j > 0; row j spans i = -w .. w.
+    const int32_t t = n + j;
+    const int32_t rowStart = j <= 0 ? t * t : t * t - 2 * j * (j - 1);
+    const int32_t w = n - (j < 0 ? -j : j);
+    const uint32_t ck = uint32_t(hh * hemi + rowStart + i + w);
+    const float* u = unit4 + size_t(ck) * 4;
+    const float d = u[0] * qx + u[1] * qy + u[2] * qz;
+    if (!any || d > bestDot || (d == bestDot && ck < *k)) {
+      bestDot = d;
+      *k = ck;
+      *a = ca;
+      *b = cb;
+      any = true;
+    }
+  }
+  return any;
+}
+
 // The octa-hemi2 candidates of PositionSet::candidates (positions.cpp, octaCandidates) for the
 // direction q (finite, non-zero, need not be unit), evaluated in binary32, then the nearest of
-// them by binary32 dot products with the float table `unit` (ties to the smallest index), as
-// FieldQuery does with the reference candidates. False when the projection of q lies within
-// gridGuard(n) of a grid line, where the binary64 reference could choose another cell. `unit4`
-// holds 4 floats per sample: x, y, z and padding.
+// them (octaBestCandidate). False when the projection of q lies within gridGuard(n) of a grid
+// line, where the binary64 reference could choose another cell.
 inline bool octaNearestFast(uint32_t un, const float* unit4, Vec3 q, uint32_t* out) noexcept {
   const int32_t n = int32_t(un);
   const float ax = std::fabs(q.x), ay = std::fabs(q.y), az = std::fabs(q.z);
@@ -129,34 +171,8 @@ inline bool octaNearestFast(uint32_t un, const float* unit4, Vec3 q, uint32_t* o
   if (pa - fa < g || fa + 1.0f - pa < g || pb - fb < g || fb + 1.0f - pb < g)
     return false;
   const int32_t a0 = std::min(int32_t(fa), n - 1), b0 = std::min(int32_t(fb), n - 1);
-  const int32_t h = q.z >= 0 ? 0 : 1;
-  const int32_t si = q.x < 0 ? -1 : 1, sj = q.y < 0 ? -1 : 1;
-  const int32_t hemi = 2 * n * n + 2 * n + 1;
-  uint32_t best = 0;
-  float bestDot = -INFINITY;
-  bool any = false;
-  for (const auto& c : kOctaCandidates) {
-    const int32_t a = a0 + c[0], b = b0 + c[1];
-    const int32_t aa = a < 0 ? -a : a, ab = b < 0 ? -b : b;
-    if (aa + ab > n) continue;
-    const int32_t i = si * a, j = sj * b;
-    const int32_t hh = aa + ab == n ? 0 : h;  // an equator point is its hemisphere-0 copy
-    // octaIndex: row j starts at (n + j)^2, less 2 j (j - 1) for j > 0; row j spans i = -w .. w.
-    const int32_t t = n + j;
-    const int32_t rowStart = j <= 0 ? t * t : t * t - 2 * j * (j - 1);
-    const int32_t w = n - (j < 0 ? -j : j);
-    const uint32_t k = uint32_t(hh * hemi + rowStart + i + w);
-    const float* u = unit4 + size_t(k) * 4;
-    const float d = u[0] * q.x + u[1] * q.y + u[2] * q.z;
-    if (!any || d > bestDot || (d == bestDot && k < best)) {
-      bestDot = d;
-      best = k;
-      any = true;
-    }
-  }
-  if (!any) return false;
-  *out = best;
-  return true;
+  int32_t a, b;
+  return octaBestCandidate(n, unit4, q.x, q.y, q.z, a0, b0, out, &a, &b);
 }
 
 // atan(t) for |t| <= 1 in binary32 (Cephes atanf: range reduction at tan(pi/8), degree-9
@@ -229,4 +245,5 @@ inline bool texelFast(DirectionScheme scheme, Vec3 local, uint32_t m, uint32_t* 
   return true;
 }
 
+}  // namespace
 }  // namespace vff::detail

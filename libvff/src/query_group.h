@@ -8,8 +8,9 @@
 // reading their positions, fast_lookup.h's kOctaScoreError) and the texel of the lookup direction
 // in that sample's map; for occlusion batches over one-byte maps, decodeGroup() then reads the
 // texels and decodes the hit flags. Where the kernel computes what prepare() computes it performs
-// the same binary32 operations in the same order, and it leaves to the caller (bit `redo`) every ray
-// on which a guard of fast_lookup.h trips, whose two best candidates score too close to call, or
+// the same binary32 operations in the same order. Where its two best candidates score too close
+// to call, it scores that ray's candidates as the reference does (octaBestCandidate, one lane at a
+// time). It leaves to the caller (bit `redo`) every ray on which a guard of fast_lookup.h trips or
 // whose scheme it does not handle, so that a group gives exactly the texel and the answer
 // prepare() and hitsAt() give (tests/unit/test_fast_lookup.cpp checks this ray by ray, with every
 // kernel). The kernel itself is query_group_kernel.h.
