@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,31 @@ inline float dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 inline Vec3 normalize(Vec3 v) {
   const float l = std::sqrt(dot(v, v));
   return l > 0 ? v * (1.0f / l) : Vec3{};
+}
+
+// A RigidTransform's inverse, taken apart once for many rays: what toObjectVector and
+// toObjectPoint compute, inlined. The group kernel repeats these operations lane by lane
+// (GroupTables::toObject).
+struct ToObject {
+  const float (&r)[3][3];  // the inverse rotation is the transpose
+  Vec3 translation;
+  float invScale;
+  explicit ToObject(const RigidTransform& x) noexcept
+      : r(x.rotation), translation(x.translation), invScale(1.0f / x.scale) {}
+  Vec3 vector(Vec3 v) const noexcept {
+    return Vec3{r[0][0] * v.x + r[1][0] * v.y + r[2][0] * v.z, r[0][1] * v.x + r[1][1] * v.y + r[2][1] * v.z,
+                r[0][2] * v.x + r[1][2] * v.y + r[2][2] * v.z} *
+           invScale;
+  }
+  Vec3 point(Vec3 p) const noexcept { return vector(p - translation); }
+  Ray ray(const Ray& w) const noexcept { return Ray{point(w.origin), vector(w.direction), w.tmin, w.tmax}; }
+};
+
+// The field's answer to an object-space ray, in world space (both rays share t).
+void toWorld(const RigidTransform& x, const Ray& worldRay, QueryHit* h) {
+  if (!h->hit) return;
+  h->point = worldRay.origin + worldRay.direction * h->t;
+  if (h->hasNormal) h->normal = normalize(x.toWorldVector(h->normal));
 }
 
 // One decoded texel: a hit at `distance` from the map's sample point, or a miss.
@@ -219,8 +245,19 @@ struct FieldQuery::Impl {
   }
   // kHitOnly: emit(base, n, hits) per run of rays; otherwise emit(r, const QueryHit&, float
   // visibility) per ray (see the definition).
+  // With `to`, the rays are in world space: the kernel and prepare() take them to object space.
   template <bool kHitOnly, class Emit>
-  void batchNearest(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept;
+  void batchNearest(std::span<const Ray> rays, const QueryOptions& o, const ToObject* to, Emit&& emit) const noexcept;
+  // The batch calls of FieldQuery (x null: object-space rays) and of Instance (world-space rays, x
+  // their transform). Nearest batches hand the transform to the group kernel, which applies it
+  // lane by lane; interpolated batches take the rays to object space a few hundred at a time.
+  // out.size() == rays.size().
+  void intersectBatch(std::span<const Ray> rays, std::span<QueryHit> out, const QueryOptions& o,
+                      const RigidTransform* x) const noexcept;
+  void occludedBatch(std::span<const Ray> rays, std::span<uint8_t> out, const QueryOptions& o,
+                     const RigidTransform* x) const noexcept;
+  void visibilityBatch(std::span<const Ray> rays, std::span<float> out, const QueryOptions& o,
+                       const RigidTransform* x) const noexcept;
   const uint8_t* texelAddress(uint32_t k, uint32_t i, uint32_t j) const noexcept {
     return dist[k] + detail::texelByte(field.distanceEncoding, m, i, j);
   }
@@ -712,7 +749,9 @@ detail::GroupTables FieldQuery::Impl::groupTables(const QueryOptions& o, bool de
 // kHitOnly: emit(base, n, hits) for each run of n <= 64 rays from base, bit r of `hits` saying
 // whether ray base + r hits. Otherwise: emit(r, const QueryHit&, float visibility) per ray.
 template <bool kHitOnly, class Emit>
-void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept {
+void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOptions& o, const ToObject* to,
+                                    Emit&& emit) const noexcept {
+  auto objectRay = [&](size_t r) { return to ? to->ray(rays[r]) : rays[r]; };
   if (!detail::groupKernelAvailable()) {
     for (size_t base = 0; base < rays.size(); base += detail::kGroupRays) {
       const size_t n = std::min(detail::kGroupRays, rays.size() - base);
@@ -720,7 +759,8 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
       for (size_t r = 0; r < n; ++r) {
         float vis = 1.0f;
         Lookup l;
-        const QueryHit h = prepare(rays[base + r], o, &l) ? nearestHit(rays[base + r], l, &vis) : QueryHit{};
+        const Ray ray = objectRay(base + r);
+        const QueryHit h = prepare(ray, o, &l) ? nearestHit(ray, l, &vis) : QueryHit{};
         if constexpr (kHitOnly) {
           hits |= uint64_t(h.hit) << r;
         } else {
@@ -731,7 +771,13 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
     }
     return;
   }
-  const detail::GroupTables tables = groupTables(o, kHitOnly);
+  detail::GroupTables tables = groupTables(o, kHitOnly);
+  if (to) {
+    tables.toObject = true;
+    std::memcpy(tables.objectRotation, to->r, sizeof tables.objectRotation);
+    tables.objectShift = to->translation;
+    tables.objectInvScale = to->invScale;
+  }
   forEachGroup(rays, tables, [&](size_t base, size_t n, detail::Group& g) {
     // Every ray misses unless it reaches the sphere.
     if constexpr (!kHitOnly) {
@@ -743,7 +789,7 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
     for (uint64_t redo = g.redo; redo != 0; redo &= redo - 1) {
       const uint32_t p = uint32_t(__builtin_ctzll(redo)), r = g.ray[p];
       Lookup l;
-      if (!prepare(rays[base + r], o, &l)) {
+      if (!prepare(objectRay(base + r), o, &l)) {
         dead |= uint64_t(1) << p;
         continue;
       }
@@ -774,22 +820,99 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
         const uint32_t r = g.ray[p];
         float vis = 1.0f;
         const QueryHit h = (dead >> p) & 1u ? QueryHit{}
-                                            : hitAt(rays[base + r], g.k[p], g.i[p], g.j[p], g.t0[r], (g.inside >> r) & 1u,
-                                                    g.lo[r], g.hi[r], g.len[r], &vis);
+                                            : hitAt(objectRay(base + r), g.k[p], g.i[p], g.j[p], g.t0[r],
+                                                    (g.inside >> r) & 1u, g.lo[r], g.hi[r], g.len[r], &vis);
         emit(base + r, h, vis);
       }
     }
   });
 }
 
-void FieldQuery::intersect(std::span<const Ray> rays, std::span<QueryHit> out, const QueryOptions& options) const noexcept {
-  const size_t n = std::min(rays.size(), out.size());
-  if (impl_ && options.reconstruction == Reconstruction::kNearest) {
-    impl_->batchNearest<false>(rays.first(n), options, [&](size_t r, const QueryHit& h, float) { out[r] = h; });
+namespace {
+
+// Calls batch(objectRays, first) for rays in chunks, taken to object space by x (none: the rays
+// are in object space, one call).
+template <class Batch>
+void inObjectSpace(const RigidTransform* x, std::span<const Ray> rays, Batch&& batch) {
+  if (!x) {
+    batch(rays, size_t(0));
     return;
   }
+  constexpr size_t kChunk = 256;
+  const ToObject to(*x);
+  Ray local[kChunk];
+  for (size_t first = 0; first < rays.size(); first += kChunk) {
+    const size_t n = std::min(kChunk, rays.size() - first);
+    for (size_t r = 0; r < n; ++r) local[r] = to.ray(rays[first + r]);
+    batch(std::span<const Ray>(local, n), first);
+  }
+}
+
+// fn(to) with x taken apart (null for none).
+template <class Fn>
+void withToObject(const RigidTransform* x, Fn&& fn) {
+  if (x) {
+    const ToObject to(*x);
+    fn(&to);
+  } else {
+    fn(static_cast<const ToObject*>(nullptr));
+  }
+}
+
+}  // namespace
+
+void FieldQuery::Impl::intersectBatch(std::span<const Ray> rays, std::span<QueryHit> out, const QueryOptions& o,
+                                      const RigidTransform* x) const noexcept {
+  if (o.reconstruction == Reconstruction::kNearest) {
+    withToObject(x, [&](const ToObject* to) {
+      batchNearest<false>(rays, o, to, [&](size_t r, const QueryHit& h, float) {
+        out[r] = h;
+        if (x) toWorld(*x, rays[r], &out[r]);
+      });
+    });
+    return;
+  }
+  inObjectSpace(x, rays, [&](std::span<const Ray> objectRays, size_t first) {
+    batchInterpolated(objectRays, o, [&](size_t r, const QueryHit& h, float) {
+      out[first + r] = h;
+      if (x) toWorld(*x, rays[first + r], &out[first + r]);
+    });
+  });
+}
+
+void FieldQuery::Impl::occludedBatch(std::span<const Ray> rays, std::span<uint8_t> out, const QueryOptions& o,
+                                     const RigidTransform* x) const noexcept {
+  if (o.reconstruction == Reconstruction::kNearest) {
+    withToObject(x, [&](const ToObject* to) {
+      batchNearest<true>(rays, o, to,
+                         [&](size_t base, size_t count, uint64_t hits) { writeHitBytes(hits, count, &out[base]); });
+    });
+    return;
+  }
+  inObjectSpace(x, rays, [&](std::span<const Ray> objectRays, size_t first) {
+    batchInterpolated(objectRays, o, [&](size_t r, const QueryHit& h, float) { out[first + r] = h.hit ? 1 : 0; });
+  });
+}
+
+void FieldQuery::Impl::visibilityBatch(std::span<const Ray> rays, std::span<float> out, const QueryOptions& o,
+                                       const RigidTransform* x) const noexcept {
+  if (o.reconstruction == Reconstruction::kNearest) {
+    withToObject(x, [&](const ToObject* to) {
+      batchNearest<true>(rays, o, to, [&](size_t base, size_t count, uint64_t hits) {
+        for (size_t r = 0; r < count; ++r) out[base + r] = (hits >> r) & 1u ? 0.0f : 1.0f;
+      });
+    });
+    return;
+  }
+  inObjectSpace(x, rays, [&](std::span<const Ray> objectRays, size_t first) {
+    batchInterpolated(objectRays, o, [&](size_t r, const QueryHit&, float v) { out[first + r] = v; });
+  });
+}
+
+void FieldQuery::intersect(std::span<const Ray> rays, std::span<QueryHit> out, const QueryOptions& options) const noexcept {
+  const size_t n = std::min(rays.size(), out.size());
   if (impl_) {
-    impl_->batchInterpolated(rays.first(n), options, [&](size_t r, const QueryHit& h, float) { out[r] = h; });
+    impl_->intersectBatch(rays.first(n), out.first(n), options, nullptr);
   } else {
     std::fill_n(out.begin(), n, QueryHit{});
   }
@@ -797,13 +920,8 @@ void FieldQuery::intersect(std::span<const Ray> rays, std::span<QueryHit> out, c
 
 void FieldQuery::occluded(std::span<const Ray> rays, std::span<uint8_t> out, const QueryOptions& options) const noexcept {
   const size_t n = std::min(rays.size(), out.size());
-  if (impl_ && options.reconstruction == Reconstruction::kNearest) {
-    impl_->batchNearest<true>(rays.first(n), options,
-                              [&](size_t base, size_t count, uint64_t hits) { writeHitBytes(hits, count, &out[base]); });
-    return;
-  }
   if (impl_) {
-    impl_->batchInterpolated(rays.first(n), options, [&](size_t r, const QueryHit& h, float) { out[r] = h.hit ? 1 : 0; });
+    impl_->occludedBatch(rays.first(n), out.first(n), options, nullptr);
   } else {
     std::fill_n(out.begin(), n, uint8_t(0));
   }
@@ -811,14 +929,8 @@ void FieldQuery::occluded(std::span<const Ray> rays, std::span<uint8_t> out, con
 
 void FieldQuery::visibility(std::span<const Ray> rays, std::span<float> out, const QueryOptions& options) const noexcept {
   const size_t n = std::min(rays.size(), out.size());
-  if (impl_ && options.reconstruction == Reconstruction::kNearest) {
-    impl_->batchNearest<true>(rays.first(n), options, [&](size_t base, size_t count, uint64_t hits) {
-      for (size_t r = 0; r < count; ++r) out[base + r] = (hits >> r) & 1u ? 0.0f : 1.0f;
-    });
-    return;
-  }
   if (impl_) {
-    impl_->batchInterpolated(rays.first(n), options, [&](size_t r, const QueryHit&, float v) { out[r] = v; });
+    impl_->visibilityBatch(rays.first(n), out.first(n), options, nullptr);
   } else {
     std::fill_n(out.begin(), n, 1.0f);
   }
@@ -835,14 +947,9 @@ Vec3 RigidTransform::toWorldVector(Vec3 v) const noexcept {
 
 Vec3 RigidTransform::toWorldPoint(Vec3 p) const noexcept { return toWorldVector(p) + translation; }
 
-Vec3 RigidTransform::toObjectVector(Vec3 v) const noexcept {
-  const auto& r = rotation;  // the inverse rotation is the transpose
-  return Vec3{r[0][0] * v.x + r[1][0] * v.y + r[2][0] * v.z, r[0][1] * v.x + r[1][1] * v.y + r[2][1] * v.z,
-              r[0][2] * v.x + r[1][2] * v.y + r[2][2] * v.z} *
-         (1.0f / scale);
-}
+Vec3 RigidTransform::toObjectVector(Vec3 v) const noexcept { return ToObject(*this).vector(v); }
 
-Vec3 RigidTransform::toObjectPoint(Vec3 p) const noexcept { return toObjectVector(p - translation); }
+Vec3 RigidTransform::toObjectPoint(Vec3 p) const noexcept { return ToObject(*this).point(p); }
 
 RigidTransform RigidTransform::fromAxisAngle(Vec3 axis, float radians, Vec3 translation, float scale) noexcept {
   RigidTransform x;
@@ -864,20 +971,7 @@ RigidTransform RigidTransform::fromAxisAngle(Vec3 axis, float radians, Vec3 tran
 
 namespace {
 
-Ray toObject(const RigidTransform& x, const Ray& r) {
-  return Ray{x.toObjectPoint(r.origin), x.toObjectVector(r.direction), r.tmin, r.tmax};
-}
-
-}  // namespace
-
-namespace {
-
-// The field's answer to toObject(x, worldRay), in world space (both rays share t).
-void toWorld(const RigidTransform& x, const Ray& worldRay, QueryHit* h) {
-  if (!h->hit) return;
-  h->point = worldRay.origin + worldRay.direction * h->t;
-  if (h->hasNormal) h->normal = normalize(x.toWorldVector(h->normal));
-}
+Ray toObject(const RigidTransform& x, const Ray& r) { return ToObject(x).ray(r); }
 
 }  // namespace
 
@@ -896,54 +990,31 @@ float Instance::visibility(const Ray& worldRay, const QueryOptions& options) con
   return field ? field->visibility(toObject(transform, worldRay), options) : 1.0f;
 }
 
-namespace {
-
-// Calls batch(objectRays, first) for worldRays in chunks, transformed to object space.
-template <class Batch>
-void inObjectSpace(const RigidTransform& x, std::span<const Ray> worldRays, Batch&& batch) {
-  constexpr size_t kChunk = 256;
-  Ray local[kChunk];
-  for (size_t first = 0; first < worldRays.size(); first += kChunk) {
-    const size_t n = std::min(kChunk, worldRays.size() - first);
-    for (size_t r = 0; r < n; ++r) local[r] = toObject(x, worldRays[first + r]);
-    batch(std::span<const Ray>(local, n), first);
-  }
-}
-
-}  // namespace
-
 void Instance::intersect(std::span<const Ray> worldRays, std::span<QueryHit> out, const QueryOptions& options) const noexcept {
   const size_t n = std::min(worldRays.size(), out.size());
-  if (!field) {
+  if (field && field->impl_) {
+    field->impl_->intersectBatch(worldRays.first(n), out.first(n), options, &transform);
+  } else {
     std::fill_n(out.begin(), n, QueryHit{});
-    return;
   }
-  inObjectSpace(transform, worldRays.first(n), [&](std::span<const Ray> rays, size_t first) {
-    field->intersect(rays, out.subspan(first, rays.size()), options);
-    for (size_t r = 0; r < rays.size(); ++r) toWorld(transform, worldRays[first + r], &out[first + r]);
-  });
 }
 
 void Instance::occluded(std::span<const Ray> worldRays, std::span<uint8_t> out, const QueryOptions& options) const noexcept {
   const size_t n = std::min(worldRays.size(), out.size());
-  if (!field) {
+  if (field && field->impl_) {
+    field->impl_->occludedBatch(worldRays.first(n), out.first(n), options, &transform);
+  } else {
     std::fill_n(out.begin(), n, uint8_t(0));
-    return;
   }
-  inObjectSpace(transform, worldRays.first(n), [&](std::span<const Ray> rays, size_t first) {
-    field->occluded(rays, out.subspan(first, rays.size()), options);
-  });
 }
 
 void Instance::visibility(std::span<const Ray> worldRays, std::span<float> out, const QueryOptions& options) const noexcept {
   const size_t n = std::min(worldRays.size(), out.size());
-  if (!field) {
+  if (field && field->impl_) {
+    field->impl_->visibilityBatch(worldRays.first(n), out.first(n), options, &transform);
+  } else {
     std::fill_n(out.begin(), n, 1.0f);
-    return;
   }
-  inObjectSpace(transform, worldRays.first(n), [&](std::span<const Ray> rays, size_t first) {
-    field->visibility(rays, out.subspan(first, rays.size()), options);
-  });
 }
 
 Sphere Instance::worldSphere() const noexcept {

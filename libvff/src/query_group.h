@@ -59,6 +59,12 @@ struct GroupTables {
   // maps with byteTexels only, whose distance is code * distanceScale (code 255: a miss).
   bool decodeHits = false;
   float distanceScale = 0;  // 2 R / 254, as FieldQuery::Impl::texel computes it
+  // The rays are in world space (Instance batches): each lane first goes to object space as
+  // RigidTransform::toObjectPoint and toObjectVector take a ray, with the same binary32 operations.
+  bool toObject = false;
+  float objectRotation[3][3] = {};  // the transform's rotation (applied transposed)
+  Vec3 objectShift;                 // its translation
+  float objectInvScale = 1.0f;      // 1 / its scale
 };
 
 // The state of up to kGroupRays rays. Per ray r (bit r of the masks, entry r of the arrays): the

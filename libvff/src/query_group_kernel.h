@@ -149,12 +149,30 @@ inline F atanUnitV(F t) {
   return sel(lt(t, F(0.0f)), vneg(r), r);
 }
 
+// A world-space ray to object space (GroupTables::toObject), as ToObject in query.cpp:
+// (r^T (p - translation)) / scale, each row a left-to-right sum of products, then times 1 / scale.
+template <class F>
+inline void toObjectLanes(const GroupTables& tb, F* ox, F* oy, F* oz, F* dx, F* dy, F* dz) {
+  const auto& r = tb.objectRotation;
+  const F s(tb.objectInvScale);
+  auto row = [&](int c, F x, F y, F z) { return ((F(r[0][c]) * x + F(r[1][c]) * y) + F(r[2][c]) * z) * s; };
+  const F px = *ox - F(tb.objectShift.x), py = *oy - F(tb.objectShift.y), pz = *oz - F(tb.objectShift.z);
+  *ox = row(0, px, py, pz);
+  *oy = row(1, px, py, pz);
+  *oz = row(2, px, py, pz);
+  const F vx = *dx, vy = *dy, vz = *dz;
+  *dx = row(0, vx, vy, vz);
+  *dy = row(1, vx, vy, vz);
+  *dz = row(2, vx, vy, vz);
+}
+
 // Step 1 for F::kLanes rays starting at rays[0] (all readable), lanes r0 .. of g: the sphere;
 // appends the rays that reach it to g's packed rays and their lookups to q.
 template <class F>
 void sphereStep(const GroupTables& tb, const Ray* rays, Group* g, size_t r0, LookupQueue* q) {
   F ox, oy, oz, dx, dy, dz, tmin, tmax;
   loadRays(reinterpret_cast<const float*>(rays), &ox, &oy, &oz, &dx, &dy, &dz, &tmin, &tmax);
+  if (tb.toObject) toObjectLanes(tb, &ox, &oy, &oz, &dx, &dy, &dz);
   const F zero(0.0f), one(1.0f);
 
   // prepare(): the ray's length and unit direction.

@@ -6,15 +6,17 @@
 //   aimed  origins outside the bounding sphere (1.05 R to 3 R from its centre, uniform directions),
 //          each aimed at a uniform point inside the sphere, tmax infinite.
 // Measured in one run on the same threads (rays handed out in chunks of 4096), best of --repeat
-// (the five take turns in every repetition):
+// (the six take turns in every repetition):
 //   (a) Embree rtcOccluded1 against the mesh (world space)
 //   (b) FieldQuery::occluded, batch, kNearest (object space: the same rays, transformed beforehand;
 //       --batch rays per call, 4096 by default)
 //   (c) FieldQuery::occluded, one ray per call, kNearest
 //   (d) FieldQuery::visibility, batch, kInterpolated
+//   (e) Instance::occluded, batch, kNearest, on the world-space rays (as (a)): the field placed by
+//       the object's rigid transform, which the batch applies to each ray
 //   (m) no query: one read of a random byte of the field's maps per ray, 64 requested at a time
 //       then read (as the batch does): the memory floor of any lookup into a table this size
-// plus the agreement of (b) and of (d) > 0.5 with (a): the fraction of rays with the same answer.
+// plus the agreement of (b), (c), (d) > 0.5 and (e) with (a): the fraction of rays with the same answer.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -92,6 +94,7 @@ int runBench(const Options& o) {
   auto field = bakeQuery(*world, *scene, config, false, threads);
   if (!field) return vff::cli::reportError(kProg, o.mesh, field.error());
   const vff::FieldQuery& q = (*field)->query;
+  const vff::Instance& instance = (*field)->instance;  // q placed in the world
 
   std::printf("Query benchmark: %s (%zu triangles), field %s (%.2f MiB payload, baked in %.2f s), "
               "%u rays per set, %u threads, best of %d, batch kernel %s, %u rays per batch call\n\n",
@@ -121,9 +124,10 @@ int runBench(const Options& o) {
       at[i] = uint32_t(std::min(double(Rng(uint32_t(i), 2, 0xb2).next01()) * double(maps.size()), double(maps.size() - 1)));
     std::vector<uint8_t> read(n);  // (stores into memory the threads share: the reads are kept)
 
-    // The five measurements take turns within each repetition, so that a slow spell of the machine
+    // The six measurements take turns within each repetition, so that a slow spell of the machine
     // does not fall on one of them only.
-    double ta = 1e30, tb = 1e30, tc = 1e30, td = 1e30, tm = 1e30;
+    std::vector<uint8_t> placed(n);
+    double ta = 1e30, tb = 1e30, tc = 1e30, td = 1e30, te = 1e30, tm = 1e30;
     for (int rep = 0; rep < o.repeat; ++rep) {
       ta = std::min(ta, seconds([&] {
         parallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
@@ -149,6 +153,14 @@ int runBench(const Options& o) {
           });
         });
       }));
+      te = std::min(te, seconds([&] {
+        parallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
+          inBatches(b, e, o.benchBatch, [&](uint64_t x, uint64_t y) {
+            instance.occluded(std::span<const vff::Ray>(set.world).subspan(x, y - x),
+                              std::span<uint8_t>(placed).subspan(x, y - x), qn);
+          });
+        });
+      }));
       tm = std::min(tm, seconds([&] {
         parallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
           for (uint64_t g = b; g < e; g += 64) {
@@ -160,16 +172,18 @@ int runBench(const Options& o) {
       }));
     }
 
-    uint64_t occA = 0, occB = 0, occC = 0, occD = 0, agreeB = 0, agreeC = 0, agreeD = 0;
+    uint64_t occA = 0, occB = 0, occC = 0, occD = 0, occE = 0, agreeB = 0, agreeC = 0, agreeD = 0, agreeE = 0;
     for (size_t i = 0; i < n; ++i) {
-      const bool a = ref[i] != 0, b = nearest[i] != 0, c = single[i] != 0, d = vis[i] < 0.5f;
+      const bool a = ref[i] != 0, b = nearest[i] != 0, c = single[i] != 0, d = vis[i] < 0.5f, e = placed[i] != 0;
       occA += a;
       occB += b;
       occC += c;
       occD += d;
+      occE += e;
       agreeB += a == b;
       agreeC += a == c;
       agreeD += a == d;
+      agreeE += a == e;
     }
     const double mr = double(n) / 1e6;
     auto row = [&](const char* query, double t, uint64_t occ, const std::string& agree) {
@@ -185,6 +199,7 @@ int runBench(const Options& o) {
     row("(b) field occluded, batch, nearest", tb, occB, pct(agreeB));
     row("(c) field occluded, single ray, nearest", tc, occC, pct(agreeC));
     row("(d) field visibility, batch, interpolated", td, occD, pct(agreeD) + " (visibility < 0.5)");
+    row("(e) instance occluded, batch, nearest, world rays", te, occE, pct(agreeE));
     std::printf("| %s | (m) no query: one random read of the maps per ray | %.2f | %.2f | - | - |\n", set.name.c_str(),
                 mr / tm, ta / tm);
   }

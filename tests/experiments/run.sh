@@ -36,6 +36,12 @@ case "$case" in
     [ "$(answers stdout.txt | wc -l)" -eq 4 ] || { cat stdout.txt; fail "bench lacks the (b) and (d) rows"; }
     [ "$(answers stdout.txt)" = "$(answers small.txt)" ] \
       || { answers stdout.txt; answers small.txt; fail "batch answers depend on the call size"; }
+    # (e) takes the world-space rays to object space in the kernel, with the operations the bench
+    # used to make (b)'s rays: the same occluded and agreement figures.
+    figures() { grep -F "$2" "$1" | awk -F'|' '{print $2, $6, $7}'; }
+    [ "$(figures stdout.txt '(e) instance' | wc -l)" -eq 2 ] || { cat stdout.txt; fail "bench lacks the (e) rows"; }
+    [ "$(figures stdout.txt '(e) instance')" = "$(figures stdout.txt '(b) field')" ] \
+      || { cat stdout.txt; fail "instance batches answer otherwise than the field's"; }
     ;;
   images_do_not_depend_on_threads)
     "$exp" ao "${small[@]}" --rays 8 -j 1 -o one >/dev/null 2>&1 || fail "ao -j 1 failed"

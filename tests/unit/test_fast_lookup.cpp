@@ -483,6 +483,33 @@ void checkBatches(detail::KernelChoice) {
         ASSERT_EQ(hits[r].hit, single.hit) << "n " << n << " ray " << r;
         ASSERT_EQ(hits[r].t, single.t) << "n " << n << " ray " << r;
       }
+      // The field placed by an Instance: its nearest batches hand the kernel world-space rays,
+      // which it takes to object space lane by lane; its one-ray calls use RigidTransform.
+      const Instance inst{&*q, RigidTransform::fromAxisAngle({1, 2, 3}, 0.7f, {5, -2, 1}, 2.5f)};
+      std::vector<Ray> world(rays.size());
+      for (size_t r = 0; r < rays.size(); ++r)
+        world[r] = {inst.transform.toWorldPoint(rays[r].origin), inst.transform.toWorldVector(rays[r].direction),
+                    rays[r].tmin, rays[r].tmax};
+      for (size_t batch : {size_t(65), world.size()}) {
+        std::vector<uint8_t> occ(world.size());
+        for (size_t b = 0; b < world.size(); b += batch) {
+          const size_t e = std::min(world.size(), b + batch);
+          inst.occluded(std::span<const Ray>(world).subspan(b, e - b), std::span<uint8_t>(occ).subspan(b, e - b), o);
+          inst.intersect(std::span<const Ray>(world).subspan(b, e - b), std::span<QueryHit>(hits).subspan(b, e - b), o);
+        }
+        size_t hitCount = 0;
+        for (size_t r = 0; r < world.size(); ++r) {
+          const QueryHit single = inst.intersect(world[r], o);
+          ASSERT_EQ(hits[r].hit, single.hit) << "n " << n << " batch " << batch << " world ray " << r;
+          ASSERT_EQ(occ[r] != 0, single.hit) << "n " << n << " batch " << batch << " world ray " << r;
+          if (single.hit) {
+            ASSERT_EQ(hits[r].t, single.t) << "n " << n << " batch " << batch << " world ray " << r;
+            ASSERT_EQ(hits[r].point.x, single.point.x) << "n " << n << " batch " << batch << " world ray " << r;
+            ++hitCount;
+          }
+        }
+        EXPECT_GT(hitCount, world.size() / 10);
+      }
     }
   }
 }

@@ -158,6 +158,7 @@ class FieldQuery {
   void visibility(std::span<const Ray> rays, std::span<float> out, const QueryOptions& options = {}) const noexcept;
 
   struct Impl;  // opaque
+  friend struct Instance;  // (its batches reach the field's kernel with their transform)
 
  private:
   std::unique_ptr<Impl> impl_;
@@ -187,9 +188,10 @@ struct Instance {
   QueryHit intersect(const Ray& worldRay, const QueryOptions& options = {}) const noexcept;
   bool occluded(const Ray& worldRay, const QueryOptions& options = {}) const noexcept;
   float visibility(const Ray& worldRay, const QueryOptions& options = {}) const noexcept;
-  // Batches of world-space rays: transformed to object space a few hundred at a time and handed to
-  // the field's batch functions (out.size() must equal worldRays.size(); extra entries are
-  // ignored). The same answers as the one-ray functions above.
+  // Batches of world-space rays, as fast as the field's own (out.size() must equal
+  // worldRays.size(); extra entries are ignored): kNearest batches take each ray to object space
+  // in the field's batch kernel, kInterpolated ones a few hundred at a time. The same answers as
+  // the one-ray functions above.
   void intersect(std::span<const Ray> worldRays, std::span<QueryHit> out, const QueryOptions& options = {}) const noexcept;
   void occluded(std::span<const Ray> worldRays, std::span<uint8_t> out, const QueryOptions& options = {}) const noexcept;
   void visibility(std::span<const Ray> worldRays, std::span<float> out, const QueryOptions& options = {}) const noexcept;
