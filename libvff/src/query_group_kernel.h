@@ -19,8 +19,8 @@
 // lane computes bit for bit what prepare() computes for that ray. The one quantity of its own, a
 // candidate's score, uses the CPU's approximate reciprocal square root, which differs between
 // CPU makers and between rsqrtps and AVX-512's rsqrt14ps: it only decides which sample wins when
-// the lead is beyond its error bound, so the answers are the same everywhere, and only which rays
-// are redone can differ.
+// the lead is beyond its error bound (closer leads are settled by the reference's own scores), so
+// the answers are the same everywhere, and only which lanes are settled that way can differ.
 #pragma once
 
 #include <cstddef>
@@ -277,8 +277,8 @@ void lookupStep(const GroupTables& tb, size_t p, LookupQueue* q) {
     bestB = sel(better, b, bestB);
   }
   // No valid candidate (best - second is NaN) or a near tie: the reference's own scores decide
-  // (octaBestCandidate, one lane at a time: about 0.7% of random lanes); where there is no valid
-  // candidate the lane is redone.
+  // (octaBestCandidate, one lane at a time: well under 1% of random lanes); where there is no
+  // valid candidate the lane is redone.
   F tie = ngt(best - second, F(2.0f * kOctaScoreError) * l1);
   if (const unsigned settle = movemask(bandnot(redo, tie)); settle != 0) {
     alignas(64) float sa[L], sb[L], fa0[L], fb0[L];
