@@ -56,7 +56,9 @@ struct GroupTables {
   const uint8_t* texels = nullptr;
   int32_t mapBytes = 0;
   // Also decode the hit flags (Group::hits), as FieldQuery::Impl::hitsAt does: kUnorm8Diameter
-  // maps with byteTexels only, whose distance is code * distanceScale (code 255: a miss).
+  // maps with byteTexels only, whose distance is code * distanceScale (code 255: a miss). The
+  // kernel then leaves a Group's per-ray t0, lo, hi, len and inside unset, and with texels its
+  // packed k, i and j too: the caller needs them only for the rays it redoes, which prepare() fills.
   bool decodeHits = false;
   float distanceScale = 0;  // 2 R / 254, as FieldQuery::Impl::texel computes it
   // The rays are in world space (Instance batches): each lane first goes to object space as

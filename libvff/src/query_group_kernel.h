@@ -202,11 +202,13 @@ void sphereStep(const GroupTables& tb, const Ray* rays, Group* g, size_t r0, Loo
   const F eux = ((ox + wx * t0) - cx) * invR;
   const F euy = ((oy + wy * t0) - cy) * invR;
   const F euz = ((oz + wz * t0) - cz) * invR;
-  store(g->t0 + r0, t0);
-  store(g->lo + r0, lo);
-  store(g->hi + r0, tmaxL);
-  store(g->len + r0, len);
-  g->inside |= uint64_t(movemask(inside)) << r0;
+  if (!tb.decodeHits) {  // (see GroupTables::decodeHits)
+    store(g->t0 + r0, t0);
+    store(g->lo + r0, lo);
+    store(g->hi + r0, tmaxL);
+    store(g->len + r0, len);
+    g->inside |= uint64_t(movemask(inside)) << r0;
+  }
   const unsigned bits = movemask(live);
   if (bits == 0) return;
   g->reached |= uint64_t(bits) << r0;
@@ -360,9 +362,11 @@ void lookupStep(const GroupTables& tb, size_t p, LookupQueue* q) {
   redo = bor(redo, bor(nearEdge(x, fx), nearEdge(y, fy)));
   const F ok = bnot(redo);
   const F ti = band(ok, vmin(vmax(fx, zero), top)), tj = band(ok, vmin(vmax(fy, zero), top));
-  storeInt(reinterpret_cast<int32_t*>(q->k + p), band(ok, bestK));
-  storeInt(reinterpret_cast<int32_t*>(q->i + p), ti);
-  storeInt(reinterpret_cast<int32_t*>(q->j + p), tj);
+  if (!(tb.decodeHits && tb.texels)) {  // (see GroupTables::decodeHits)
+    storeInt(reinterpret_cast<int32_t*>(q->k + p), band(ok, bestK));
+    storeInt(reinterpret_cast<int32_t*>(q->i + p), ti);
+    storeInt(reinterpret_cast<int32_t*>(q->j + p), tj);
+  }
   q->redo[p / 64] |= uint64_t(movemask(redo)) << (p % 64);
   // Ask for the texels now: they arrive while the next group goes through the sphere and the
   // queue (FieldQuery decodes a group only after that).
@@ -409,10 +413,12 @@ void decodeGroupWith(const GroupTables& tb, Group* g) {
   // Not the padded lanes, nor the redone rays (the caller's).
   const uint64_t all = packedBits(count);
   const uint64_t keep = all & ~g->redo, laneBits = packedBits(L);
-  for (size_t p = count; p % L != 0; ++p) {  // lanes past `count`: read, then left out of `keep`
-    g->k[p] = 0;
-    g->t[p] = 0;
-    g->pt0[p] = g->plo[p] = g->phi[p] = g->pinside[p] = 0.0f;
+  if (count % L != 0) {  // lanes past `count`: read, then left out of `keep` (count + L <= the arrays' size)
+    static_assert(kGroupRays + Group::kSlack >= kGroupRays + L, "a vector fits past the last packed ray");
+    for (void* a : {static_cast<void*>(g->k + count), static_cast<void*>(g->t + count), static_cast<void*>(g->pt0 + count),
+                    static_cast<void*>(g->plo + count), static_cast<void*>(g->phi + count),
+                    static_cast<void*>(g->pinside + count)})
+      std::memset(a, 0, L * sizeof(float));
   }
   for (size_t p = 0; p < count; p += L) decodeStep<F>(tb, p, unsigned((keep >> p) & laneBits), g);
 }
@@ -470,9 +476,11 @@ void lookupQueueWith(const GroupTables& tb, LookupQueue* q, bool flush) {
     if (sg.first >= done) break;
     const uint32_t n = uint32_t(done - sg.first < sg.n ? done - sg.first : sg.n);
     Group* g = sg.group;
-    std::memcpy(g->k + sg.p0, q->k + sg.first, n * sizeof(uint32_t));
-    std::memcpy(g->i + sg.p0, q->i + sg.first, n * sizeof(uint32_t));
-    std::memcpy(g->j + sg.p0, q->j + sg.first, n * sizeof(uint32_t));
+    if (!(tb.decodeHits && tb.texels)) {  // (see GroupTables::decodeHits)
+      std::memcpy(g->k + sg.p0, q->k + sg.first, n * sizeof(uint32_t));
+      std::memcpy(g->i + sg.p0, q->i + sg.first, n * sizeof(uint32_t));
+      std::memcpy(g->j + sg.p0, q->j + sg.first, n * sizeof(uint32_t));
+    }
     std::memcpy(g->t + sg.p0, q->t + sg.first, n * sizeof(int32_t));
     g->redo |= (uint64_t(queueRedo >> sg.first) & packedBits(n)) << sg.p0;
     g->looked += n;
