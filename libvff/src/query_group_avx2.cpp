@@ -128,8 +128,8 @@ inline uint64_t F8::rayBits(const uint32_t* ray, unsigned bits) {
   // sllv gives 0 for shifts of 32 or more: the low word takes rays 0 .. 31, the high 32 .. 63.
   const __m256i lo = _mm256_and_si256(on, _mm256_sllv_epi32(one, r));
   const __m256i hi = _mm256_and_si256(on, _mm256_sllv_epi32(one, _mm256_sub_epi32(r, _mm256_set1_epi32(32))));
-  auto orLanes = [](__m256i v) {
-    __m128i x = _mm_or_si128(_mm256_castsi256_si128(v), _mm256_extracti128_si256(v, 1));
+  auto orLanes = [](__m256i w) {
+    __m128i x = _mm_or_si128(_mm256_castsi256_si128(w), _mm256_extracti128_si256(w, 1));
     x = _mm_or_si128(x, _mm_shuffle_epi32(x, 0x4E));
     x = _mm_or_si128(x, _mm_shuffle_epi32(x, 0xB1));
     return uint32_t(_mm_cvtsi128_si32(x));
