@@ -413,12 +413,12 @@ void decodeGroupWith(const GroupTables& tb, Group* g) {
   // Not the padded lanes, nor the redone rays (the caller's).
   const uint64_t all = packedBits(count);
   const uint64_t keep = all & ~g->redo, laneBits = packedBits(L);
-  if (count % L != 0) {  // lanes past `count`: read, then left out of `keep` (count + L <= the arrays' size)
-    static_assert(kGroupRays + Group::kSlack >= kGroupRays + L, "a vector fits past the last packed ray");
+  if (count % L != 0) {  // lanes past `count`: read, then left out of `keep`
+    static_assert(Group::kSlack >= L, "a whole vector fits past the last packed ray");
     for (void* a : {static_cast<void*>(g->k + count), static_cast<void*>(g->t + count), static_cast<void*>(g->pt0 + count),
                     static_cast<void*>(g->plo + count), static_cast<void*>(g->phi + count),
                     static_cast<void*>(g->pinside + count)})
-      std::memset(a, 0, L * sizeof(float));
+      std::memset(a, 0, L * 4);  // (4-byte entries)
   }
   for (size_t p = 0; p < count; p += L) decodeStep<F>(tb, p, unsigned((keep >> p) & laneBits), g);
 }
