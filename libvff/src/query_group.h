@@ -56,9 +56,7 @@ struct GroupTables {
   const uint8_t* texels = nullptr;
   int32_t mapBytes = 0;
   // Also decode the hit flags (Group::hits), as FieldQuery::Impl::hitsAt does: kUnorm8Diameter
-  // maps with byteTexels only, whose distance is code * distanceScale (code 255: a miss). The
-  // kernel then leaves a Group's per-ray t0, lo, hi, len and inside unset, and with texels its
-  // packed k, i and j too: the caller needs them only for the rays it redoes, which prepare() fills.
+  // maps with byteTexels only, whose distance is code * distanceScale (code 255: a miss).
   bool decodeHits = false;
   float distanceScale = 0;  // 2 R / 254, as FieldQuery::Impl::texel computes it
   // The rays are in world space (Instance batches): each lane first goes to object space as
@@ -118,6 +116,12 @@ struct LookupQueue {
 };
 
 namespace {  // (a copy per file: the AVX2 kernel's file must share no inline function with the rest)
+
+// What the kernel fills beyond Group::t and the hit flags. When it decodes the hits, the caller
+// needs a Group's per-ray t0, lo, hi, len and inside, and (texels set) its packed k, i and j, only
+// for the rays it redoes, which prepare() fills: the kernel leaves them unset.
+inline bool perRayState(const GroupTables& t) { return !t.decodeHits; }
+inline bool packedIndices(const GroupTables& t) { return !(t.decodeHits && t.texels); }
 
 // The bits of packed rays 0 .. count - 1 (count <= 64).
 inline uint64_t packedBits(size_t count) { return count >= 64 ? ~uint64_t(0) : (uint64_t(1) << count) - 1; }

@@ -202,7 +202,7 @@ void sphereStep(const GroupTables& tb, const Ray* rays, Group* g, size_t r0, Loo
   const F eux = ((ox + wx * t0) - cx) * invR;
   const F euy = ((oy + wy * t0) - cy) * invR;
   const F euz = ((oz + wz * t0) - cz) * invR;
-  if (!tb.decodeHits) {  // (see GroupTables::decodeHits)
+  if (perRayState(tb)) {
     store(g->t0 + r0, t0);
     store(g->lo + r0, lo);
     store(g->hi + r0, tmaxL);
@@ -362,7 +362,7 @@ void lookupStep(const GroupTables& tb, size_t p, LookupQueue* q) {
   redo = bor(redo, bor(nearEdge(x, fx), nearEdge(y, fy)));
   const F ok = bnot(redo);
   const F ti = band(ok, vmin(vmax(fx, zero), top)), tj = band(ok, vmin(vmax(fy, zero), top));
-  if (!(tb.decodeHits && tb.texels)) {  // (see GroupTables::decodeHits)
+  if (packedIndices(tb)) {
     storeInt(reinterpret_cast<int32_t*>(q->k + p), band(ok, bestK));
     storeInt(reinterpret_cast<int32_t*>(q->i + p), ti);
     storeInt(reinterpret_cast<int32_t*>(q->j + p), tj);
@@ -476,7 +476,7 @@ void lookupQueueWith(const GroupTables& tb, LookupQueue* q, bool flush) {
     if (sg.first >= done) break;
     const uint32_t n = uint32_t(done - sg.first < sg.n ? done - sg.first : sg.n);
     Group* g = sg.group;
-    if (!(tb.decodeHits && tb.texels)) {  // (see GroupTables::decodeHits)
+    if (packedIndices(tb)) {
       std::memcpy(g->k + sg.p0, q->k + sg.first, n * sizeof(uint32_t));
       std::memcpy(g->i + sg.p0, q->i + sg.first, n * sizeof(uint32_t));
       std::memcpy(g->j + sg.p0, q->j + sg.first, n * sizeof(uint32_t));

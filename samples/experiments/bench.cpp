@@ -13,7 +13,7 @@
 //   (c) FieldQuery::occluded, one ray per call, kNearest
 //   (d) FieldQuery::visibility, batch, kInterpolated
 //   (e) Instance::occluded, batch, kNearest, on the world-space rays (as (a)): the field placed by
-//       the object's rigid transform, which the batch applies to each ray
+//       the object's rigid transform, which the batch applies to each ray (--batch rays per call)
 //   (m) no query: one read of a random byte of the field's maps per ray, 64 requested at a time
 //       then read (as the batch does): the memory floor of any lookup into a table this size
 // plus the agreement of (b), (c), (d) > 0.5 and (e) with (a): the fraction of rays with the same answer.

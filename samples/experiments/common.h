@@ -231,7 +231,7 @@ struct Options {
   float aoDistance = 2.0f;
   // bench
   uint32_t benchRays = 1u << 21;
-  uint32_t benchBatch = 4096;  // rays per batch call in (b) and (d)
+  uint32_t benchBatch = 4096;  // rays per batch call in (b), (d) and (e)
   int repeat = 3;
 };
 

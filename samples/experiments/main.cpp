@@ -48,7 +48,7 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--bench-rays", o.benchRays, "bench: rays per ray set")->capture_default_str()
       ->check(CLI::Range(1u, 1u << 26));
-  app.add_option("--batch", o.benchBatch, "bench: rays per batch call in (b) and (d) (a renderer's call: a tile, a pixel)")
+  app.add_option("--batch", o.benchBatch, "bench: rays per batch call in (b), (d) and (e) (a renderer's call: a tile, a pixel)")
       ->capture_default_str()
       ->check(CLI::Range(1u, 1u << 26));
   app.add_option("--repeat", o.repeat, "bench: repetitions (best is reported)")->capture_default_str()

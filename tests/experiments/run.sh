@@ -32,15 +32,15 @@ case "$case" in
     "$exp" bench --mesh knot.obj --config 1090x16x16 --bench-rays 20000 --repeat 1 --batch 333 >small.txt 2>stderr.txt \
       || { cat stderr.txt; fail "bench --batch 333 failed"; }
     grep -q "333 rays per batch call" small.txt || { cat small.txt; fail "bench does not print its batch size"; }
-    answers() { grep -E '\((b|d)\) field' "$1" | awk -F'|' '{print $2, $3, $6, $7}'; }
-    [ "$(answers stdout.txt | wc -l)" -eq 4 ] || { cat stdout.txt; fail "bench lacks the (b) and (d) rows"; }
-    [ "$(answers stdout.txt)" = "$(answers small.txt)" ] \
-      || { answers stdout.txt; answers small.txt; fail "batch answers depend on the call size"; }
+    # figures FILE ROWS: ray set, occluded and agreement of the rows matching the regex ROWS, in order.
+    figures() { grep -E "$2" "$1" | awk -F'|' '{print $2, $6, $7}'; }
+    [ "$(figures stdout.txt '\((b|d)\) field' | wc -l)" -eq 4 ] || { cat stdout.txt; fail "bench lacks the (b) and (d) rows"; }
+    [ "$(figures stdout.txt '\((b|d)\) field')" = "$(figures small.txt '\((b|d)\) field')" ] \
+      || { cat stdout.txt small.txt; fail "batch answers depend on the call size"; }
     # (e) takes the world-space rays to object space in the kernel, with the operations the bench
     # used to make (b)'s rays: the same occluded and agreement figures.
-    figures() { grep -F "$2" "$1" | awk -F'|' '{print $2, $6, $7}'; }
-    [ "$(figures stdout.txt '(e) instance' | wc -l)" -eq 2 ] || { cat stdout.txt; fail "bench lacks the (e) rows"; }
-    [ "$(figures stdout.txt '(e) instance')" = "$(figures stdout.txt '(b) field')" ] \
+    [ "$(figures stdout.txt '\(e\) instance' | wc -l)" -eq 2 ] || { cat stdout.txt; fail "bench lacks the (e) rows"; }
+    [ "$(figures stdout.txt '\(e\) instance')" = "$(figures stdout.txt '\(b\) field')" ] \
       || { cat stdout.txt; fail "instance batches answer otherwise than the field's"; }
     ;;
   images_do_not_depend_on_threads)
