@@ -25,25 +25,42 @@ uint64_t Xxh3Stream::digest() const noexcept {
   return XXH3_64bits_digest(static_cast<const XXH3_state_t*>(state_));
 }
 
+namespace {
+
+// One compression context per thread, reset before each frame: a level-19 context holds megabytes
+// of tables, which were allocated and freed for every block. Only the level and the fixed
+// parameters set below shape a frame, so reusing a context gives the same bytes.
+ZSTD_CCtx* threadCCtx() {
+  thread_local const std::unique_ptr<ZSTD_CCtx, size_t (*)(ZSTD_CCtx*)> context(ZSTD_createCCtx(), ZSTD_freeCCtx);
+  return context.get();
+}
+
+}  // namespace
+
 Status compress(Codec codec, int level, std::span<const uint8_t> raw, std::vector<uint8_t>* out) {
   switch (codec) {
     case Codec::kStored:
       out->assign(raw.begin(), raw.end());
       return {};
     case Codec::kZstd: {
-      out->resize(ZSTD_compressBound(raw.size()));
-      ZSTD_CCtx* cctx = ZSTD_createCCtx();
+      ZSTD_CCtx* cctx = threadCCtx();
       if (!cctx) return makeError(Code::kOutOfMemory, "cannot create a zstd context");
+      ZSTD_CCtx_reset(cctx, ZSTD_reset_session_and_parameters);
       // Fixed parameters: the output depends only on the input, the level and the zstd version.
       ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, level);
       ZSTD_CCtx_setParameter(cctx, ZSTD_c_contentSizeFlag, 1);
       ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 0);
       ZSTD_CCtx_setParameter(cctx, ZSTD_c_dictIDFlag, 0);
-      size_t n = ZSTD_compress2(cctx, out->data(), out->size(), raw.data(), raw.size());
-      ZSTD_freeCCtx(cctx);
+      // The frame goes to a scratch buffer of the worst-case size (not cleared first), and *out
+      // gets exactly its bytes: a vector sized to the bound and shrunk would keep the bound's
+      // capacity, and a writer holding many compressed blocks at once would hold their raw size.
+      const size_t bound = ZSTD_compressBound(raw.size());
+      std::unique_ptr<uint8_t[]> frame(new (std::nothrow) uint8_t[bound]);
+      if (!frame) return makeError(Code::kOutOfMemory, "cannot allocate " + std::to_string(bound) + " bytes for a zstd frame");
+      const size_t n = ZSTD_compress2(cctx, frame.get(), bound, raw.data(), raw.size());
       if (ZSTD_isError(n))
         return makeError(Code::kInvalidArgument, std::string("zstd: ") + ZSTD_getErrorName(n));
-      out->resize(n);
+      out->assign(frame.get(), frame.get() + n);
       return {};
     }
   }

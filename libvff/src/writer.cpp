@@ -228,8 +228,20 @@ struct Writer::Impl {
     ps.index.assign(uint64_t(ps.blockCount) * kBlockEntrySize, 0);
   }
 
-  // Encodes and writes complete raw blocks (in order), compressing them on several threads.
+  // Encodes and writes complete raw blocks (in order), compressing them on several threads, a
+  // window of blocks at a time: at most a window's compressed blocks are held at once.
   Status writeBlocks(Plane p, const std::vector<std::span<const uint8_t>>& raws) {
+    const size_t threads = std::max(1u, std::thread::hardware_concurrency());
+    const size_t window = 8 * threads;
+    for (size_t first = 0; first < raws.size(); first += window) {
+      const size_t n = std::min(window, raws.size() - first);
+      Status st = writeWindow(p, std::span<const std::span<const uint8_t>>(raws).subspan(first, n), threads);
+      if (!st) return st;
+    }
+    return {};
+  }
+
+  Status writeWindow(Plane p, std::span<const std::span<const uint8_t>> raws, size_t threads) {
     PlaneState& ps = planes[size_t(p)];
     std::vector<std::vector<uint8_t>> stored(raws.size());
     std::vector<Codec> codecs(raws.size(), options.codec);
@@ -259,7 +271,7 @@ struct Writer::Impl {
           }
         }
       };
-      const size_t nThreads = std::min<size_t>(raws.size(), std::max(1u, std::thread::hardware_concurrency()));
+      const size_t nThreads = std::min(raws.size(), threads);
       std::vector<std::thread> pool;
       for (size_t t = 1; t < nThreads; ++t) pool.emplace_back(work);
       work();

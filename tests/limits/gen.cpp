@@ -437,6 +437,13 @@ const std::map<std::string, std::function<Bytes()>> kInputs = {
        v.seal();
        return v.b;
      }},
+    {"vff-miss-blocks-128mib.vff", [] {  // as above with 32768 maps: a valid all-miss field of 128 MiB in
+       Vff v = base(false);                // 512 blocks of 256 KiB, for the peak of a whole-field rewrite
+       claimField(v, fibonacci(1u << 15, 64));
+       setBlocks(v, 64, 0xFF);
+       v.seal();
+       return v.b;
+     }},
     {"vff-block-frame-stored.vff", [] {  // a 256-byte block whose frame claims 4294963200 bytes
        Vff v = base(false);
        v.setLastBlock(kTagDistance, 0, zstdFrameClaiming(kBigRaw, 16), 256);
