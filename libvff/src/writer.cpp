@@ -229,14 +229,19 @@ struct Writer::Impl {
   }
 
   // Encodes and writes complete raw blocks (in order), compressing them on several threads, a
-  // window of blocks at a time: at most a window's compressed blocks are held at once.
+  // window of blocks at a time: at least one block per thread and kWindowBytes of raw bytes, so
+  // that the compressed blocks held at once stay within about that (a frame kept is smaller than
+  // its block) while each thread's zstd context serves many blocks.
+  static constexpr uint64_t kWindowBytes = 32u << 20;
   Status writeBlocks(Plane p, const std::vector<std::span<const uint8_t>>& raws) {
     const size_t threads = std::max(1u, std::thread::hardware_concurrency());
-    const size_t window = 8 * threads;
-    for (size_t first = 0; first < raws.size(); first += window) {
-      const size_t n = std::min(window, raws.size() - first);
+    for (size_t first = 0; first < raws.size();) {
+      size_t n = 0;
+      uint64_t bytes = 0;
+      while (first + n < raws.size() && (n < threads || bytes < kWindowBytes)) bytes += raws[first + n++].size();
       Status st = writeWindow(p, std::span<const std::span<const uint8_t>>(raws).subspan(first, n), threads);
       if (!st) return st;
+      first += n;
     }
     return {};
   }
