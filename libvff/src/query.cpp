@@ -171,19 +171,13 @@ struct FieldQuery::Impl {
   // decodeHits: also decode the hit flags in the kernel, where it can (kUnorm8Diameter).
   detail::GroupTables groupTables(const QueryOptions& o, bool decodeHits) const noexcept;
   QueryHit interpolated(const Ray& ray, const Lookup& l, float* visibility) const noexcept;
-  // interpolated() in two halves (see there).
-  struct InterpPlan {
-    struct Tap {
-      uint32_t k = 0;      // the sample
-      int ix = 0, iy = 0;  // its lower-left texel of the bilinear footprint (before clamping)
-      float fx = 0, fy = 0, weight = 0, base = 0;
-    };
-    uint32_t count = 0;
-    Tap taps[1 + kNeighbours];
-  };
-  void planInterpolated(const Ray& ray, const Lookup& l, InterpPlan* plan) const noexcept;
-  void prefetchPlan(const InterpPlan& plan) const noexcept;
-  QueryHit blendInterpolated(const Ray& ray, const Lookup& l, const InterpPlan& plan, float* visibility) const noexcept;
+  // interpolated() in two halves (see there), for lane `lane` of a block of plans (a batch plans
+  // detail::kPlanLanes rays at once: detail::planGroup).
+  void planInterpolated(const Ray& ray, const Lookup& l, detail::PlanBlock* plan, size_t lane) const noexcept;
+  void prefetchPlan(const detail::PlanBlock& plan, size_t lane) const noexcept;
+  QueryHit blendInterpolated(const Ray& ray, const Lookup& l, const detail::PlanBlock& plan, size_t lane,
+                             float* visibility) const noexcept;
+  detail::PlanTables planTables() const noexcept;
   template <class Emit>
   void batchInterpolated(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept;
   // Runs the group kernel over rays, kGroupRays at a time: each(base, n, group), where bit r of
@@ -531,75 +525,87 @@ QueryHit FieldQuery::Impl::query(const Ray& ray, const QueryOptions& o, float* v
 // rays) with miss-aware bilinear weights; each hit point is projected onto the ray. In two halves,
 // so that a batch can fetch the texels of many rays at once: planInterpolated() finds the samples
 // and their texels, blendInterpolated() reads and blends them.
-void FieldQuery::Impl::planInterpolated(const Ray& ray, const Lookup& l, InterpPlan* plan) const noexcept {
+void FieldQuery::Impl::planInterpolated(const Ray& ray, const Lookup& l, detail::PlanBlock* plan,
+                                        size_t lane) const noexcept {
+  static_assert(detail::kPlanSlots == 1 + kNeighbours, "a slot per candidate sample");
   const Vec3 eu = l.eu, v = l.v, w = l.w;
   auto kernel = [&](uint32_t k) {
     const Vec3 d = eu - unit(k);
     const float x = 1.0f - dot(d, d) / kernelRadius2;
     return x > 0 ? x * x : 0.0f;
   };
-  uint32_t ks[1 + kNeighbours];
-  float kw[1 + kNeighbours];
-  uint32_t kc = 0;
-  ks[kc] = l.k0;
-  kw[kc++] = std::max(kernel(l.k0), 1e-6f);  // the nearest sample always contributes
+  uint32_t mask = 0;
+  // Slot 0: the nearest sample, which always contributes; slot 1 + c: its neighbour c.
   const uint32_t* nb = &neighbours[size_t(l.k0) * kNeighbours];
-  for (uint32_t c = 0; c < kNeighbours && nb[c] != UINT32_MAX; ++c) {
-    const float wk = kernel(nb[c]);
-    if (wk > 0) {
-      ks[kc] = nb[c];
-      kw[kc++] = wk;
-    }
-  }
-  plan->count = 0;
-  for (uint32_t c = 0; c < kc; ++c) {
-    const uint32_t k = ks[c];
+  for (uint32_t c = 0; c < detail::kPlanSlots; ++c) {
+    const uint32_t k = c == 0 ? l.k0 : nb[c - 1];
+    if (k == UINT32_MAX) break;
+    const float weight = c == 0 ? std::max(kernel(k), 1e-6f) : kernel(k);
+    if (!(weight > 0)) continue;
     const Vec3 local = toLocal(frames[k], v);
     if (local.z <= 0) continue;  // the sample does not see this direction
     const Vec2 uv = detail::hemisphereToSquareFast(field.directionScheme, local);
     const float x = (uv.x + 1.0f) * 0.5f * float(m) - 0.5f;
     const float y = (uv.y + 1.0f) * 0.5f * float(m) - 0.5f;
     const float fx0 = std::floor(x), fy0 = std::floor(y);
-    InterpPlan::Tap& tap = plan->taps[plan->count++];
-    tap.k = k;
-    tap.weight = kw[c];
-    tap.fx = x - fx0;
-    tap.fy = y - fy0;
-    tap.ix = int(fx0);
-    tap.iy = int(fy0);
-    tap.base = dot(samplePoint(k) - ray.origin, w);  // t of the sample point, projected on the ray
+    mask |= 1u << c;
+    plan->k[c][lane] = int32_t(k);
+    plan->weight[c][lane] = weight;
+    plan->fx[c][lane] = x - fx0;
+    plan->fy[c][lane] = y - fy0;
+    plan->ix[c][lane] = int32_t(fx0);
+    plan->iy[c][lane] = int32_t(fy0);
+    plan->base[c][lane] = dot(samplePoint(k) - ray.origin, w);  // t of the sample point, projected on the ray
+  }
+  plan->mask[lane] = mask;
+}
+
+detail::PlanTables FieldQuery::Impl::planTables() const noexcept {
+  detail::PlanTables t;
+  t.unit4 = unit4.data();
+  t.neighbours = neighbours.data();
+  t.kernelRadius2 = kernelRadius2;
+  t.center = center;
+  t.radius = radius;
+  t.m = m;
+  t.scheme = field.directionScheme;
+  return t;
+}
+
+void FieldQuery::Impl::prefetchPlan(const detail::PlanBlock& plan, size_t lane) const noexcept {
+  for (uint32_t bits = plan.mask[lane]; bits != 0; bits &= bits - 1) {
+    const unsigned c = unsigned(__builtin_ctz(bits));
+    const uint32_t k = uint32_t(plan.k[c][lane]);
+    const uint32_t ti = uint32_t(std::clamp(plan.ix[c][lane], 0, int(m) - 1));
+    __builtin_prefetch(texelAddress(k, ti, uint32_t(std::clamp(plan.iy[c][lane], 0, int(m) - 1))));
+    __builtin_prefetch(texelAddress(k, ti, uint32_t(std::clamp(plan.iy[c][lane] + 1, 0, int(m) - 1))));
   }
 }
 
-void FieldQuery::Impl::prefetchPlan(const InterpPlan& plan) const noexcept {
-  for (uint32_t c = 0; c < plan.count; ++c) {
-    const InterpPlan::Tap& tap = plan.taps[c];
-    const uint32_t ti = uint32_t(std::clamp(tap.ix, 0, int(m) - 1));
-    __builtin_prefetch(texelAddress(tap.k, ti, uint32_t(std::clamp(tap.iy, 0, int(m) - 1))));
-    __builtin_prefetch(texelAddress(tap.k, ti, uint32_t(std::clamp(tap.iy + 1, 0, int(m) - 1))));
-  }
-}
-
-QueryHit FieldQuery::Impl::blendInterpolated(const Ray& ray, const Lookup& l, const InterpPlan& plan,
-                                             float* visibility) const noexcept {
+QueryHit FieldQuery::Impl::blendInterpolated(const Ray& ray, const Lookup& l, const detail::PlanBlock& plan,
+                                             size_t lane, float* visibility) const noexcept {
   QueryHit out;
   const float lo = l.lo, hi = l.hi;
   const float along = l.inside ? -1.0f : 1.0f;  // t per unit distance along v
   Blend bl;
-  for (uint32_t c = 0; c < plan.count; ++c) {
-    const InterpPlan::Tap& tap = plan.taps[c];
+  for (uint32_t bits = plan.mask[lane]; bits != 0; bits &= bits - 1) {
+    const unsigned c = unsigned(__builtin_ctz(bits));
+    const uint32_t k = uint32_t(plan.k[c][lane]);
+    const float fx = plan.fx[c][lane], fy = plan.fy[c][lane], weight = plan.weight[c][lane];
+    const float base = plan.base[c][lane];
+    const int ix = plan.ix[c][lane], iy = plan.iy[c][lane];
     for (int dj = 0; dj < 2; ++dj) {
       for (int di = 0; di < 2; ++di) {
-        const float bw = tap.weight * (di ? tap.fx : 1.0f - tap.fx) * (dj ? tap.fy : 1.0f - tap.fy);
+        const float bw = weight * (di ? fx : 1.0f - fx) * (dj ? fy : 1.0f - fy);
         if (bw <= 0) continue;
-        const uint32_t ti = uint32_t(std::clamp(tap.ix + di, 0, int(m) - 1));
-        const uint32_t tj = uint32_t(std::clamp(tap.iy + dj, 0, int(m) - 1));
-        const Sample s = texel(tap.k, ti, tj);
+        const uint32_t ti = uint32_t(std::clamp(ix + di, 0, int(m) - 1));
+        const uint32_t tj = uint32_t(std::clamp(iy + dj, 0, int(m) - 1));
+        const Sample s = texel(k, ti, tj);
         if (!s.hit) {
           bl.missWeight += bw;
           continue;
         }
-        const float t = tap.base + along * s.distance;
+        const float t = base + along * s.distance;
         if (t > hi) {
           bl.farWeight += bw;
         } else if (t < lo) {
@@ -607,7 +613,7 @@ QueryHit FieldQuery::Impl::blendInterpolated(const Ray& ray, const Lookup& l, co
         } else {
           bl.hitWeight += bw;
           bl.tSum += bw * t;
-          if (!norm.empty()) bl.normalSum = bl.normalSum + normalAt(tap.k, ti, tj) * bw;
+          if (!norm.empty()) bl.normalSum = bl.normalSum + normalAt(k, ti, tj) * bw;
         }
       }
     }
@@ -631,20 +637,20 @@ QueryHit FieldQuery::Impl::blendInterpolated(const Ray& ray, const Lookup& l, co
 }
 
 QueryHit FieldQuery::Impl::interpolated(const Ray& ray, const Lookup& l, float* visibility) const noexcept {
-  InterpPlan plan;
-  planInterpolated(ray, l, &plan);
-  return blendInterpolated(ray, l, plan, visibility);
+  detail::PlanBlock plan;  // (lane 0 only)
+  planInterpolated(ray, l, &plan, 0);
+  return blendInterpolated(ray, l, plan, 0, visibility);
 }
 
 // Batches of interpolated lookups. The group kernel finds, for 64 rays at a time, those that reach
-// the sphere and their nearest samples; then 16 at a time are planned with all their taps' texels
-// requested from memory, and blended. Rays from inside the sphere are answered as kNearest
-// (query()).
+// the sphere and their nearest samples; then 16 at a time are planned together (detail::planGroup,
+// as planInterpolated() one ray at a time) with all their taps' texels requested from memory, and
+// blended. Rays from inside the sphere are answered as kNearest (query()).
 template <class Emit>
 void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept {
-  constexpr size_t kPlanned = 16;
+  constexpr size_t kPlanned = detail::kPlanLanes;
   Lookup l[kPlanned];
-  InterpPlan plan[kPlanned];
+  detail::PlanBlock plan;
   uint32_t which[kPlanned];
   bool live[kPlanned];
   auto finish = [&](size_t base, size_t count) {
@@ -652,18 +658,17 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
       const Ray& ray = rays[base + which[c]];
       float vis = 1.0f;
       QueryHit h;
-      if (live[c]) h = l[c].inside ? nearestHit(ray, l[c], &vis) : blendInterpolated(ray, l[c], plan[c], &vis);
+      if (live[c]) h = l[c].inside ? nearestHit(ray, l[c], &vis) : blendInterpolated(ray, l[c], plan, c, &vis);
       emit(base + which[c], h, vis);
     }
   };
-  auto start = [&](size_t base, size_t c) {
+  // Requests the texels of lane c (planned, where its ray starts outside the sphere).
+  auto request = [&](size_t c) {
     if (!live[c]) return;
-    if (l[c].inside) {
+    if (l[c].inside)
       __builtin_prefetch(texelAddress(l[c].k0, l[c].i, l[c].j));
-    } else {
-      planInterpolated(rays[base + which[c]], l[c], &plan[c]);
-      prefetchPlan(plan[c]);
-    }
+    else
+      prefetchPlan(plan, c);
   };
   if (!detail::groupKernelAvailable()) {
     for (size_t base = 0; base < rays.size(); base += kPlanned) {
@@ -671,31 +676,58 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
       for (size_t r = 0; r < n; ++r) {
         which[r] = uint32_t(r);
         live[r] = prepare(rays[base + r], o, &l[r]);
-        start(base, r);
+        if (live[r] && !l[r].inside) planInterpolated(rays[base + r], l[r], &plan, r);
+        request(r);
       }
       finish(base, n);
     }
     return;
   }
+  const detail::PlanTables tables = planTables();
   forEachGroup(rays, groupTables(o, false), [&](size_t base, size_t n, detail::Group& g) {
     for (size_t r = 0; r < n; ++r)
       if (!((g.reached >> r) & 1u)) emit(base + r, QueryHit{}, 1.0f);
     for (uint32_t first = 0; first < g.count; first += kPlanned) {
       const size_t count = std::min<size_t>(kPlanned, g.count - first);
+      detail::PlanRays in{};  // (lanes not planned: zero, inactive)
       for (size_t c = 0; c < count; ++c) {
         const uint32_t p = first + uint32_t(c), r = g.ray[p];
+        const Ray& ray = rays[base + r];
         which[c] = r;
         if ((g.redo >> p) & 1u) {
-          live[c] = prepare(rays[base + r], o, &l[c]);
+          live[c] = prepare(ray, o, &l[c]);
         } else {
           live[c] = true;
-          lookupFrom(rays[base + r], g.len[r], g.t0[r], (g.inside >> r) & 1u, g.lo[r], g.hi[r], &l[c]);
+          lookupFrom(ray, g.len[r], g.t0[r], (g.inside >> r) & 1u, g.lo[r], g.hi[r], &l[c]);
           l[c].k0 = g.k[p];
           l[c].i = g.i[p];
           l[c].j = g.j[p];
         }
-        start(base, c);
+        if (!live[c] || l[c].inside) continue;
+        in.eux[c] = l[c].eu.x;
+        in.euy[c] = l[c].eu.y;
+        in.euz[c] = l[c].eu.z;
+        in.vx[c] = l[c].v.x;
+        in.vy[c] = l[c].v.y;
+        in.vz[c] = l[c].v.z;
+        in.wx[c] = l[c].w.x;
+        in.wy[c] = l[c].w.y;
+        in.wz[c] = l[c].w.z;
+        in.ox[c] = ray.origin.x;
+        in.oy[c] = ray.origin.y;
+        in.oz[c] = ray.origin.z;
+        in.k0[c] = l[c].k0;
+        in.active[c] = 1;
       }
+      if (!detail::planGroup(tables, in, &plan)) {
+        for (size_t c = 0; c < count; ++c) {
+          if (in.active[c])
+            planInterpolated(rays[base + which[c]], l[c], &plan, c);
+          else
+            plan.mask[c] = 0;
+        }
+      }
+      for (size_t c = 0; c < count; ++c) request(c);
       finish(base, count);
     }
   });

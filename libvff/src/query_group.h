@@ -115,6 +115,44 @@ struct LookupQueue {
   uint32_t segments = 0;
 };
 
+// The plans of interpolated lookups (FieldQuery's kInterpolated), up to kPlanLanes rays at once,
+// slot by slot: slot 0 is the ray's nearest sample, slot 1 + c its neighbour c (the table of
+// PlanTables::neighbours). Bit c of mask[lane] says whether slot c of that ray is a tap (the
+// sample has a kernel weight > 0, or is the nearest, and sees the lookup direction); only those
+// slots are set. A tap's texel footprint is (ix, iy) .. (ix + 1, iy + 1) before clamping, with
+// fractions fx, fy; base is the sample point's distance along the ray. FieldQuery::Impl
+// blends the taps in slot order.
+inline constexpr size_t kPlanLanes = 16;
+inline constexpr size_t kPlanSlots = 1 + kQueryNeighbours;
+struct PlanBlock {
+  uint32_t mask[kPlanLanes];
+  int32_t k[kPlanSlots][kPlanLanes], ix[kPlanSlots][kPlanLanes], iy[kPlanSlots][kPlanLanes];
+  float fx[kPlanSlots][kPlanLanes], fy[kPlanSlots][kPlanLanes], weight[kPlanSlots][kPlanLanes],
+      base[kPlanSlots][kPlanLanes];
+};
+
+// What planGroup reads: plain tables owned by FieldQuery::Impl.
+struct PlanTables {
+  const float* unit4 = nullptr;          // as GroupTables::unit4
+  const uint32_t* neighbours = nullptr;  // kQueryNeighbours per map, UINT32_MAX pads (at the end)
+  float kernelRadius2 = 0;               // the interpolation kernel's squared chord radius
+  Vec3 center;
+  float radius = 0;
+  uint32_t m = 0;  // map resolution
+  DirectionScheme scheme = DirectionScheme::kInvalid;
+};
+
+// The rays to plan, lane by lane (FieldQuery::Impl::Lookup's eu, v, w and k0, and the ray's
+// origin); lanes with active[lane] == 0 get mask 0.
+struct PlanRays {
+  float eux[kPlanLanes], euy[kPlanLanes], euz[kPlanLanes];
+  float vx[kPlanLanes], vy[kPlanLanes], vz[kPlanLanes];
+  float wx[kPlanLanes], wy[kPlanLanes], wz[kPlanLanes];
+  float ox[kPlanLanes], oy[kPlanLanes], oz[kPlanLanes];
+  uint32_t k0[kPlanLanes];
+  uint32_t active[kPlanLanes];
+};
+
 namespace {  // (a copy per file: the AVX2 kernel's file must share no inline function with the rest)
 
 // What the kernel fills beyond Group::t and the hit flags. When it decodes the hits, the caller
@@ -167,5 +205,11 @@ void lookupQueue(const GroupTables& tables, LookupQueue* q, bool flush) noexcept
 // to 0). Best called some time after its lookup (FieldQuery hands a group over only after the
 // lookups of the next group), so that the texels have arrived.
 void decodeGroup(const GroupTables& tables, Group* g) noexcept;
+// The plans of rays' interpolated lookups (PlanBlock), as FieldQuery::Impl::planInterpolated
+// computes them one ray at a time, with the same binary32 operations in the same order (the
+// sample's frame from its position, as PositionSet::frame; concentric maps with atanUnit). False
+// (and *out untouched) where the kernel that runs has no planner (SSE2): the caller plans the
+// rays one at a time.
+bool planGroup(const PlanTables& tables, const PlanRays& rays, PlanBlock* out) noexcept;
 
 }  // namespace vff::detail

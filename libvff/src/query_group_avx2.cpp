@@ -176,6 +176,10 @@ void lookupQueueAvx2(const GroupTables& tables, LookupQueue* q, bool flush) noex
 
 void decodeGroupAvx2(const GroupTables& tables, Group* g) noexcept { decodeGroupWith<Pair<Pair<F8>>>(tables, g); }
 
+void planGroupAvx2(const PlanTables& tables, const PlanRays& rays, PlanBlock* out) noexcept {
+  planWith<F8>(tables, rays, out);
+}
+
 }  // namespace vff::detail
 
 #endif

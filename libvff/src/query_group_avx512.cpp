@@ -179,6 +179,10 @@ void lookupQueueAvx512(const GroupTables& tables, LookupQueue* q, bool flush) no
 
 void decodeGroupAvx512(const GroupTables& tables, Group* g) noexcept { decodeGroupWith<Pair<F16>>(tables, g); }
 
+void planGroupAvx512(const PlanTables& tables, const PlanRays& rays, PlanBlock* out) noexcept {
+  planWith<F16>(tables, rays, out);
+}
+
 }  // namespace vff::detail
 
 #endif

@@ -512,5 +512,111 @@ void lookupQueueWith(const GroupTables& tb, LookupQueue* q, bool flush) {
   q->size = uint32_t(left);
 }
 
+// floor(x) per lane, for |x| < 2^31 (floorPos truncates toward zero).
+template <class F>
+inline F floorV(F x) {
+  const F t = floorPos(x);
+  return sel(lt(x, t), t - F(1.0f), t);
+}
+
+// planGroup (query_group.h) with lanes F: each line mirrors a line of
+// FieldQuery::Impl::planInterpolated (its kernel weight, toLocal of the sample's frame,
+// hemisphereToSquareFast, the footprint and the sample point's distance along the ray) or of
+// frameFromNormal, with the same binary32 operations in the same order.
+template <class F>
+void planWith(const PlanTables& tb, const PlanRays& in, PlanBlock* out) {
+  constexpr size_t L = F::kLanes;
+  static_assert(kPlanLanes % L == 0, "whole vectors of lanes");
+  const F zero(0.0f), one(1.0f), half(0.5f), mone(-1.0f);
+  const F kr2(tb.kernelRadius2), minWeight(1e-6f), fm(float(tb.m));
+  const F cx(tb.center.x), cy(tb.center.y), cz(tb.center.z), radius(tb.radius);
+  for (size_t l = 0; l < kPlanLanes; ++l) out->mask[l] = 0;
+  for (size_t c0 = 0; c0 < kPlanLanes; c0 += L) {
+    const F eux = F::load(in.eux + c0), euy = F::load(in.euy + c0), euz = F::load(in.euz + c0);
+    const F vx = F::load(in.vx + c0), vy = F::load(in.vy + c0), vz = F::load(in.vz + c0);
+    const F wx = F::load(in.wx + c0), wy = F::load(in.wy + c0), wz = F::load(in.wz + c0);
+    const F ox = F::load(in.ox + c0), oy = F::load(in.oy + c0), oz = F::load(in.oz + c0);
+    for (size_t c = 0; c < kPlanSlots; ++c) {
+      // The slot's sample (the nearest, or neighbour c - 1 of it) and its position; lanes without
+      // one read sample 0 and are left out.
+      alignas(64) float ux[L], uy[L], uz[L];
+      alignas(64) int32_t ks[L], use[L];
+      for (size_t l = 0; l < L; ++l) {
+        const bool active = in.active[c0 + l] != 0;
+        uint32_t k = active ? in.k0[c0 + l] : 0;
+        if (c > 0 && active) k = tb.neighbours[size_t(k) * kQueryNeighbours + (c - 1)];
+        const bool ok = active && k != UINT32_MAX;
+        k = ok ? k : 0;
+        ks[l] = int32_t(k);
+        use[l] = ok ? 1 : 0;
+        ux[l] = tb.unit4[size_t(k) * 4];
+        uy[l] = tb.unit4[size_t(k) * 4 + 1];
+        uz[l] = tb.unit4[size_t(k) * 4 + 2];
+      }
+      const F ux0 = F::load(ux), uy0 = F::load(uy), uz0 = F::load(uz);
+      // The kernel weight: (1 - |eu - u|^2 / r^2)^2 where positive; the nearest sample at least 1e-6.
+      const F dx = eux - ux0, dy = euy - uy0, dz = euz - uz0;
+      const F x = one - (dx * dx + dy * dy + dz * dz) / kr2;
+      F weight = sel(gt(x, zero), x * x, zero);
+      F keep = eq(F::loadInt(use), one);
+      if (c == 0)
+        weight = maxStd(weight, minWeight);
+      else
+        keep = band(keep, gt(weight, zero));
+      if (movemask(keep) == 0) continue;
+      // The sample's frame (frameFromNormal of its inward normal) and the direction in it.
+      const F nx = vneg(ux0), ny = vneg(uy0), nz = vneg(uz0);
+      const F fs = sel(ge(nz, zero), one, mone);
+      const F fA = vneg(one / (fs + nz));
+      const F fk = nx * ny * fA;
+      const F tx = one + fs * nx * nx * fA, ty = fs * fk, tz = vneg(fs) * nx;
+      const F bx = fk, by = fs + ny * ny * fA, bz = vneg(ny);
+      const F lx = vx * tx + vy * ty + vz * tz;
+      const F ly = vx * bx + vy * by + vz * bz;
+      const F lz = vx * nx + vy * ny + vz * nz;
+      keep = bandnot(le(lz, zero), keep);  // the sample does not see this direction
+      const unsigned bits = movemask(keep);
+      if (bits == 0) continue;
+      // hemisphereToSquareFast.
+      const F z = vmax(lz, zero);
+      F a, b;
+      if (tb.scheme == DirectionScheme::kHemiOctahedral) {
+        const F hinv = one / (vabs(lx) + vabs(ly) + z);
+        const F hx = lx * hinv, hy = ly * hinv;
+        a = hx + hy;
+        b = hx - hy;
+      } else {
+        const F r = vsqrt(vmax(one - z, zero));
+        const F lax = vabs(lx), lay = vabs(ly);
+        const F kr = r * F(4.0f / 3.14159265358979323846f);
+        const F bigX = gt(lax, lay);
+        const F s = atanUnitV(sel(bigX, ly, lx) / sel(bigX, lx, ly)) * kr;
+        const F xNeg = lt(lx, zero), yNeg = lt(ly, zero);
+        a = sel(bigX, sel(xNeg, vneg(r), r), sel(yNeg, vneg(s), s));
+        b = sel(bigX, sel(xNeg, vneg(s), s), sel(yNeg, vneg(r), r));
+        const F axis = band(eq(lax, zero), eq(lay, zero));  // straight along n: (r, 0)
+        a = sel(axis, r, a);
+        b = sel(axis, zero, b);
+      }
+      a = vmin(vmax(a, mone), one);
+      b = vmin(vmax(b, mone), one);
+      // The bilinear footprint.
+      const F px = (a + one) * half * fm - half, py = (b + one) * half * fm - half;
+      const F fx0 = floorV(px), fy0 = floorV(py);
+      // The sample point's distance along the ray: (centre + u R - origin) . w.
+      const F sx = (cx + ux0 * radius) - ox, sy = (cy + uy0 * radius) - oy, sz = (cz + uz0 * radius) - oz;
+      const F base = sx * wx + sy * wy + sz * wz;
+      std::memcpy(out->k[c] + c0, ks, sizeof ks);
+      storeInt(out->ix[c] + c0, fx0);
+      storeInt(out->iy[c] + c0, fy0);
+      store(out->fx[c] + c0, px - fx0);
+      store(out->fy[c] + c0, py - fy0);
+      store(out->weight[c] + c0, weight);
+      store(out->base[c] + c0, base);
+      for (unsigned m = bits; m != 0; m &= m - 1) out->mask[c0 + unsigned(__builtin_ctz(m))] |= 1u << c;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace vff::detail
