@@ -8,7 +8,8 @@
 //
 // The vector type H (a float vector with +, -, *, / and the free functions used below, and static
 // load, loadInt, gatherBytes, compressIndex and rayBits) is defined by the including file, which
-// runs the kernel on lanes F = Pair<H> or Pair<Pair<H>>: two or four vectors side by side, so
+// runs the kernel on lanes F = Pair<H> or Pair<Pair<H>> (the interpolated planner, planWith, on
+// H itself, AVX2 and AVX-512 only): two or four vectors side by side, so
 // that the CPU overlaps their long dependency chains (the nearest sample, then the frame, then
 // the texel). With eight-lane vectors, 32 lanes run 1.2-1.3x faster than 8 on the aimed rays of
 // vff-experiments bench and 1.1x on its AO rays; with four-lane vectors 8 lanes beat 4 and 16;

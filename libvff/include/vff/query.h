@@ -43,7 +43,8 @@
 // time, in AVX-512 or AVX2 vectors where the CPU has them (8 in SSE2 vectors on other x86-64
 // CPUs), the rays that reach the sphere gathered from consecutive groups of 64 so that the
 // vectors are full, and fetch the texels from memory ahead of their use; kInterpolated batches
-// fetch the texels of 16 rays at once. They give bit for bit the answers of the one-ray
+// plan 16 rays at once (in AVX-512 or AVX2 lanes where the CPU has them) and fetch all their
+// texels before blending. They give bit for bit the answers of the one-ray
 // functions, several times faster (vff-experiments bench). Hand them thousands of rays per call
 // where you can: each call ends with its last rays in a part-filled vector (vff-experiments bench
 // --batch 256 against the default 4096). occluded() and visibility() with kNearest are fastest on
