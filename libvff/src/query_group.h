@@ -134,7 +134,7 @@ struct PlanBlock {
 // What planGroup reads: plain tables owned by FieldQuery::Impl.
 struct PlanTables {
   const float* unit4 = nullptr;          // as GroupTables::unit4
-  const uint32_t* neighbours = nullptr;  // kQueryNeighbours per map, UINT32_MAX pads (at the end)
+  const uint32_t* neighbours = nullptr;  // kQueryNeighbours per map; UINT32_MAX ends a list
   float kernelRadius2 = 0;               // the interpolation kernel's squared chord radius
   Vec3 center;
   float radius = 0;

@@ -537,15 +537,17 @@ void planWith(const PlanTables& tb, const PlanRays& in, PlanBlock* out) {
     const F vx = F::load(in.vx + c0), vy = F::load(in.vy + c0), vz = F::load(in.vz + c0);
     const F wx = F::load(in.wx + c0), wy = F::load(in.wy + c0), wz = F::load(in.wz + c0);
     const F ox = F::load(in.ox + c0), oy = F::load(in.oy + c0), oz = F::load(in.oz + c0);
+    unsigned ended = 0;  // bit l: lane l's neighbour list has ended (as planInterpolated's break)
     for (size_t c = 0; c < kPlanSlots; ++c) {
       // The slot's sample (the nearest, or neighbour c - 1 of it) and its position; lanes without
       // one read sample 0 and are left out.
       alignas(64) float ux[L], uy[L], uz[L];
       alignas(64) int32_t ks[L], use[L];
       for (size_t l = 0; l < L; ++l) {
-        const bool active = in.active[c0 + l] != 0;
+        const bool active = in.active[c0 + l] != 0 && !((ended >> l) & 1u);
         uint32_t k = active ? in.k0[c0 + l] : 0;
         if (c > 0 && active) k = tb.neighbours[size_t(k) * kQueryNeighbours + (c - 1)];
+        if (active && k == UINT32_MAX) ended |= 1u << l;
         const bool ok = active && k != UINT32_MAX;
         k = ok ? k : 0;
         ks[l] = int32_t(k);
