@@ -167,6 +167,53 @@ inline void toObjectLanes(const GroupTables& tb, F* ox, F* oy, F* oz, F* dx, F* 
   *dz = row(2, vx, vy, vz);
 }
 
+// v in the frame of the sample at unit position u: frameFromNormal of its inward normal -u (as
+// PositionSet::frame), then toLocal.
+template <class F>
+inline void toSampleFrame(F ux, F uy, F uz, F vx, F vy, F vz, F* lx, F* ly, F* lz) {
+  const F zero(0.0f), one(1.0f);
+  const F nx = vneg(ux), ny = vneg(uy), nz = vneg(uz);
+  const F fs = sel(ge(nz, zero), one, F(-1.0f));
+  const F fA = vneg(one / (fs + nz));
+  const F fk = nx * ny * fA;
+  const F tx = one + fs * nx * nx * fA, ty = fs * fk, tz = vneg(fs) * nx;
+  const F bx = fk, by = fs + ny * ny * fA, bz = vneg(ny);
+  *lx = vx * tx + vy * ty + vz * tz;
+  *ly = vx * bx + vy * by + vz * bz;
+  *lz = vx * nx + vy * ny + vz * nz;
+}
+
+// hemisphereToSquareFast (fast_lookup.h) per lane: the square point (a, b) of local direction l.
+// kAxis: also its answer (r, 0) for directions with x = y = 0 (the group kernel redoes those
+// lanes: they lie on the concentric map's octant diagonals).
+template <bool kAxis, class F>
+inline void hemisphereToSquareV(DirectionScheme scheme, F lx, F ly, F lz, F* a, F* b) {
+  const F zero(0.0f), one(1.0f), mone(-1.0f);
+  const F z = vmax(lz, zero);  // std::max(0.0f, z): 0 for NaN and -0
+  if (scheme == DirectionScheme::kHemiOctahedral) {
+    const F hinv = one / (vabs(lx) + vabs(ly) + z);
+    const F x = lx * hinv, y = ly * hinv;
+    *a = x + y;
+    *b = x - y;
+  } else {
+    const F r = vsqrt(vmax(one - z, zero));
+    const F lax = vabs(lx), lay = vabs(ly);
+    const F k = r * F(4.0f / 3.14159265358979323846f);
+    const F bigX = gt(lax, lay);
+    const F s = atanUnitV(sel(bigX, ly, lx) / sel(bigX, lx, ly)) * k;
+    const F xNeg = lt(lx, zero), yNeg = lt(ly, zero);
+    *a = sel(bigX, sel(xNeg, vneg(r), r), sel(yNeg, vneg(s), s));
+    *b = sel(bigX, sel(xNeg, vneg(s), s), sel(yNeg, vneg(r), r));
+    if (kAxis) {
+      const F axis = band(eq(lax, zero), eq(lay, zero));
+      *a = sel(axis, r, *a);
+      *b = sel(axis, zero, *b);
+    }
+  }
+  *a = vmin(vmax(*a, mone), one);
+  *b = vmin(vmax(*b, mone), one);
+}
+
 // Step 1 for F::kLanes rays starting at rays[0] (all readable), lanes r0 .. of g: the sphere;
 // appends the rays that reach it to g's packed rays and their lookups to q.
 template <class F>
@@ -321,36 +368,13 @@ void lookupStep(const GroupTables& tb, size_t p, LookupQueue* q) {
 
   // 3. The texel: the sample's frame (frameFromNormal of its inward normal, as
   // PositionSet::frame), toLocal, then texelFast.
-  const F nx = vneg(bestX), ny = vneg(bestY), nz = vneg(bestZ);
-  const F fs = sel(ge(nz, zero), one, F(-1.0f));
-  const F fA = vneg(one / (fs + nz));
-  const F fk = nx * ny * fA;
-  const F tx = one + fs * nx * nx * fA, ty = fs * fk, tz = vneg(fs) * nx;
-  const F bx = fk, by = fs + ny * ny * fA, bz = vneg(ny);
-  const F lx = vx * tx + vy * ty + vz * tz;
-  const F ly = vx * bx + vy * by + vz * bz;
-  const F lz = vx * nx + vy * ny + vz * nz;
-  const F z = vmax(lz, zero);  // std::max(0.0f, z): 0 for NaN and -0
-  F a, b;
-  if (tb.scheme == DirectionScheme::kHemiOctahedral) {
-    const F hinv = one / (vabs(lx) + vabs(ly) + z);
-    const F x = lx * hinv, y = ly * hinv;
-    a = x + y;
-    b = x - y;
-  } else {
-    const F r = vsqrt(vmax(one - z, zero));
+  F lx, ly, lz, a, b;
+  toSampleFrame(bestX, bestY, bestZ, vx, vy, vz, &lx, &ly, &lz);
+  hemisphereToSquareV<false>(tb.scheme, lx, ly, lz, &a, &b);
+  if (tb.scheme != DirectionScheme::kHemiOctahedral) {
     const F lax = vabs(lx), lay = vabs(ly);
     redo = bor(redo, ngt(vabs(lax - lay), F(1e-5f) * (lax + lay)));  // octant diagonals
-    const F k = r * F(4.0f / 3.14159265358979323846f);
-    const F bigX = gt(lax, lay);
-    const F s = atanUnitV(sel(bigX, ly, lx) / sel(bigX, lx, ly)) * k;
-    const F xNeg = lt(lx, zero), yNeg = lt(ly, zero);
-    a = sel(bigX, sel(xNeg, vneg(r), r), sel(yNeg, vneg(s), s));
-    b = sel(bigX, sel(xNeg, vneg(s), s), sel(yNeg, vneg(r), r));
   }
-  const F mone(-1.0f);
-  a = vmin(vmax(a, mone), one);
-  b = vmin(vmax(b, mone), one);
   const float fmS = float(tb.m);
   const F fm(fmS), half(0.5f);
   const F x = (a + one) * half * fm, y = (b + one) * half * fm;
@@ -528,7 +552,7 @@ template <class F>
 void planWith(const PlanTables& tb, const PlanRays& in, PlanBlock* out) {
   constexpr size_t L = F::kLanes;
   static_assert(kPlanLanes % L == 0, "whole vectors of lanes");
-  const F zero(0.0f), one(1.0f), half(0.5f), mone(-1.0f);
+  const F zero(0.0f), one(1.0f), half(0.5f);
   const F kr2(tb.kernelRadius2), minWeight(1e-6f), fm(float(tb.m));
   const F cx(tb.center.x), cy(tb.center.y), cz(tb.center.z), radius(tb.radius);
   for (size_t l = 0; l < kPlanLanes; ++l) out->mask[l] = 0;
@@ -567,42 +591,13 @@ void planWith(const PlanTables& tb, const PlanRays& in, PlanBlock* out) {
       else
         keep = band(keep, gt(weight, zero));
       if (movemask(keep) == 0) continue;
-      // The sample's frame (frameFromNormal of its inward normal) and the direction in it.
-      const F nx = vneg(ux0), ny = vneg(uy0), nz = vneg(uz0);
-      const F fs = sel(ge(nz, zero), one, mone);
-      const F fA = vneg(one / (fs + nz));
-      const F fk = nx * ny * fA;
-      const F tx = one + fs * nx * nx * fA, ty = fs * fk, tz = vneg(fs) * nx;
-      const F bx = fk, by = fs + ny * ny * fA, bz = vneg(ny);
-      const F lx = vx * tx + vy * ty + vz * tz;
-      const F ly = vx * bx + vy * by + vz * bz;
-      const F lz = vx * nx + vy * ny + vz * nz;
+      // The direction in the sample's frame.
+      F lx, ly, lz, a, b;
+      toSampleFrame(ux0, uy0, uz0, vx, vy, vz, &lx, &ly, &lz);
       keep = bandnot(le(lz, zero), keep);  // the sample does not see this direction
       const unsigned bits = movemask(keep);
       if (bits == 0) continue;
-      // hemisphereToSquareFast.
-      const F z = vmax(lz, zero);
-      F a, b;
-      if (tb.scheme == DirectionScheme::kHemiOctahedral) {
-        const F hinv = one / (vabs(lx) + vabs(ly) + z);
-        const F hx = lx * hinv, hy = ly * hinv;
-        a = hx + hy;
-        b = hx - hy;
-      } else {
-        const F r = vsqrt(vmax(one - z, zero));
-        const F lax = vabs(lx), lay = vabs(ly);
-        const F kr = r * F(4.0f / 3.14159265358979323846f);
-        const F bigX = gt(lax, lay);
-        const F s = atanUnitV(sel(bigX, ly, lx) / sel(bigX, lx, ly)) * kr;
-        const F xNeg = lt(lx, zero), yNeg = lt(ly, zero);
-        a = sel(bigX, sel(xNeg, vneg(r), r), sel(yNeg, vneg(s), s));
-        b = sel(bigX, sel(xNeg, vneg(s), s), sel(yNeg, vneg(r), r));
-        const F axis = band(eq(lax, zero), eq(lay, zero));  // straight along n: (r, 0)
-        a = sel(axis, r, a);
-        b = sel(axis, zero, b);
-      }
-      a = vmin(vmax(a, mone), one);
-      b = vmin(vmax(b, mone), one);
+      hemisphereToSquareV<true>(tb.scheme, lx, ly, lz, &a, &b);
       // The bilinear footprint.
       const F px = (a + one) * half * fm - half, py = (b + one) * half * fm - half;
       const F fx0 = floorV(px), fy0 = floorV(py);
