@@ -13,7 +13,9 @@
 // time). It leaves to the caller (bit `redo`) every ray on which a guard of fast_lookup.h trips or
 // whose scheme it does not handle, so that a group gives exactly the texel and the answer
 // prepare() and hitsAt() give (tests/unit/test_fast_lookup.cpp checks this ray by ray, with every
-// kernel). The kernel itself is query_group_kernel.h.
+// kernel). Interpolated batches then hand 16 of those rays at a time to planGroup(), which plans
+// their lookups (the taps) as FieldQuery::Impl::planInterpolated does, in AVX-512 or AVX2 lanes.
+// The kernel itself is query_group_kernel.h.
 #pragma once
 
 #include <cstddef>
