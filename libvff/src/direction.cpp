@@ -20,6 +20,16 @@ Frame frameFromNormal(Vec3 n) noexcept {
   return f;
 }
 
+Vec3 toLocal(const Frame& f, Vec3 w) noexcept {
+  return {w.x * f.t.x + w.y * f.t.y + w.z * f.t.z, w.x * f.b.x + w.y * f.b.y + w.z * f.b.z,
+          w.x * f.n.x + w.y * f.n.y + w.z * f.n.z};
+}
+
+Vec3 toWorld(const Frame& f, Vec3 l) noexcept {
+  return {l.x * f.t.x + l.y * f.b.x + l.z * f.n.x, l.x * f.t.y + l.y * f.b.y + l.z * f.n.y,
+          l.x * f.t.z + l.y * f.b.z + l.z * f.n.z};
+}
+
 Vec3 squareToHemisphere(DirectionScheme scheme, Vec2 uv) noexcept {
   const float a = std::clamp(uv.x, -1.0f, 1.0f), b = std::clamp(uv.y, -1.0f, 1.0f);
   if (scheme == DirectionScheme::kHemiOctahedral) {

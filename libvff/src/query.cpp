@@ -25,6 +25,14 @@ inline Vec3 operator*(Vec3 a, float s) { return {a.x * s, a.y * s, a.z * s}; }
 inline Vec3 operator-(Vec3 a) { return {-a.x, -a.y, -a.z}; }
 inline float dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
+// toLocal (direction.h), compiled here: the exported one is reached through the shared library's
+// PLT, which cost interpolated batches 4-16% (they call it for every candidate sample; in-process
+// A/B on vff-experiments bench rays). Same operations, and this file is built without contraction.
+inline Vec3 localOf(const Frame& f, Vec3 w) {
+  return {w.x * f.t.x + w.y * f.t.y + w.z * f.t.z, w.x * f.b.x + w.y * f.b.y + w.z * f.b.z,
+          w.x * f.n.x + w.y * f.n.y + w.z * f.n.z};
+}
+
 inline Vec3 normalize(Vec3 v) {
   const float l = std::sqrt(dot(v, v));
   return l > 0 ? v * (1.0f / l) : Vec3{};
@@ -484,7 +492,7 @@ bool FieldQuery::Impl::prepare(const Ray& ray, const QueryOptions& o, Lookup* l)
   if (!inside && t0 > tmax) return false;  // the sphere begins beyond the range
   lookupFrom(ray, len, t0, inside, lo, tmax, l);
   l->k0 = nearestSample(l->eu);
-  const Vec3 local = toLocal(frames[l->k0], l->v);
+  const Vec3 local = localOf(frames[l->k0], l->v);
   if (!detail::texelFast(field.directionScheme, local, m, &l->i, &l->j))
     squareToTexel(hemisphereToSquare(field.directionScheme, local), m, &l->i, &l->j);
   return true;
@@ -541,8 +549,8 @@ void FieldQuery::Impl::planInterpolated(const Ray& ray, const Lookup& l, detail:
     const uint32_t k = c == 0 ? l.k0 : nb[c - 1];
     if (k == UINT32_MAX) break;
     const float weight = c == 0 ? std::max(kernel(k), 1e-6f) : kernel(k);
-    if (!(weight > 0)) continue;
-    const Vec3 local = toLocal(frames[k], v);
+    if (c > 0 && !(weight > 0)) continue;  // (the nearest sample always contributes)
+    const Vec3 local = localOf(frames[k], v);
     if (local.z <= 0) continue;  // the sample does not see this direction
     const Vec2 uv = detail::hemisphereToSquareFast(field.directionScheme, local);
     const float x = (uv.x + 1.0f) * 0.5f * float(m) - 0.5f;
@@ -719,7 +727,9 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
         in.k0[c] = l[c].k0;
         in.active[c] = 1;
       }
-      if (!detail::planGroup(tables, in, &plan)) {
+      bool any = false;
+      for (size_t c = 0; c < count; ++c) any = any || in.active[c] != 0;
+      if (any && !detail::planGroup(tables, in, &plan)) {
         for (size_t c = 0; c < count; ++c) {
           if (in.active[c])
             planInterpolated(rays[base + which[c]], l[c], &plan, c);

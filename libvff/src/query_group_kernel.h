@@ -183,7 +183,8 @@ inline void toSampleFrame(F ux, F uy, F uz, F vx, F vy, F vz, F* lx, F* ly, F* l
   *lz = vx * nx + vy * ny + vz * nz;
 }
 
-// hemisphereToSquareFast (fast_lookup.h) per lane: the square point (a, b) of local direction l.
+// hemisphereToSquareFast (fast_lookup.h) per lane: the square point (a, b) of local direction l
+// (finite: the clamps take NaN to -1 or 1, where std::min and std::max keep it).
 // kAxis: also its answer (r, 0) for directions with x = y = 0 (the group kernel redoes those
 // lanes: they lie on the concentric map's octant diagonals).
 template <bool kAxis, class F>

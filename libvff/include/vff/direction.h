@@ -31,16 +31,9 @@ struct Frame {
 };
 Frame frameFromNormal(Vec3 n) noexcept;
 
-// Local (frame) coordinates <-> world coordinates: three dot products, each summed left to
-// right (inline: the query calls toLocal for every candidate sample of an interpolated lookup).
-inline Vec3 toLocal(const Frame& f, Vec3 w) noexcept {
-  return {w.x * f.t.x + w.y * f.t.y + w.z * f.t.z, w.x * f.b.x + w.y * f.b.y + w.z * f.b.z,
-          w.x * f.n.x + w.y * f.n.y + w.z * f.n.z};
-}
-inline Vec3 toWorld(const Frame& f, Vec3 l) noexcept {
-  return {l.x * f.t.x + l.y * f.b.x + l.z * f.n.x, l.x * f.t.y + l.y * f.b.y + l.z * f.n.y,
-          l.x * f.t.z + l.y * f.b.z + l.z * f.n.z};
-}
+// Local (frame) coordinates <-> world coordinates.
+Vec3 toLocal(const Frame& f, Vec3 world) noexcept;
+Vec3 toWorld(const Frame& f, Vec3 local) noexcept;
 
 // Square [-1,1]^2 -> unit local direction with z >= 0.
 Vec3 squareToHemisphere(DirectionScheme scheme, Vec2 uv) noexcept;
