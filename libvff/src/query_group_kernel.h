@@ -441,10 +441,10 @@ void decodeGroupWith(const GroupTables& tb, Group* g) {
   const uint64_t keep = all & ~g->redo, laneBits = packedBits(L);
   if (count % L != 0) {  // lanes past `count`: read, then left out of `keep`
     static_assert(Group::kSlack >= L, "a whole vector fits past the last packed ray");
-    for (void* a : {static_cast<void*>(g->k + count), static_cast<void*>(g->t + count), static_cast<void*>(g->pt0 + count),
-                    static_cast<void*>(g->plo + count), static_cast<void*>(g->phi + count),
-                    static_cast<void*>(g->pinside + count)})
-      std::memset(a, 0, L * 4);  // (4-byte entries)
+    // (Arrays, not braced lists: a std::initializer_list's inline accessors, emitted here at -O0,
+    // would be copies compiled for this file's instruction set.)
+    void* const tails[] = {g->k + count, g->t + count, g->pt0 + count, g->plo + count, g->phi + count, g->pinside + count};
+    for (void* a : tails) std::memset(a, 0, L * 4);  // (4-byte entries)
   }
   for (size_t p = 0; p < count; p += L) decodeStep<F>(tb, p, unsigned((keep >> p) & laneBits), g);
 }
@@ -486,7 +486,8 @@ void lookupQueueWith(const GroupTables& tb, LookupQueue* q, bool flush) {
   if (flush && done < size) {
     // Pad the last lanes with copies of the last entry (their answers are left out).
     done = size + (L - size % L);
-    for (float* a : {q->eux, q->euy, q->euz, q->vx, q->vy, q->vz})
+    float* const entries[] = {q->eux, q->euy, q->euz, q->vx, q->vy, q->vz};
+    for (float* a : entries)
       for (size_t p = size; p < done; ++p) a[p] = a[size - 1];
   }
   if (done == 0) return;
@@ -522,7 +523,8 @@ void lookupQueueWith(const GroupTables& tb, LookupQueue* q, bool flush) {
   // done + L <= kCapacity.)
   const size_t left = size - done;
   if (left) {
-    for (float* a : {q->eux, q->euy, q->euz, q->vx, q->vy, q->vz}) {
+    float* const entries[] = {q->eux, q->euy, q->euz, q->vx, q->vy, q->vz};
+    for (float* a : entries) {
       float moved[L];
       std::memcpy(moved, a + done, sizeof moved);
       std::memcpy(a, moved, sizeof moved);
