@@ -14,7 +14,9 @@
 // whose scheme it does not handle, so that a group gives exactly the texel and the answer
 // prepare() and hitsAt() give (tests/unit/test_fast_lookup.cpp checks this ray by ray, with every
 // kernel). Interpolated batches then hand 16 of those rays at a time to planGroup(), which plans
-// their lookups (the taps) as FieldQuery::Impl::planInterpolated does, in AVX-512 or AVX2 lanes.
+// their lookups (the taps) as FieldQuery::Impl::planInterpolated does, and over unorm8-diameter
+// maps to blendGroup(), which sums the taps' weights as blendInterpolated does, in AVX-512 or
+// AVX2 lanes.
 // The kernel itself is query_group_kernel.h.
 #pragma once
 
@@ -155,6 +157,26 @@ struct PlanRays {
   uint32_t active[kPlanLanes];
 };
 
+// What blendGroup reads: the distance maps back to back (GroupTables::texels), unorm8-diameter.
+struct BlendTables {
+  const uint8_t* texels = nullptr;
+  int32_t mapBytes = 0;
+  uint32_t m = 0;
+  float distanceScale = 0;  // 2 R / 254: a code's distance
+};
+
+// A block's rays, lane by lane (Lookup::lo and hi: the range of t along the unit direction).
+// Only rays from outside the sphere are blended (a tap's t is base + its distance).
+struct BlendRays {
+  float lo[kPlanLanes], hi[kPlanLanes];
+};
+
+// The weight sums of a block's blends, lane by lane: FieldQuery::Impl's Blend without the
+// normals and the weight of the hits before the range (which no answer reads).
+struct BlendSums {
+  float hit[kPlanLanes], miss[kPlanLanes], far[kPlanLanes], tSum[kPlanLanes];
+};
+
 namespace {  // (a copy per file: the AVX2 kernel's file must share no inline function with the rest)
 
 // What the kernel fills beyond Group::t and the hit flags. When it decodes the hits, the caller
@@ -213,5 +235,10 @@ void decodeGroup(const GroupTables& tables, Group* g) noexcept;
 // (and *out untouched) where the kernel that runs has no planner (SSE2): the caller plans the
 // rays one at a time.
 bool planGroup(const PlanTables& tables, const PlanRays& rays, PlanBlock* out) noexcept;
+// The weight sums of a block of plans (PlanBlock; lanes with mask 0 sum to zero), as
+// FieldQuery::Impl::blendInterpolated accumulates them one ray at a time: taps in slot order,
+// each tap's four texels in its order, with the same binary32 operations. False (and *out
+// untouched) where the kernel that runs has no blend (SSE2).
+bool blendGroup(const BlendTables& tables, const PlanBlock& plans, const BlendRays& rays, BlendSums* out) noexcept;
 
 }  // namespace vff::detail

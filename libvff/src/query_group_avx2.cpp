@@ -93,6 +93,15 @@ inline void gatherUnit(const float* unit4, F8 k, F8* x, F8* y, F8* z) {
   *z = _mm256_i32gather_ps(unit4 + 2, idx, 4);
 }
 
+// The words table[stride k + offset] as floats (UINT32_MAX as -1) for the lanes' k
+// (integer-valued floats) in `use`, 0 in the others.
+inline F8 gatherWord(const uint32_t* table, F8 k, int32_t stride, int32_t offset, F8 use) {
+  const __m256i idx =
+      _mm256_add_epi32(_mm256_mullo_epi32(_mm256_cvttps_epi32(k.v), _mm256_set1_epi32(stride)), _mm256_set1_epi32(offset));
+  return _mm256_cvtepi32_ps(_mm256_mask_i32gather_epi32(_mm256_setzero_si256(), reinterpret_cast<const int*>(table), idx,
+                                                        _mm256_castps_si256(use.v), 4));
+}
+
 // The union of the bytes table[idx] over the lanes in `use` (idx: integer-valued floats; reads
 // 4 bytes at table + idx).
 inline unsigned maskUnion(const uint8_t* table, F8 idx, F8 use) {
@@ -178,6 +187,10 @@ void decodeGroupAvx2(const GroupTables& tables, Group* g) noexcept { decodeGroup
 
 void planGroupAvx2(const PlanTables& tables, const PlanRays& rays, PlanBlock* out) noexcept {
   planWith<F8>(tables, rays, out);
+}
+
+void blendGroupAvx2(const BlendTables& tables, const PlanBlock& plans, const BlendRays& rays, BlendSums* out) noexcept {
+  blendWith<F8>(tables, plans, rays, out);
 }
 
 }  // namespace vff::detail

@@ -91,6 +91,14 @@ inline void gatherUnit(const float* unit4, F16 k, F16* x, F16* y, F16* z) {
   *z = _mm512_i32gather_ps(idx, unit4 + 2, 4);
 }
 
+// The words table[stride k + offset] as floats (UINT32_MAX as -1) for the lanes' k
+// (integer-valued floats) in `use`, 0 in the others.
+inline F16 gatherWord(const uint32_t* table, F16 k, int32_t stride, int32_t offset, F16 use) {
+  const __m512i idx =
+      _mm512_add_epi32(_mm512_mullo_epi32(_mm512_cvttps_epi32(k.v), _mm512_set1_epi32(stride)), _mm512_set1_epi32(offset));
+  return _mm512_cvtepi32_ps(_mm512_mask_i32gather_epi32(_mm512_setzero_si512(), laneMask(use), idx, table, 4));
+}
+
 // The union of the bytes table[idx] over the lanes in `use` (idx: integer-valued floats; reads
 // 4 bytes at table + idx).
 inline unsigned maskUnion(const uint8_t* table, F16 idx, F16 use) {
@@ -181,6 +189,10 @@ void decodeGroupAvx512(const GroupTables& tables, Group* g) noexcept { decodeGro
 
 void planGroupAvx512(const PlanTables& tables, const PlanRays& rays, PlanBlock* out) noexcept {
   planWith<F16>(tables, rays, out);
+}
+
+void blendGroupAvx512(const BlendTables& tables, const PlanBlock& plans, const BlendRays& rays, BlendSums* out) noexcept {
+  blendWith<F16>(tables, plans, rays, out);
 }
 
 }  // namespace vff::detail

@@ -8,8 +8,8 @@
 //
 // The vector type H (a float vector with +, -, *, / and the free functions used below, and static
 // load, loadInt, gatherBytes, compressIndex and rayBits) is defined by the including file, which
-// runs the kernel on lanes F = Pair<H> or Pair<Pair<H>> (the interpolated planner, planWith, on
-// H itself, AVX2 and AVX-512 only): two or four vectors side by side, so
+// runs the kernel on lanes F = Pair<H> or Pair<Pair<H>> (the interpolated planner and blend,
+// planWith and blendWith, on H itself, AVX2 and AVX-512 only): two or four vectors side by side, so
 // that the CPU overlaps their long dependency chains (the nearest sample, then the frame, then
 // the texel). With eight-lane vectors, 32 lanes run 1.2-1.3x faster than 8 on the aimed rays of
 // vff-experiments bench and 1.1x on its AO rays; with four-lane vectors 8 lanes beat 4 and 16;
@@ -564,31 +564,27 @@ void planWith(const PlanTables& tb, const PlanRays& in, PlanBlock* out) {
     const F vx = F::load(in.vx + c0), vy = F::load(in.vy + c0), vz = F::load(in.vz + c0);
     const F wx = F::load(in.wx + c0), wy = F::load(in.wy + c0), wz = F::load(in.wz + c0);
     const F ox = F::load(in.ox + c0), oy = F::load(in.oy + c0), oz = F::load(in.oz + c0);
-    unsigned ended = 0;  // bit l: lane l's neighbour list has ended (as planInterpolated's break)
+    // (k0 < 2^24: exact as a float.)
+    const F k0 = F::loadInt(reinterpret_cast<const int32_t*>(in.k0 + c0));
+    const F planned = eq(F::loadInt(reinterpret_cast<const int32_t*>(in.active + c0)), one);
+    F ended = zero;  // lanes whose neighbour list has ended (as planInterpolated's break)
     for (size_t c = 0; c < kPlanSlots; ++c) {
       // The slot's sample (the nearest, or neighbour c - 1 of it) and its position; lanes without
       // one read sample 0 and are left out.
-      alignas(64) float ux[L], uy[L], uz[L];
-      alignas(64) int32_t ks[L], use[L];
-      for (size_t l = 0; l < L; ++l) {
-        const bool active = in.active[c0 + l] != 0 && !((ended >> l) & 1u);
-        uint32_t k = active ? in.k0[c0 + l] : 0;
-        if (c > 0 && active) k = tb.neighbours[size_t(k) * kQueryNeighbours + (c - 1)];
-        if (active && k == UINT32_MAX) ended |= 1u << l;
-        const bool ok = active && k != UINT32_MAX;
-        k = ok ? k : 0;
-        ks[l] = int32_t(k);
-        use[l] = ok ? 1 : 0;
-        ux[l] = tb.unit4[size_t(k) * 4];
-        uy[l] = tb.unit4[size_t(k) * 4 + 1];
-        uz[l] = tb.unit4[size_t(k) * 4 + 2];
-      }
-      const F ux0 = F::load(ux), uy0 = F::load(uy), uz0 = F::load(uz);
+      const F active = bandnot(ended, planned);
+      F k = band(active, k0);
+      if (c > 0) k = gatherWord(tb.neighbours, k, int32_t(kQueryNeighbours), int32_t(c - 1), active);
+      const F end = band(active, eq(k, F(-1.0f)));  // UINT32_MAX
+      ended = bor(ended, end);
+      const F use = bandnot(end, active);
+      k = band(use, k);
+      F ux0, uy0, uz0;
+      gatherUnit(tb.unit4, k, &ux0, &uy0, &uz0);
       // The kernel weight: (1 - |eu - u|^2 / r^2)^2 where positive; the nearest sample at least 1e-6.
       const F dx = eux - ux0, dy = euy - uy0, dz = euz - uz0;
       const F x = one - (dx * dx + dy * dy + dz * dz) / kr2;
       F weight = sel(gt(x, zero), x * x, zero);
-      F keep = eq(F::loadInt(use), one);
+      F keep = use;
       if (c == 0)
         weight = maxStd(weight, minWeight);
       else
@@ -607,7 +603,7 @@ void planWith(const PlanTables& tb, const PlanRays& in, PlanBlock* out) {
       // The sample point's distance along the ray: (centre + u R - origin) . w.
       const F sx = (cx + ux0 * radius) - ox, sy = (cy + uy0 * radius) - oy, sz = (cz + uz0 * radius) - oz;
       const F base = sx * wx + sy * wy + sz * wz;
-      std::memcpy(out->k[c] + c0, ks, sizeof ks);
+      storeInt(out->k[c] + c0, k);
       storeInt(out->ix[c] + c0, fx0);
       storeInt(out->iy[c] + c0, fy0);
       store(out->fx[c] + c0, px - fx0);
@@ -616,6 +612,59 @@ void planWith(const PlanTables& tb, const PlanRays& in, PlanBlock* out) {
       store(out->base[c] + c0, base);
       for (unsigned m = bits; m != 0; m &= m - 1) out->mask[c0 + unsigned(__builtin_ctz(m))] |= 1u << c;
     }
+  }
+}
+
+// blendGroup (query_group.h) with lanes F: each lane accumulates its taps in slot order and each
+// tap's texels (ix, iy), (ix + 1, iy), (ix, iy + 1), (ix + 1, iy + 1) in that order, as
+// FieldQuery::Impl::blendInterpolated does, with the same binary32 operations (a texel's weight
+// (weight * wx) * wy; t = base + distance, the ray being from outside).
+template <class F>
+void blendWith(const BlendTables& tb, const PlanBlock& plan, const BlendRays& in, BlendSums* out) {
+  constexpr size_t L = F::kLanes;
+  static_assert(kPlanLanes % L == 0, "whole vectors of lanes");
+  const F zero(0.0f), one(1.0f), fm(float(tb.m)), top(float(tb.m) - 1.0f), scale(tb.distanceScale), missCode(255.0f);
+  for (size_t c0 = 0; c0 < kPlanLanes; c0 += L) {
+    const F lo = F::load(in.lo + c0), hi = F::load(in.hi + c0);
+    F hitW = zero, missW = zero, farW = zero, tSum = zero;
+    for (size_t c = 0; c < kPlanSlots; ++c) {
+      alignas(64) int32_t tap[L];
+      unsigned any = 0;
+      for (size_t l = 0; l < L; ++l) {
+        tap[l] = int32_t((plan.mask[c0 + l] >> c) & 1u);
+        any |= unsigned(tap[l]);
+      }
+      if (any == 0) continue;
+      // Lanes without this tap read texel 0 of map 0 and add nothing.
+      const F inSlot = eq(F::loadInt(tap), one);
+      const F k = band(inSlot, F::loadInt(plan.k[c] + c0));
+      const F ix = F::loadInt(plan.ix[c] + c0), iy = F::loadInt(plan.iy[c] + c0);
+      const F fx = F::load(plan.fx[c] + c0), fy = F::load(plan.fy[c] + c0);
+      const F weight = F::load(plan.weight[c] + c0), base = F::load(plan.base[c] + c0);
+      const F wx[2] = {one - fx, fx}, wy[2] = {one - fy, fy};
+      for (int dj = 0; dj < 2; ++dj) {
+        for (int di = 0; di < 2; ++di) {
+          const F bw = weight * wx[di] * wy[dj];
+          const F take = bandnot(le(bw, zero), inSlot);  // (blendInterpolated skips bw <= 0)
+          const F ti = vmin(vmax(ix + F(float(di)), zero), top), tj = vmin(vmax(iy + F(float(dj)), zero), top);
+          alignas(64) int32_t at[L];
+          storeTexelIndex(at, k, band(inSlot, tj * fm + ti), tb.mapBytes);
+          const F code = F::gatherBytes(tb.texels, at);
+          const F hit = bandnot(eq(code, missCode), take);
+          missW = sel(bandnot(hit, take), missW + bw, missW);
+          const F t = base + code * scale;
+          const F far = band(hit, gt(t, hi));  // beyond the range: unoccluded
+          farW = sel(far, farW + bw, farW);
+          const F counted = bandnot(bor(far, lt(t, lo)), hit);  // (before the range: left out)
+          hitW = sel(counted, hitW + bw, hitW);
+          tSum = sel(counted, tSum + bw * t, tSum);
+        }
+      }
+    }
+    store(out->hit + c0, hitW);
+    store(out->miss + c0, missW);
+    store(out->far + c0, farW);
+    store(out->tSum + c0, tSum);
   }
 }
 
