@@ -24,7 +24,7 @@ case "$case" in
       "$exp" "$e" "${small[@]}" --rays 4 -o out >stdout.txt 2>stderr.txt || { cat stderr.txt; fail "$e failed"; }
       [ -s "out/$e-table.md" ] || { ls out; fail "missing out/$e-table.md"; }
     done
-    "$exp" bench --mesh knot.obj --config 1090x16x16 --bench-rays 20000 --repeat 1 >stdout.txt 2>stderr.txt \
+    "$exp" bench --mesh knot.obj --config 1090x16x16 --bench-rays 20000 --repeat 1 -j 2 >stdout.txt 2>stderr.txt \
       || { cat stderr.txt; fail "bench failed"; }
     grep -q "Embree rtcOccluded1" stdout.txt || { cat stdout.txt; fail "bench prints no baseline"; }
     # Calls of 333 rays (groups and lookup vectors cut anywhere): the same occluded and agreement
@@ -42,6 +42,11 @@ case "$case" in
     [ "$(figures stdout.txt '\(e\) instance' | wc -l)" -eq 2 ] || { cat stdout.txt; fail "bench lacks the (e) rows"; }
     [ "$(figures stdout.txt '\(e\) instance')" = "$(figures stdout.txt '\(b\) field')" ] \
       || { cat stdout.txt; fail "instance batches answer otherwise than the field's"; }
+    # With two threads, (a) and (b) again on one thread: the same answers.
+    [ "$(figures stdout.txt '\(b1\) field' | wc -l)" -eq 2 ] || { cat stdout.txt; fail "bench lacks the one-thread (b1) rows"; }
+    [ "$(figures stdout.txt '\(b1\) field')" = "$(figures stdout.txt '\(b\) field')" ] \
+      || { cat stdout.txt; fail "one-thread batches answer otherwise"; }
+    grep -q '(a1) Embree rtcOccluded1, 1 thread' stdout.txt || { cat stdout.txt; fail "bench lacks the one-thread baseline"; }
     ;;
   images_do_not_depend_on_threads)
     "$exp" ao "${small[@]}" --rays 8 -j 1 -o one >/dev/null 2>&1 || fail "ao -j 1 failed"
