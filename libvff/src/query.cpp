@@ -660,22 +660,18 @@ QueryHit FieldQuery::Impl::interpolated(const Ray& ray, const Lookup& l, float* 
 // Batches of interpolated lookups. The group kernel finds, for 64 rays at a time, those that reach
 // the sphere and their nearest samples; then 16 at a time are planned together (detail::planGroup,
 // as planInterpolated() one ray at a time) with all their taps' texels requested from memory, and
-// blended together (detail::blendGroup, as blendInterpolated() one ray at a time). Rays from
-// inside the sphere are answered as kNearest (query()). (Blending a block while the next is
-// planned, so that its texels have longer to arrive, gained nothing: in-process A/B on
-// vff-experiments bench rays, 0.96-1.05x.)
+// blended, 16 at a time too where the kernel can (detail::blendGroup, as blendInterpolated() one
+// ray at a time). Rays from inside the sphere are answered as kNearest (query()). (Blending a
+// block while the next is planned, so that its texels had longer to arrive, gained nothing:
+// in-process A/B on vff-experiments bench rays, 0.96-1.05x.)
 template <class Emit>
 void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept {
   constexpr size_t kPlanned = detail::kPlanLanes;
-  struct Block {
-    Lookup l[kPlanned];
-    detail::PlanBlock plan{};  // (zero: the blend kernel reads the lanes of a slot it leaves out)
-    uint32_t which[kPlanned];  // the rays, from base
-    bool live[kPlanned];
-    size_t base = 0, count = 0;
-  };
-  Block b;
-  // The blend kernel: where a group kernel runs, on unorm8-diameter maps back to back without
+  Lookup l[kPlanned];
+  detail::PlanBlock plan{};  // (zeroed: the blend kernel reads every lane of a slot)
+  uint32_t which[kPlanned];
+  bool live[kPlanned];
+  // The blend kernel: where a group kernel runs, over unorm8-diameter maps back to back without
   // normals (it sums no normals).
   detail::BlendTables blendTables;
   if (detail::groupKernelAvailable() && contiguous && field.distanceEncoding == DistanceEncoding::kUnorm8Diameter &&
@@ -685,61 +681,58 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
     blendTables.m = m;
     blendTables.distanceScale = 2.0f * radius / 254.0f;
   }
-  // Answers the block, planned and its texels requested.
-  auto finish = [&] {
+  auto finish = [&](size_t base, size_t count) {
+    // The blends of the block's rays from outside the sphere, 16 at once where the kernel can.
     detail::BlendSums sums;
-    bool summed = false;  // sums holds the block's blends
+    bool summed = false;
     if (blendTables.texels) {
       bool any = false;
       detail::BlendRays br;
       for (size_t c = 0; c < kPlanned; ++c) {
-        const bool blended = c < b.count && b.live[c] && !b.l[c].inside;
+        const bool blended = c < count && live[c] && !l[c].inside;
         any = any || blended;
-        br.lo[c] = blended ? b.l[c].lo : 0.0f;
-        br.hi[c] = blended ? b.l[c].hi : 0.0f;
+        br.lo[c] = blended ? l[c].lo : 0.0f;
+        br.hi[c] = blended ? l[c].hi : 0.0f;
       }
-      summed = any && detail::blendGroup(blendTables, b.plan, br, &sums);
+      summed = any && detail::blendGroup(blendTables, plan, br, &sums);
     }
-    for (size_t c = 0; c < b.count; ++c) {
-      const Ray& ray = rays[b.base + b.which[c]];
+    for (size_t c = 0; c < count; ++c) {
+      const Ray& ray = rays[base + which[c]];
       float vis = 1.0f;
       QueryHit h;
-      if (b.live[c] && b.l[c].inside) {
-        h = nearestHit(ray, b.l[c], &vis);
-      } else if (b.live[c] && summed) {
+      if (live[c] && l[c].inside) {
+        h = nearestHit(ray, l[c], &vis);
+      } else if (live[c] && summed) {
         Blend bl;
         bl.hitWeight = sums.hit[c];
         bl.missWeight = sums.miss[c];
         bl.farWeight = sums.far[c];
         bl.tSum = sums.tSum[c];
-        h = blendResult(ray, b.l[c], bl, &vis);
-      } else if (b.live[c]) {
-        h = blendInterpolated(ray, b.l[c], b.plan, c, &vis);
+        h = blendResult(ray, l[c], bl, &vis);
+      } else if (live[c]) {
+        h = blendInterpolated(ray, l[c], plan, c, &vis);
       }
-      emit(b.base + b.which[c], h, vis);
+      emit(base + which[c], h, vis);
     }
   };
-  // Requests the texels of the block's lanes.
-  auto request = [&] {
-    for (size_t c = 0; c < b.count; ++c) {
-      if (!b.live[c]) continue;
-      if (b.l[c].inside)
-        __builtin_prefetch(texelAddress(b.l[c].k0, b.l[c].i, b.l[c].j));
-      else
-        prefetchPlan(b.plan, c);
-    }
+  // Requests the texels of lane c (planned, where its ray starts outside the sphere).
+  auto request = [&](size_t c) {
+    if (!live[c]) return;
+    if (l[c].inside)
+      __builtin_prefetch(texelAddress(l[c].k0, l[c].i, l[c].j));
+    else
+      prefetchPlan(plan, c);
   };
   if (!detail::groupKernelAvailable()) {
     for (size_t base = 0; base < rays.size(); base += kPlanned) {
-      b.base = base;
-      b.count = std::min(kPlanned, rays.size() - base);
-      for (size_t r = 0; r < b.count; ++r) {
-        b.which[r] = uint32_t(r);
-        b.live[r] = prepare(rays[base + r], o, &b.l[r]);
-        if (b.live[r] && !b.l[r].inside) planInterpolated(rays[base + r], b.l[r], &b.plan, r);
+      const size_t n = std::min(kPlanned, rays.size() - base);
+      for (size_t r = 0; r < n; ++r) {
+        which[r] = uint32_t(r);
+        live[r] = prepare(rays[base + r], o, &l[r]);
+        if (live[r] && !l[r].inside) planInterpolated(rays[base + r], l[r], &plan, r);
+        request(r);
       }
-      request();
-      finish();
+      finish(base, n);
     }
     return;
   }
@@ -749,53 +742,49 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
     for (size_t r = 0; r < n; ++r)
       if (!((g.reached >> r) & 1u)) emit(base + r, QueryHit{}, 1.0f);
     for (uint32_t first = 0; first < g.count; first += kPlanned) {
-      b.base = base;
-      b.count = std::min<size_t>(kPlanned, g.count - first);
+      const size_t count = std::min<size_t>(kPlanned, g.count - first);
       detail::PlanRays in{};  // (lanes not planned: zero, inactive)
-      for (size_t c = 0; c < b.count; ++c) {
+      for (size_t c = 0; c < count; ++c) {
         const uint32_t p = first + uint32_t(c), r = g.ray[p];
         const Ray& ray = rays[base + r];
-        Lookup& l = b.l[c];
-        b.which[c] = r;
+        which[c] = r;
         if ((g.redo >> p) & 1u) {
-          b.live[c] = prepare(ray, o, &l);
+          live[c] = prepare(ray, o, &l[c]);
         } else {
-          b.live[c] = true;
-          lookupFrom(ray, g.len[r], g.t0[r], (g.inside >> r) & 1u, g.lo[r], g.hi[r], &l);
-          l.k0 = g.k[p];
-          l.i = g.i[p];
-          l.j = g.j[p];
+          live[c] = true;
+          lookupFrom(ray, g.len[r], g.t0[r], (g.inside >> r) & 1u, g.lo[r], g.hi[r], &l[c]);
+          l[c].k0 = g.k[p];
+          l[c].i = g.i[p];
+          l[c].j = g.j[p];
         }
-        if (!b.live[c] || l.inside) continue;
-        in.eux[c] = l.eu.x;
-        in.euy[c] = l.eu.y;
-        in.euz[c] = l.eu.z;
-        in.vx[c] = l.v.x;
-        in.vy[c] = l.v.y;
-        in.vz[c] = l.v.z;
-        in.wx[c] = l.w.x;
-        in.wy[c] = l.w.y;
-        in.wz[c] = l.w.z;
+        if (!live[c] || l[c].inside) continue;
+        in.eux[c] = l[c].eu.x;
+        in.euy[c] = l[c].eu.y;
+        in.euz[c] = l[c].eu.z;
+        in.vx[c] = l[c].v.x;
+        in.vy[c] = l[c].v.y;
+        in.vz[c] = l[c].v.z;
+        in.wx[c] = l[c].w.x;
+        in.wy[c] = l[c].w.y;
+        in.wz[c] = l[c].w.z;
         in.ox[c] = ray.origin.x;
         in.oy[c] = ray.origin.y;
         in.oz[c] = ray.origin.z;
-        in.k0[c] = l.k0;
+        in.k0[c] = l[c].k0;
         in.active[c] = 1;
       }
       bool any = false;
-      for (size_t c = 0; c < b.count; ++c) any = any || in.active[c] != 0;
-      if (!any) {
-        for (size_t c = 0; c < kPlanned; ++c) b.plan.mask[c] = 0;
-      } else if (!(groupPlans && detail::planGroup(tables, in, &b.plan))) {
-        for (size_t c = 0; c < kPlanned; ++c) {
-          if (c < b.count && in.active[c])
-            planInterpolated(rays[base + b.which[c]], b.l[c], &b.plan, c);
+      for (size_t c = 0; c < count; ++c) any = any || in.active[c] != 0;
+      if (any && !(groupPlans && detail::planGroup(tables, in, &plan))) {
+        for (size_t c = 0; c < count; ++c) {
+          if (in.active[c])
+            planInterpolated(rays[base + which[c]], l[c], &plan, c);
           else
-            b.plan.mask[c] = 0;
+            plan.mask[c] = 0;
         }
       }
-      request();
-      finish();
+      for (size_t c = 0; c < count; ++c) request(c);
+      finish(base, count);
     }
   });
 }
