@@ -54,7 +54,8 @@ constexpr Kernel kSse2{"sse2", sphereGroupSse2, lookupQueueSse2, decodeGroupSse2
 constexpr Kernel kAvx2{"avx2", sphereGroupAvx2, lookupQueueAvx2, decodeGroupAvx2, planGroupAvx2, blendGroupAvx2};
 #endif
 #if defined(VFF_HAVE_AVX512_KERNEL)
-constexpr Kernel kAvx512{"avx512", sphereGroupAvx512, lookupQueueAvx512, decodeGroupAvx512, planGroupAvx512, blendGroupAvx512};
+constexpr Kernel kAvx512{"avx512", sphereGroupAvx512, lookupQueueAvx512, decodeGroupAvx512,
+                         planGroupAvx512, blendGroupAvx512};
 #endif
 
 // The kernels this CPU runs (decided once): null where it has not the instructions (or this
