@@ -89,8 +89,9 @@ struct FieldQuery::Impl {
   uint32_t m = 0;
   uint64_t distMapBytes = 0, normMapBytes = 0;
   std::vector<const uint8_t*> dist;  // per map
-  // GroupTables::byteTexels, and whether the maps lie back to back (GroupTables::texels).
-  bool byteTexels = false, contiguous = false;
+  // GroupTables::byteTexels, and whether the maps lie back to back (GroupTables::texels); the
+  // same for the normal maps (detail::BlendTables::normals).
+  bool byteTexels = false, contiguous = false, normalsContiguous = false;
   std::vector<const uint8_t*> norm;  // per map, empty without normals
   std::vector<Frame> frames;         // frame of map k (inward normal)
   std::vector<float> unit4;          // û_k, float, padded to 4 floats per map (for the group kernel)
@@ -304,6 +305,8 @@ void FieldQuery::Impl::build() {
                m <= 4096 && n > 0;
   contiguous = byteTexels && planeBytes >= 4 && planeBytes < (uint64_t(1) << 31);
   for (uint32_t k = 0; k < n && contiguous; ++k) contiguous = dist[k] == dist[0] + size_t(k) * distMapBytes;
+  normalsContiguous = !norm.empty() && uint64_t(n) * normMapBytes < (uint64_t(1) << 31);
+  for (uint32_t k = 0; k < n && normalsContiguous; ++k) normalsContiguous = norm[k] == norm[0] + size_t(k) * normMapBytes;
   frames.resize(n);
   unit4.assign(size_t(n) * 4, 0.0f);
   for (uint32_t k = 0; k < n; ++k) {
@@ -671,15 +674,19 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
   detail::PlanBlock plan{};  // (zeroed: the blend kernel reads every lane of a slot)
   uint32_t which[kPlanned];
   bool live[kPlanned];
-  // The blend kernel: where a group kernel runs, over unorm8-diameter maps back to back without
-  // normals (it sums no normals).
+  // The blend kernel: where a group kernel runs, over unorm8-diameter maps back to back (and their
+  // normal maps, if any, back to back too).
   detail::BlendTables blendTables;
   if (detail::groupKernelAvailable() && contiguous && field.distanceEncoding == DistanceEncoding::kUnorm8Diameter &&
-      norm.empty() && dist.size() < (size_t(1) << 24)) {  // (map indices exact in binary32)
+      (norm.empty() || normalsContiguous) && dist.size() < (size_t(1) << 24)) {  // (map indices exact in binary32)
     blendTables.texels = dist[0];
     blendTables.mapBytes = int32_t(distMapBytes);
     blendTables.m = m;
     blendTables.distanceScale = 2.0f * radius / 254.0f;
+    if (!norm.empty()) {
+      blendTables.normals = norm[0];
+      blendTables.normalMapBytes = int32_t(normMapBytes);
+    }
   }
   auto finish = [&](size_t base, size_t count) {
     // The blends of the block's rays from outside the sphere, 16 at once where the kernel can.
@@ -708,6 +715,7 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
         bl.missWeight = sums.miss[c];
         bl.farWeight = sums.far[c];
         bl.tSum = sums.tSum[c];
+        bl.normalSum = {sums.nx[c], sums.ny[c], sums.nz[c]};
         h = blendResult(ray, l[c], bl, &vis);
       } else if (live[c]) {
         h = blendInterpolated(ray, l[c], plan, c, &vis);

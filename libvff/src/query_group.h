@@ -15,8 +15,8 @@
 // prepare() and hitsAt() give (tests/unit/test_fast_lookup.cpp checks this ray by ray, with every
 // kernel). Interpolated batches then hand 16 of those rays at a time to planGroup(), which plans
 // their lookups (the taps) as FieldQuery::Impl::planInterpolated does, and over unorm8-diameter
-// maps to blendGroup(), which sums the taps' weights as blendInterpolated does, in AVX-512 or
-// AVX2 lanes.
+// maps to blendGroup(), which sums the taps' weights (and normals) as blendInterpolated does, in
+// AVX-512 or AVX2 lanes.
 // The kernel itself is query_group_kernel.h.
 #pragma once
 
@@ -157,12 +157,15 @@ struct PlanRays {
   uint32_t active[kPlanLanes];
 };
 
-// What blendGroup reads: the distance maps back to back (GroupTables::texels), unorm8-diameter.
+// What blendGroup reads: the distance maps back to back (GroupTables::texels), unorm8-diameter,
+// and the normal maps (oct-snorm16) back to back, or none.
 struct BlendTables {
   const uint8_t* texels = nullptr;
   int32_t mapBytes = 0;
   uint32_t m = 0;
   float distanceScale = 0;  // 2 R / 254: a code's distance
+  const uint8_t* normals = nullptr;  // null: no normal field
+  int32_t normalMapBytes = 0;
 };
 
 // A block's rays, lane by lane (Lookup::lo and hi: the range of t along the unit direction).
@@ -171,10 +174,11 @@ struct BlendRays {
   float lo[kPlanLanes], hi[kPlanLanes];
 };
 
-// The weight sums of a block's blends, lane by lane: FieldQuery::Impl's Blend without the
-// normals and the weight of the hits before the range (which no answer reads).
+// The weight sums of a block's blends, lane by lane: FieldQuery::Impl's Blend without the weight
+// of the hits before the range (which no answer reads); the normal sums only with normals.
 struct BlendSums {
   float hit[kPlanLanes], miss[kPlanLanes], far[kPlanLanes], tSum[kPlanLanes];
+  float nx[kPlanLanes], ny[kPlanLanes], nz[kPlanLanes];
 };
 
 namespace {  // (a copy per file: the AVX2 kernel's file must share no inline function with the rest)
@@ -237,7 +241,8 @@ void decodeGroup(const GroupTables& tables, Group* g) noexcept;
 bool planGroup(const PlanTables& tables, const PlanRays& rays, PlanBlock* out) noexcept;
 // The weight sums of a block of plans (PlanBlock; lanes with mask 0 sum to zero), as
 // FieldQuery::Impl::blendInterpolated accumulates them one ray at a time: taps in slot order,
-// each tap's four texels in its order, with the same binary32 operations. False (and *out
+// each tap's four texels in its order, with the same binary32 operations (normals decoded as
+// decodeNormal does). False (and *out
 // untouched) where the kernel that runs has no blend (SSE2).
 bool blendGroup(const BlendTables& tables, const PlanBlock& plans, const BlendRays& rays, BlendSums* out) noexcept;
 

@@ -20,6 +20,7 @@ struct F8 {
   static F8 load(const float* p);
   static F8 loadInt(const int32_t* p);
   static F8 gatherBytes(const uint8_t* base, const int32_t* at);
+  static void gatherSnorm16Pairs(const uint8_t* base, const int32_t* at, F8* x, F8* y);
   static void compressIndex(uint32_t* dst, uint32_t first, unsigned mask);
   static uint64_t rayBits(const uint32_t* ray, unsigned bits);
 };
@@ -127,6 +128,13 @@ inline F8 F8::gatherBytes(const uint8_t* base, const int32_t* at) {
   const __m256i words = _mm256_i32gather_epi32(reinterpret_cast<const int*>(base), _mm256_sub_epi32(idx, back), 1);
   const __m256i bytes = _mm256_and_si256(_mm256_srlv_epi32(words, _mm256_slli_epi32(back, 3)), _mm256_set1_epi32(0xFF));
   return _mm256_cvtepi32_ps(bytes);
+}
+// The two snorm16 codes of the 4-byte words at base + at[l] (little-endian), as floats.
+inline void F8::gatherSnorm16Pairs(const uint8_t* base, const int32_t* at, F8* x, F8* y) {
+  const __m256i w = _mm256_i32gather_epi32(reinterpret_cast<const int*>(base),
+                                           _mm256_loadu_si256(reinterpret_cast<const __m256i*>(at)), 1);
+  *x = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(w, 16), 16));
+  *y = _mm256_cvtepi32_ps(_mm256_srai_epi32(w, 16));
 }
 // Bit ray[l] for every lane l set in `bits` (ray[l] < 64).
 inline uint64_t F8::rayBits(const uint32_t* ray, unsigned bits) {

@@ -29,6 +29,7 @@ struct F16 {
   static F16 load(const float* p);
   static F16 loadInt(const int32_t* p);
   static F16 gatherBytes(const uint8_t* base, const int32_t* at);
+  static void gatherSnorm16Pairs(const uint8_t* base, const int32_t* at, F16* x, F16* y);
   static void compressIndex(uint32_t* dst, uint32_t first, unsigned mask);
   static uint64_t rayBits(const uint32_t* ray, unsigned bits);
 };
@@ -121,6 +122,12 @@ inline F16 F16::gatherBytes(const uint8_t* base, const int32_t* at) {
   alignas(64) int32_t bytes[16];
   for (int l = 0; l < 16; ++l) bytes[l] = base[at[l]];
   return _mm512_cvtepi32_ps(_mm512_load_si512(bytes));
+}
+// The two snorm16 codes of the 4-byte words at base + at[l] (little-endian), as floats.
+inline void F16::gatherSnorm16Pairs(const uint8_t* base, const int32_t* at, F16* x, F16* y) {
+  const __m512i w = _mm512_i32gather_epi32(_mm512_loadu_si512(at), base, 1);
+  *x = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w, 16), 16));
+  *y = _mm512_cvtepi32_ps(_mm512_srai_epi32(w, 16));
 }
 // Bit ray[l] for every lane l set in `bits` (ray[l] < 64).
 inline uint64_t F16::rayBits(const uint32_t* ray, unsigned bits) {

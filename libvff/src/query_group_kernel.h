@@ -7,11 +7,11 @@
 // for AVX2 or AVX-512 can be shared with code that runs on a CPU without it.
 //
 // The vector type H (a float vector with +, -, *, / and the free functions used below, and static
-// load, loadInt, gatherBytes, compressIndex and rayBits) is defined by the including file, which
-// runs the kernel on lanes F = Pair<H> or Pair<Pair<H>> (the interpolated planner and blend,
-// planWith and blendWith, on H itself, AVX2 and AVX-512 only): two or four vectors side by side, so
-// that the CPU overlaps their long dependency chains (the nearest sample, then the frame, then
-// the texel). With eight-lane vectors, 32 lanes run 1.2-1.3x faster than 8 on the aimed rays of
+// load, loadInt, gatherBytes, compressIndex and rayBits; AVX2 and AVX-512: gatherSnorm16Pairs) is
+// defined by the including file, which runs the kernel on lanes F = Pair<H> or Pair<Pair<H>> (the
+// interpolated planner and blend, planWith and blendWith, on H itself, AVX2 and AVX-512 only): two
+// or four vectors side by side, so that the CPU overlaps their long dependency chains (the nearest
+// sample, then the frame, then the texel). With eight-lane vectors, 32 lanes run 1.2-1.3x faster than 8 on the aimed rays of
 // vff-experiments bench and 1.1x on its AO rays; with four-lane vectors 8 lanes beat 4 and 16;
 // with sixteen-lane vectors 32 lanes beat 16 by about 1.1x.
 // Every line that computes a quantity prepare() also computes mirrors a line
@@ -615,6 +615,22 @@ void planWith(const PlanTables& tb, const PlanRays& in, PlanBlock* out) {
   }
 }
 
+// decodeNormal (encoding.cpp) per lane, from the two snorm16 codes (cx, cy) of oct-snorm16.
+template <class F>
+inline void decodeNormalV(F cx, F cy, F* x, F* y, F* z) {
+  const F one(1.0f), mone(-1.0f), zero(0.0f), snorm(32767.0f);
+  const F px = maxStd(cx / snorm, mone), py = maxStd(cy / snorm, mone);
+  const F nz = (one - vabs(px)) - vabs(py);
+  const F fold = lt(nz, zero);
+  const F ox = (one - vabs(py)) * sel(ge(px, zero), one, mone);
+  const F oy = (one - vabs(px)) * sel(ge(py, zero), one, mone);
+  const F nx = sel(fold, ox, px), ny = sel(fold, oy, py);
+  const F len = vsqrt(nx * nx + ny * ny + nz * nz);
+  *x = nx / len;
+  *y = ny / len;
+  *z = nz / len;
+}
+
 // blendGroup (query_group.h) with lanes F: each lane accumulates its taps in slot order and each
 // tap's texels (ix, iy), (ix + 1, iy), (ix, iy + 1), (ix + 1, iy + 1) in that order, as
 // FieldQuery::Impl::blendInterpolated does, with the same binary32 operations (a texel's weight
@@ -626,7 +642,7 @@ void blendWith(const BlendTables& tb, const PlanBlock& plan, const BlendRays& in
   const F zero(0.0f), one(1.0f), fm(float(tb.m)), top(float(tb.m) - 1.0f), scale(tb.distanceScale), missCode(255.0f);
   for (size_t c0 = 0; c0 < kPlanLanes; c0 += L) {
     const F lo = F::load(in.lo + c0), hi = F::load(in.hi + c0);
-    F hitW = zero, missW = zero, farW = zero, tSum = zero;
+    F hitW = zero, missW = zero, farW = zero, tSum = zero, nsx = zero, nsy = zero, nsz = zero;
     for (size_t c = 0; c < kPlanSlots; ++c) {
       alignas(64) int32_t tap[L];
       unsigned any = 0;
@@ -658,6 +674,16 @@ void blendWith(const BlendTables& tb, const PlanBlock& plan, const BlendRays& in
           const F counted = bandnot(bor(far, lt(t, lo)), hit);  // (before the range: left out)
           hitW = sel(counted, hitW + bw, hitW);
           tSum = sel(counted, tSum + bw * t, tSum);
+          if (tb.normals) {
+            alignas(64) int32_t atNormal[L];
+            storeTexelIndex(atNormal, k, band(inSlot, (tj * fm + ti) * F(4.0f)), tb.normalMapBytes);
+            F cx, cy, nx, ny, nz;
+            F::gatherSnorm16Pairs(tb.normals, atNormal, &cx, &cy);
+            decodeNormalV(cx, cy, &nx, &ny, &nz);
+            nsx = sel(counted, nsx + nx * bw, nsx);
+            nsy = sel(counted, nsy + ny * bw, nsy);
+            nsz = sel(counted, nsz + nz * bw, nsz);
+          }
         }
       }
     }
@@ -665,6 +691,9 @@ void blendWith(const BlendTables& tb, const PlanBlock& plan, const BlendRays& in
     store(out->miss + c0, missW);
     store(out->far + c0, farW);
     store(out->tSum + c0, tSum);
+    store(out->nx + c0, nsx);
+    store(out->ny + c0, nsy);
+    store(out->nz + c0, nsz);
   }
 }
 

@@ -371,7 +371,10 @@ int expectBatchesEqualSingleRays(const Q& q, const std::vector<Ray>& rays) {
       EXPECT_EQ(hits[r].hit, h.hit) << "ray " << r;
       EXPECT_EQ(hits[r].t, h.t) << "ray " << r;
       EXPECT_EQ(hits[r].point.x, h.point.x) << "ray " << r;
+      EXPECT_EQ(hits[r].hasNormal, h.hasNormal) << "ray " << r;
+      EXPECT_EQ(hits[r].normal.x, h.normal.x) << "ray " << r;
       EXPECT_EQ(hits[r].normal.y, h.normal.y) << "ray " << r;
+      EXPECT_EQ(hits[r].normal.z, h.normal.z) << "ray " << r;
       EXPECT_EQ(occ[r] != 0, q.occluded(rays[r], o)) << "ray " << r;
       EXPECT_EQ(vis[r], q.visibility(rays[r], o)) << "ray " << r;
       EXPECT_GE(vis[r], 0.0f);

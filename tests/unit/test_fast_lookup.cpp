@@ -470,19 +470,34 @@ void checkBatches(detail::KernelChoice) {
         }
         EXPECT_GT(hitCount, rays.size() / 10);  // the test exercises hits, not only misses
       }
-      // Interpolated batches (the group kernel finds the nearest samples) against one-ray calls.
+      // Interpolated batches (the group kernel finds the nearest samples) against one-ray calls,
+      // on the field and on the same field with a normal field.
       QueryOptions oi = o;
       oi.reconstruction = Reconstruction::kInterpolated;
-      std::vector<float> vis(rays.size());
-      std::vector<QueryHit> hits(rays.size());
-      q->visibility(rays, vis, oi);
-      q->intersect(rays, hits, oi);
-      for (size_t r = 0; r < rays.size(); ++r) {
-        ASSERT_EQ(vis[r], q->visibility(rays[r], oi)) << "n " << n << " ray " << r;
-        const QueryHit single = q->intersect(rays[r], oi);
-        ASSERT_EQ(hits[r].hit, single.hit) << "n " << n << " ray " << r;
-        ASSERT_EQ(hits[r].t, single.t) << "n " << n << " ray " << r;
+      FieldDesc fn = f;
+      fn.normalEncoding = NormalEncoding::kOctSnorm16;
+      const std::vector<uint8_t> normals = test::syntheticNormals(fn, dist);
+      auto qn = FieldQuery::fromMaps(fn, dist, normals);
+      ASSERT_TRUE(qn);
+      size_t normalHits = 0;
+      for (const FieldQuery* field : {&*q, &*qn}) {
+        std::vector<float> vis(rays.size());
+        std::vector<QueryHit> hits(rays.size());
+        field->visibility(rays, vis, oi);
+        field->intersect(rays, hits, oi);
+        for (size_t r = 0; r < rays.size(); ++r) {
+          ASSERT_EQ(vis[r], field->visibility(rays[r], oi)) << "n " << n << " ray " << r;
+          const QueryHit single = field->intersect(rays[r], oi);
+          ASSERT_EQ(hits[r].hit, single.hit) << "n " << n << " ray " << r;
+          ASSERT_EQ(hits[r].t, single.t) << "n " << n << " ray " << r;
+          ASSERT_EQ(hits[r].hasNormal, single.hasNormal) << "n " << n << " ray " << r;
+          ASSERT_EQ(hits[r].normal.x, single.normal.x) << "n " << n << " ray " << r;
+          ASSERT_EQ(hits[r].normal.y, single.normal.y) << "n " << n << " ray " << r;
+          ASSERT_EQ(hits[r].normal.z, single.normal.z) << "n " << n << " ray " << r;
+          normalHits += single.hasNormal;
+        }
       }
+      EXPECT_GT(normalHits, rays.size() / 20);  // the normal field is exercised
       // The field placed by an Instance: its nearest batches hand the kernel world-space rays,
       // which it takes to object space lane by lane; its one-ray calls use RigidTransform.
       const Instance inst{&*q, RigidTransform::fromAxisAngle({1, 2, 3}, 0.7f, {5, -2, 1}, 2.5f)};
