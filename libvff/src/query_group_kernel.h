@@ -11,9 +11,9 @@
 // defined by the including file, which runs the kernel on lanes F = Pair<H> or Pair<Pair<H>> (the
 // interpolated planner and blend, planWith and blendWith, on H itself, AVX2 and AVX-512 only): two
 // or four vectors side by side, so that the CPU overlaps their long dependency chains (the nearest
-// sample, then the frame, then the texel). With eight-lane vectors, 32 lanes run 1.2-1.3x faster than 8 on the aimed rays of
-// vff-experiments bench and 1.1x on its AO rays; with four-lane vectors 8 lanes beat 4 and 16;
-// with sixteen-lane vectors 32 lanes beat 16 by about 1.1x.
+// sample, then the frame, then the texel). With eight-lane vectors, 32 lanes run 1.2-1.3x faster
+// than 8 on the aimed rays of vff-experiments bench and 1.1x on its AO rays; with four-lane
+// vectors 8 lanes beat 4 and 16; with sixteen-lane vectors 32 lanes beat 16 by about 1.1x.
 // Every line that computes a quantity prepare() also computes mirrors a line
 // of FieldQuery::Impl::prepare() or of fast_lookup.h with the same binary32 operations in the
 // same order (a ? b : c becomes sel(mask, b, c); no operation is fused or reordered), so that a
