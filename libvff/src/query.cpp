@@ -25,14 +25,6 @@ inline Vec3 operator*(Vec3 a, float s) { return {a.x * s, a.y * s, a.z * s}; }
 inline Vec3 operator-(Vec3 a) { return {-a.x, -a.y, -a.z}; }
 inline float dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
-// toLocal (direction.h), compiled here: the exported one is reached through the shared library's
-// PLT, which cost interpolated batches 4-16% (they call it for every candidate sample; in-process
-// A/B on vff-experiments bench rays). Same operations, and this file is built without contraction.
-inline Vec3 localOf(const Frame& f, Vec3 w) {
-  return {w.x * f.t.x + w.y * f.t.y + w.z * f.t.z, w.x * f.b.x + w.y * f.b.y + w.z * f.b.z,
-          w.x * f.n.x + w.y * f.n.y + w.z * f.n.z};
-}
-
 inline Vec3 normalize(Vec3 v) {
   const float l = std::sqrt(dot(v, v));
   return l > 0 ? v * (1.0f / l) : Vec3{};
@@ -89,9 +81,14 @@ struct FieldQuery::Impl {
   uint32_t m = 0;
   uint64_t distMapBytes = 0, normMapBytes = 0;
   std::vector<const uint8_t*> dist;  // per map
-  // GroupTables::byteTexels, and whether the maps lie back to back (GroupTables::texels); the
-  // same for the normal maps (detail::BlendTables::normals).
-  bool byteTexels = false, contiguous = false, normalsContiguous = false;
+  // GroupTables::byteTexels, and whether the maps lie back to back (GroupTables::texels).
+  bool byteTexels = false, contiguous = false;
+  // Map indices are exact in binary32 (< 2^24), as the interpolated planner and blend kernels
+  // (detail::planGroup, blendGroup) hold them.
+  bool floatMapIndices = false;
+  // What the blend kernel reads (texels null: it cannot blend this field): unorm8-diameter maps
+  // back to back, and their normal maps back to back if there are normals.
+  detail::BlendTables blendTables;
   std::vector<const uint8_t*> norm;  // per map, empty without normals
   std::vector<Frame> frames;         // frame of map k (inward normal)
   std::vector<float> unit4;          // û_k, float, padded to 4 floats per map (for the group kernel)
@@ -305,8 +302,20 @@ void FieldQuery::Impl::build() {
                m <= 4096 && n > 0;
   contiguous = byteTexels && planeBytes >= 4 && planeBytes < (uint64_t(1) << 31);
   for (uint32_t k = 0; k < n && contiguous; ++k) contiguous = dist[k] == dist[0] + size_t(k) * distMapBytes;
-  normalsContiguous = !norm.empty() && uint64_t(n) * normMapBytes < (uint64_t(1) << 31);
+  floatMapIndices = n < (1u << 24);
+  bool normalsContiguous = !norm.empty() && uint64_t(n) * normMapBytes < (uint64_t(1) << 31);
   for (uint32_t k = 0; k < n && normalsContiguous; ++k) normalsContiguous = norm[k] == norm[0] + size_t(k) * normMapBytes;
+  if (contiguous && field.distanceEncoding == DistanceEncoding::kUnorm8Diameter && floatMapIndices &&
+      (norm.empty() || normalsContiguous)) {
+    blendTables.texels = dist[0];
+    blendTables.mapBytes = int32_t(distMapBytes);
+    blendTables.m = m;
+    blendTables.distanceScale = 2.0f * radius / 254.0f;  // (texel()'s scale)
+    if (!norm.empty()) {
+      blendTables.normals = norm[0];
+      blendTables.normalMapBytes = int32_t(normMapBytes);
+    }
+  }
   frames.resize(n);
   unit4.assign(size_t(n) * 4, 0.0f);
   for (uint32_t k = 0; k < n; ++k) {
@@ -497,7 +506,7 @@ bool FieldQuery::Impl::prepare(const Ray& ray, const QueryOptions& o, Lookup* l)
   if (!inside && t0 > tmax) return false;  // the sphere begins beyond the range
   lookupFrom(ray, len, t0, inside, lo, tmax, l);
   l->k0 = nearestSample(l->eu);
-  const Vec3 local = localOf(frames[l->k0], l->v);
+  const Vec3 local = toLocal(frames[l->k0], l->v);
   if (!detail::texelFast(field.directionScheme, local, m, &l->i, &l->j))
     squareToTexel(hemisphereToSquare(field.directionScheme, local), m, &l->i, &l->j);
   return true;
@@ -555,7 +564,7 @@ void FieldQuery::Impl::planInterpolated(const Ray& ray, const Lookup& l, detail:
     if (k == UINT32_MAX) break;
     const float weight = c == 0 ? std::max(kernel(k), 1e-6f) : kernel(k);
     if (c > 0 && !(weight > 0)) continue;  // (the nearest sample always contributes)
-    const Vec3 local = localOf(frames[k], v);
+    const Vec3 local = toLocal(frames[k], v);
     if (local.z <= 0) continue;  // the sample does not see this direction
     const Vec2 uv = detail::hemisphereToSquareFast(field.directionScheme, local);
     const float x = (uv.x + 1.0f) * 0.5f * float(m) - 0.5f;
@@ -674,20 +683,6 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
   detail::PlanBlock plan{};  // (zeroed: the blend kernel reads every lane of a slot)
   uint32_t which[kPlanned];
   bool live[kPlanned];
-  // The blend kernel: where a group kernel runs, over unorm8-diameter maps back to back (and their
-  // normal maps, if any, back to back too).
-  detail::BlendTables blendTables;
-  if (detail::groupKernelAvailable() && contiguous && field.distanceEncoding == DistanceEncoding::kUnorm8Diameter &&
-      (norm.empty() || normalsContiguous) && dist.size() < (size_t(1) << 24)) {  // (map indices exact in binary32)
-    blendTables.texels = dist[0];
-    blendTables.mapBytes = int32_t(distMapBytes);
-    blendTables.m = m;
-    blendTables.distanceScale = 2.0f * radius / 254.0f;
-    if (!norm.empty()) {
-      blendTables.normals = norm[0];
-      blendTables.normalMapBytes = int32_t(normMapBytes);
-    }
-  }
   auto finish = [&](size_t base, size_t count) {
     // The blends of the block's rays from outside the sphere, 16 at once where the kernel can.
     detail::BlendSums sums;
@@ -745,7 +740,6 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
     return;
   }
   const detail::PlanTables tables = planTables();
-  const bool groupPlans = dist.size() < (size_t(1) << 24);  // (planGroup: map indices exact in binary32)
   forEachGroup(rays, groupTables(o, false), [&](size_t base, size_t n, detail::Group& g) {
     for (size_t r = 0; r < n; ++r)
       if (!((g.reached >> r) & 1u)) emit(base + r, QueryHit{}, 1.0f);
@@ -783,7 +777,7 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
       }
       bool any = false;
       for (size_t c = 0; c < count; ++c) any = any || in.active[c] != 0;
-      if (any && !(groupPlans && detail::planGroup(tables, in, &plan))) {
+      if (any && !(floatMapIndices && detail::planGroup(tables, in, &plan))) {
         for (size_t c = 0; c < count; ++c) {
           if (in.active[c])
             planInterpolated(rays[base + which[c]], l[c], &plan, c);

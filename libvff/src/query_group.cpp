@@ -126,6 +126,7 @@ bool planGroup(const PlanTables& tables, const PlanRays& rays, PlanBlock* out) n
 }
 
 bool blendGroup(const BlendTables& tables, const PlanBlock& plans, const BlendRays& rays, BlendSums* out) noexcept {
+  if (!groupKernelAvailable()) return false;
   const Kernel& k = activeKernel();
   if (!k.blend) return false;
   k.blend(tables, plans, rays, out);

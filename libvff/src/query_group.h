@@ -242,8 +242,8 @@ bool planGroup(const PlanTables& tables, const PlanRays& rays, PlanBlock* out) n
 // The weight sums of a block of plans (PlanBlock; lanes with mask 0 sum to zero), as
 // FieldQuery::Impl::blendInterpolated accumulates them one ray at a time: taps in slot order,
 // each tap's four texels in its order, with the same binary32 operations (normals decoded as
-// decodeNormal does). False (and *out
-// untouched) where the kernel that runs has no blend (SSE2).
+// decodeNormal does). False (and *out untouched) where no group kernel runs or the one that runs
+// has no blend (SSE2): the caller blends the rays one at a time.
 bool blendGroup(const BlendTables& tables, const PlanBlock& plans, const BlendRays& rays, BlendSums* out) noexcept;
 
 }  // namespace vff::detail

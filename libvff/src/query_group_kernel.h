@@ -663,8 +663,9 @@ void blendWith(const BlendTables& tb, const PlanBlock& plan, const BlendRays& in
           const F bw = weight * wx[di] * wy[dj];
           const F take = bandnot(le(bw, zero), inSlot);  // (blendInterpolated skips bw <= 0)
           const F ti = vmin(vmax(ix + F(float(di)), zero), top), tj = vmin(vmax(iy + F(float(dj)), zero), top);
+          const F texel = band(inSlot, tj * fm + ti);
           alignas(64) int32_t at[L];
-          storeTexelIndex(at, k, band(inSlot, tj * fm + ti), tb.mapBytes);
+          storeTexelIndex(at, k, texel, tb.mapBytes);
           const F code = F::gatherBytes(tb.texels, at);
           const F hit = bandnot(eq(code, missCode), take);
           missW = sel(bandnot(hit, take), missW + bw, missW);
@@ -676,7 +677,7 @@ void blendWith(const BlendTables& tb, const PlanBlock& plan, const BlendRays& in
           tSum = sel(counted, tSum + bw * t, tSum);
           if (tb.normals) {
             alignas(64) int32_t atNormal[L];
-            storeTexelIndex(atNormal, k, band(inSlot, (tj * fm + ti) * F(4.0f)), tb.normalMapBytes);
+            storeTexelIndex(atNormal, k, texel * F(4.0f), tb.normalMapBytes);  // (4 bytes a texel)
             F cx, cy, nx, ny, nz;
             F::gatherSnorm16Pairs(tb.normals, atNormal, &cx, &cy);
             decodeNormalV(cx, cy, &nx, &ny, &nz);
