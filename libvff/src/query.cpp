@@ -84,7 +84,7 @@ struct FieldQuery::Impl {
   // GroupTables::byteTexels, and whether the maps lie back to back (GroupTables::texels).
   bool byteTexels = false, contiguous = false;
   // Map indices are exact in binary32 (< 2^24), as the interpolated planner and blend kernels
-  // (detail::planGroup, blendGroup) hold them.
+  // (detail::GroupKernel::plan, blend) hold them.
   bool floatMapIndices = false;
   // What the blend kernel reads (texels null: it cannot blend this field): unorm8-diameter maps
   // back to back, and their normal maps back to back if there are normals.
@@ -178,7 +178,7 @@ struct FieldQuery::Impl {
   detail::GroupTables groupTables(const QueryOptions& o, bool decodeHits) const noexcept;
   QueryHit interpolated(const Ray& ray, const Lookup& l, float* visibility) const noexcept;
   // interpolated() in two halves (see there), for lane `lane` of a block of plans (a batch plans
-  // detail::kPlanLanes rays at once: detail::planGroup).
+  // detail::kPlanLanes rays at once: detail::GroupKernel::plan).
   void planInterpolated(const Ray& ray, const Lookup& l, detail::PlanBlock* plan, size_t lane) const noexcept;
   void prefetchPlan(const detail::PlanBlock& plan, size_t lane) const noexcept;
   QueryHit blendInterpolated(const Ray& ray, const Lookup& l, const detail::PlanBlock& plan, size_t lane,
@@ -195,7 +195,8 @@ struct FieldQuery::Impl {
   // once it was looked up before the current group's sphere step and lookups, so that its texels
   // have had that time to arrive from memory.
   template <class Each>
-  void forEachGroup(std::span<const Ray> rays, const detail::GroupTables& tables, Each&& each) const noexcept {
+  void forEachGroup(const detail::GroupKernel& kernel, std::span<const Ray> rays, const detail::GroupTables& tables,
+                    Each&& each) const noexcept {
     constexpr size_t kRing = 4;  // groups in flight
     static_assert(kRing <= detail::LookupQueue::kMaxSegments, "each group in flight may wait in the queue");
     detail::Group g[kRing];
@@ -204,7 +205,7 @@ struct FieldQuery::Impl {
     size_t next = 0, made = 0;  // groups handed over, groups prepared
     auto handOver = [&] {
       detail::Group& h = g[next % kRing];
-      detail::decodeGroup(tables, &h);
+      kernel.decode(tables, &h);
       each(base[next % kRing], count[next % kRing], h);
       ++next;
     };
@@ -217,21 +218,21 @@ struct FieldQuery::Impl {
         for (size_t o = 0; o < detail::kGroupRays * sizeof(Ray); o += 64) __builtin_prefetch(ahead + o);
       }
       if (made - next == kRing) {  // no free slot: finish the oldest group now
-        detail::lookupQueue(tables, &q, true);
+        kernel.lookup(tables, &q, true);
         handOver();
       }
       const size_t slot = made % kRing;
-      detail::sphereGroup(tables, rays.data() + b, n, &g[slot], &q);
+      kernel.sphere(tables, rays.data() + b, n, &g[slot], &q);
       base[slot] = b;
       count[slot] = n;
       ++made;
       // The groups looked up before this step (in order), handed over after its lookups.
       size_t ready = next;
       while (ready < made - 1 && g[ready % kRing].looked == g[ready % kRing].count) ++ready;
-      detail::lookupQueue(tables, &q, false);
+      kernel.lookup(tables, &q, false);
       while (next < ready) handOver();
     }
-    detail::lookupQueue(tables, &q, true);
+    kernel.lookup(tables, &q, true);
     while (next < made) handOver();
   }
   QueryHit query(const Ray& ray, const QueryOptions& o, float* visibility) const noexcept;
@@ -670,15 +671,16 @@ QueryHit FieldQuery::Impl::interpolated(const Ray& ray, const Lookup& l, float* 
 }
 
 // Batches of interpolated lookups. The group kernel finds, for 64 rays at a time, those that reach
-// the sphere and their nearest samples; then 16 at a time are planned together (detail::planGroup,
+// the sphere and their nearest samples; then 16 at a time are planned together (the kernel's plan(),
 // as planInterpolated() one ray at a time) with all their taps' texels requested from memory, and
-// blended, 16 at a time too where the kernel can (detail::blendGroup, as blendInterpolated() one
-// ray at a time). Rays from inside the sphere are answered as kNearest (query()). (Blending a
+// blended, 16 at a time too where the kernel can (its blend(), as blendInterpolated() one ray at a
+// time). Rays from inside the sphere are answered as kNearest (query()). (Blending a
 // block while the next is planned, so that its texels had longer to arrive, gained nothing:
 // in-process A/B on vff-experiments bench rays, 0.96-1.05x.)
 template <class Emit>
 void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept {
   constexpr size_t kPlanned = detail::kPlanLanes;
+  const detail::GroupKernel* kernel = detail::groupKernel();  // (one for the whole batch)
   Lookup l[kPlanned];
   detail::PlanBlock plan{};  // (zeroed: the blend kernel reads every lane of a slot)
   uint32_t which[kPlanned];
@@ -696,7 +698,10 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
         br.lo[c] = blended ? l[c].lo : 0.0f;
         br.hi[c] = blended ? l[c].hi : 0.0f;
       }
-      summed = any && detail::blendGroup(blendTables, plan, br, &sums);
+      if (any && kernel && kernel->blend) {
+        kernel->blend(blendTables, plan, br, &sums);
+        summed = true;
+      }
     }
     for (size_t c = 0; c < count; ++c) {
       const Ray& ray = rays[base + which[c]];
@@ -726,7 +731,7 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
     else
       prefetchPlan(plan, c);
   };
-  if (!detail::groupKernelAvailable()) {
+  if (!kernel) {
     for (size_t base = 0; base < rays.size(); base += kPlanned) {
       const size_t n = std::min(kPlanned, rays.size() - base);
       for (size_t r = 0; r < n; ++r) {
@@ -740,7 +745,7 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
     return;
   }
   const detail::PlanTables tables = planTables();
-  forEachGroup(rays, groupTables(o, false), [&](size_t base, size_t n, detail::Group& g) {
+  forEachGroup(*kernel, rays, groupTables(o, false), [&](size_t base, size_t n, detail::Group& g) {
     for (size_t r = 0; r < n; ++r)
       if (!((g.reached >> r) & 1u)) emit(base + r, QueryHit{}, 1.0f);
     for (uint32_t first = 0; first < g.count; first += kPlanned) {
@@ -777,7 +782,9 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
       }
       bool any = false;
       for (size_t c = 0; c < count; ++c) any = any || in.active[c] != 0;
-      if (any && !(floatMapIndices && detail::planGroup(tables, in, &plan))) {
+      if (any && floatMapIndices && kernel->plan) {
+        kernel->plan(tables, in, &plan);
+      } else if (any) {
         for (size_t c = 0; c < count; ++c) {
           if (in.active[c])
             planInterpolated(rays[base + which[c]], l[c], &plan, c);
@@ -842,7 +849,8 @@ template <bool kHitOnly, class Emit>
 void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOptions& o, const ToObject* to,
                                     Emit&& emit) const noexcept {
   auto objectRay = [&](size_t r) { return to ? to->ray(rays[r]) : rays[r]; };
-  if (!detail::groupKernelAvailable()) {
+  const detail::GroupKernel* kernel = detail::groupKernel();  // (one for the whole batch)
+  if (!kernel) {
     for (size_t base = 0; base < rays.size(); base += detail::kGroupRays) {
       const size_t n = std::min(detail::kGroupRays, rays.size() - base);
       uint64_t hits = 0;
@@ -868,7 +876,7 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
     tables.objectShift = to->translation;
     tables.objectInvScale = to->invScale;
   }
-  forEachGroup(rays, tables, [&](size_t base, size_t n, detail::Group& g) {
+  forEachGroup(*kernel, rays, tables, [&](size_t base, size_t n, detail::Group& g) {
     // Every ray misses unless it reaches the sphere.
     if constexpr (!kHitOnly) {
       for (size_t r = 0; r < n; ++r)

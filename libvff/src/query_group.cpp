@@ -35,34 +35,25 @@ void blendGroupAvx512(const BlendTables& tables, const PlanBlock& plans, const B
 
 namespace {
 
-struct Kernel {
-  const char* name;
-  void (*sphere)(const GroupTables&, const Ray*, size_t, Group*, LookupQueue*) noexcept;
-  void (*lookup)(const GroupTables&, LookupQueue*, bool) noexcept;
-  void (*decode)(const GroupTables&, Group*) noexcept;
-  void (*plan)(const PlanTables&, const PlanRays&, PlanBlock*) noexcept;  // null: none
-  void (*blend)(const BlendTables&, const PlanBlock&, const BlendRays&, BlendSums*) noexcept;  // null: none
-};
-
 // (Planning interpolated lookups four lanes at a time ran slower on the AO rays of
 // vff-experiments bench than the one-ray planner, 0.83x, and blending them eight at a time
 // 0.92x on the AO rays, 1.03x on the aimed ones: SSE2 batches plan and blend one ray at a time.
 // With AVX2 the blend kernel ran 0.99x and 1.14x, with AVX-512 1.0-1.05x and 1.35-1.45x:
 // in-process A/B, 2 threads, Zen 4.)
-constexpr Kernel kSse2{"sse2", sphereGroupSse2, lookupQueueSse2, decodeGroupSse2, nullptr, nullptr};
+constexpr GroupKernel kSse2{"sse2", sphereGroupSse2, lookupQueueSse2, decodeGroupSse2, nullptr, nullptr};
 #if defined(VFF_HAVE_AVX2_KERNEL)
-constexpr Kernel kAvx2{"avx2", sphereGroupAvx2, lookupQueueAvx2, decodeGroupAvx2, planGroupAvx2, blendGroupAvx2};
+constexpr GroupKernel kAvx2{"avx2", sphereGroupAvx2, lookupQueueAvx2, decodeGroupAvx2, planGroupAvx2, blendGroupAvx2};
 #endif
 #if defined(VFF_HAVE_AVX512_KERNEL)
-constexpr Kernel kAvx512{"avx512", sphereGroupAvx512, lookupQueueAvx512, decodeGroupAvx512,
+constexpr GroupKernel kAvx512{"avx512", sphereGroupAvx512, lookupQueueAvx512, decodeGroupAvx512,
                          planGroupAvx512, blendGroupAvx512};
 #endif
 
 // The kernels this CPU runs (decided once): null where it has not the instructions (or this
 // build not the kernel).
 struct Available {
-  const Kernel* avx2 = nullptr;
-  const Kernel* avx512 = nullptr;
+  const GroupKernel* avx2 = nullptr;
+  const GroupKernel* avx512 = nullptr;
 };
 const Available& available() noexcept {
   static const Available a = [] {
@@ -82,7 +73,7 @@ const Available& available() noexcept {
 }
 
 // The kernel that runs now: the override where this CPU runs it, else the widest.
-const Kernel& activeKernel() noexcept {
+const GroupKernel& activeKernel() noexcept {
   const Available& a = available();
   switch (kernelOverride()) {
     case KernelChoice::kSse2: return kSse2;
@@ -110,39 +101,14 @@ bool groupKernelRuns(KernelChoice choice) noexcept {
 
 const char* groupKernelName() noexcept { return groupKernelAvailable() ? activeKernel().name : "scalar"; }
 
-void sphereGroup(const GroupTables& tables, const Ray* rays, size_t n, Group* g, LookupQueue* q) noexcept {
-  activeKernel().sphere(tables, rays, n, g, q);
-}
-
-void lookupQueue(const GroupTables& tables, LookupQueue* q, bool flush) noexcept { activeKernel().lookup(tables, q, flush); }
-
-void decodeGroup(const GroupTables& tables, Group* g) noexcept { activeKernel().decode(tables, g); }
-
-bool planGroup(const PlanTables& tables, const PlanRays& rays, PlanBlock* out) noexcept {
-  const Kernel& k = activeKernel();
-  if (!k.plan) return false;
-  k.plan(tables, rays, out);
-  return true;
-}
-
-bool blendGroup(const BlendTables& tables, const PlanBlock& plans, const BlendRays& rays, BlendSums* out) noexcept {
-  if (!groupKernelAvailable()) return false;
-  const Kernel& k = activeKernel();
-  if (!k.blend) return false;
-  k.blend(tables, plans, rays, out);
-  return true;
-}
+const GroupKernel* groupKernel() noexcept { return groupKernelAvailable() ? &activeKernel() : nullptr; }
 
 #else
 
 bool groupKernelAvailable() noexcept { return false; }
 bool groupKernelRuns(KernelChoice choice) noexcept { return choice == KernelChoice::kNone; }
 const char* groupKernelName() noexcept { return "scalar"; }
-void sphereGroup(const GroupTables&, const Ray*, size_t, Group*, LookupQueue*) noexcept {}
-void lookupQueue(const GroupTables&, LookupQueue*, bool) noexcept {}
-void decodeGroup(const GroupTables&, Group*) noexcept {}
-bool planGroup(const PlanTables&, const PlanRays&, PlanBlock*) noexcept { return false; }
-bool blendGroup(const BlendTables&, const PlanBlock&, const BlendRays&, BlendSums*) noexcept { return false; }
+const GroupKernel* groupKernel() noexcept { return nullptr; }
 
 #endif
 

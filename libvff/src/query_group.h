@@ -1,21 +1,21 @@
 // query_group.h - the nearest lookup of many rays at once, 32 at a time in AVX-512 or AVX2
 // vectors or 8 in SSE2 vectors (internal).
 //
-// FieldQuery's batch functions hand rays to sphereGroup() in groups of kGroupRays, and the rays
-// that reach the sphere to lookupQueue() through a LookupQueue. Together they compute, for every
-// ray, what FieldQuery::Impl::prepare computes one ray at a time: the sphere entry, the nearest
-// positional sample (octa-hemi2: the candidates of PositionSet::candidates, scored without
+// FieldQuery's batch functions hand rays to a GroupKernel's sphere() in groups of kGroupRays, and
+// the rays that reach the sphere to its lookup() through a LookupQueue. Together they compute, for
+// every ray, what FieldQuery::Impl::prepare computes one ray at a time: the sphere entry, the
+// nearest positional sample (octa-hemi2: the candidates of PositionSet::candidates, scored without
 // reading their positions, fast_lookup.h's kOctaScoreError) and the texel of the lookup direction
-// in that sample's map; for occlusion batches over one-byte maps, decodeGroup() then reads the
+// in that sample's map; for occlusion batches over one-byte maps, decode() then reads the
 // texels and decodes the hit flags. Where the kernel computes what prepare() computes it performs
 // the same binary32 operations in the same order. Where its two best candidates score too close
 // to call, it scores that ray's candidates as the reference does (octaBestCandidate, one lane at a
 // time). It leaves to the caller (bit `redo`) every ray on which a guard of fast_lookup.h trips or
 // whose scheme it does not handle, so that a group gives exactly the texel and the answer
 // prepare() and hitsAt() give (tests/unit/test_fast_lookup.cpp checks this ray by ray, with every
-// kernel). Interpolated batches then hand 16 of those rays at a time to planGroup(), which plans
+// kernel). Interpolated batches then hand 16 of those rays at a time to plan(), which plans
 // their lookups (the taps) as FieldQuery::Impl::planInterpolated does, and over unorm8-diameter
-// maps to blendGroup(), which sums the taps' weights (and normals) as blendInterpolated does, in
+// maps to blend(), which sums the taps' weights (and normals) as blendInterpolated does, in
 // AVX-512 or AVX2 lanes.
 // The kernel itself is query_group_kernel.h.
 #pragma once
@@ -87,10 +87,10 @@ struct Group {
   // GroupTables::texels where that is set.
   int32_t t[kGroupRays + kSlack];
   // With GroupTables::decodeHits, the packed rays' t0, lo, hi and inside (a float mask), for
-  // decodeGroup.
+  // GroupKernel::decode.
   float pt0[kGroupRays + kSlack], plo[kGroupRays + kSlack], phi[kGroupRays + kSlack], pinside[kGroupRays + kSlack];
   uint64_t redo = 0;    // bit p: the caller must run the reference prepare() on packed ray p
-  // decodeGroup's answer, bit r: ray r hits within its range (hitsAt). Left unset for the rays
+  // GroupKernel::decode's answer, bit r: ray r hits within its range (hitsAt). Left unset for the rays
   // in `redo`, which the caller answers.
   uint64_t hits = 0;
   uint32_t looked = 0;  // packed rays whose texels are known (k, i, j, t, redo): all when == count
@@ -135,7 +135,7 @@ struct PlanBlock {
       base[kPlanSlots][kPlanLanes];
 };
 
-// What planGroup reads: plain tables owned by FieldQuery::Impl.
+// What GroupKernel::plan reads: plain tables owned by FieldQuery::Impl.
 struct PlanTables {
   const float* unit4 = nullptr;          // as GroupTables::unit4
   const uint32_t* neighbours = nullptr;  // kQueryNeighbours per map; UINT32_MAX ends a list
@@ -157,7 +157,7 @@ struct PlanRays {
   uint32_t active[kPlanLanes];
 };
 
-// What blendGroup reads: the distance maps back to back (GroupTables::texels), unorm8-diameter,
+// What GroupKernel::blend reads: the distance maps back to back (GroupTables::texels), unorm8-diameter,
 // and the normal maps (oct-snorm16) back to back, or none.
 struct BlendTables {
   const uint8_t* texels = nullptr;
@@ -221,29 +221,37 @@ KernelChoice kernelOverride() noexcept;
 // Whether this build and CPU run that kernel (kAuto, kSse2 and kNone: on x86-64, always).
 bool groupKernelRuns(KernelChoice choice) noexcept;
 
-// Fills g for rays[0, n), n <= kGroupRays: the sphere, and the packed rays that reach it, whose
-// lookups it appends to q (at most LookupQueue::kMaxSegments groups may wait there at once). A
-// group is looked up when g->looked == g->count (at once where the scheme is not octa-hemi2:
-// then every packed ray is in g->redo).
-void sphereGroup(const GroupTables& tables, const Ray* rays, size_t n, Group* g, LookupQueue* q) noexcept;
-// Looks up q's entries in full vectors (with flush: all of them), copies the answers into their
-// groups and requests the texels from memory.
-void lookupQueue(const GroupTables& tables, LookupQueue* q, bool flush) noexcept;
-// With tables.decodeHits, reads the texels of a looked-up group and fills g->hits (else sets it
-// to 0). Best called some time after its lookup (FieldQuery hands a group over only after the
-// lookups of the next group), so that the texels have arrived.
-void decodeGroup(const GroupTables& tables, Group* g) noexcept;
-// The plans of rays' interpolated lookups (PlanBlock), as FieldQuery::Impl::planInterpolated
-// computes them one ray at a time, with the same binary32 operations in the same order (the
-// sample's frame from its position, as PositionSet::frame; concentric maps with atanUnit). False
-// (and *out untouched) where the kernel that runs has no planner (SSE2): the caller plans the
-// rays one at a time.
-bool planGroup(const PlanTables& tables, const PlanRays& rays, PlanBlock* out) noexcept;
-// The weight sums of a block of plans (PlanBlock; lanes with mask 0 sum to zero), as
-// FieldQuery::Impl::blendInterpolated accumulates them one ray at a time: taps in slot order,
-// each tap's four texels in its order, with the same binary32 operations (normals decoded as
-// decodeNormal does). False (and *out untouched) where no group kernel runs or the one that runs
-// has no blend (SSE2): the caller blends the rays one at a time.
-bool blendGroup(const BlendTables& tables, const PlanBlock& plans, const BlendRays& rays, BlendSums* out) noexcept;
+// The entry points of one group kernel. A batch resolves the kernel once (groupKernel()) and
+// calls it through this table for all of its groups.
+struct GroupKernel {
+  const char* name;  // as groupKernelName()
+  // Fills g for rays[0, n), n <= kGroupRays: the sphere, and the packed rays that reach it, whose
+  // lookups it appends to q (at most LookupQueue::kMaxSegments groups may wait there at once). A
+  // group is looked up when g->looked == g->count (at once where the scheme is not octa-hemi2:
+  // then every packed ray is in g->redo).
+  void (*sphere)(const GroupTables& tables, const Ray* rays, size_t n, Group* g, LookupQueue* q) noexcept;
+  // Looks up q's entries in full vectors (with flush: all of them), copies the answers into their
+  // groups and requests the texels from memory.
+  void (*lookup)(const GroupTables& tables, LookupQueue* q, bool flush) noexcept;
+  // With tables.decodeHits, reads the texels of a looked-up group and fills g->hits (else sets it
+  // to 0). Best called some time after its lookup (FieldQuery hands a group over only after the
+  // lookups of the next group), so that the texels have arrived.
+  void (*decode)(const GroupTables& tables, Group* g) noexcept;
+  // The plans of rays' interpolated lookups (PlanBlock), as FieldQuery::Impl::planInterpolated
+  // computes them one ray at a time, with the same binary32 operations in the same order (the
+  // sample's frame from its position, as PositionSet::frame; concentric maps with atanUnit).
+  // Null where the kernel has no planner (SSE2): the caller plans the rays one at a time.
+  void (*plan)(const PlanTables& tables, const PlanRays& rays, PlanBlock* out) noexcept;
+  // The weight sums of a block of plans (PlanBlock; lanes with mask 0 sum to zero), as
+  // FieldQuery::Impl::blendInterpolated accumulates them one ray at a time: taps in slot order,
+  // each tap's four texels in its order, with the same binary32 operations (normals decoded as
+  // decodeNormal does). Null where the kernel has no blend (SSE2): the caller blends the rays
+  // one at a time.
+  void (*blend)(const BlendTables& tables, const PlanBlock& plans, const BlendRays& rays, BlendSums* out) noexcept;
+};
+
+// The group kernel that runs now (see forceGroupKernel), or null where none does
+// (groupKernelAvailable() is false: the caller uses prepare() per ray).
+const GroupKernel* groupKernel() noexcept;
 
 }  // namespace vff::detail

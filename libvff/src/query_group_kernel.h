@@ -408,8 +408,8 @@ void lookupStep(const GroupTables& tb, size_t p, LookupQueue* q) {
   }
 }
 
-// decodeGroup (query_group.h) for packed rays p .. p + kLanes - 1, those of `keep` only: whether
-// each texel holds a hit within the ray's range, as FieldQuery::Impl::hitsAt decodes a
+// GroupKernel::decode (query_group.h) for packed rays p .. p + kLanes - 1, those of `keep` only:
+// whether each texel holds a hit within the ray's range, as FieldQuery::Impl::hitsAt decodes a
 // kUnorm8Diameter texel, into g->hits (by ray).
 template <class F>
 void decodeStep(const GroupTables& tb, size_t p, unsigned keep, Group* g) {
@@ -429,7 +429,7 @@ void decodeStep(const GroupTables& tb, size_t p, unsigned keep, Group* g) {
   g->hits |= F::rayBits(g->ray + p, movemask(hit) & keep);
 }
 
-// decodeGroup (query_group.h) with lanes F.
+// GroupKernel::decode (query_group.h) with lanes F.
 template <class F>
 void decodeGroupWith(const GroupTables& tb, Group* g) {
   constexpr size_t L = F::kLanes;
@@ -449,7 +449,7 @@ void decodeGroupWith(const GroupTables& tb, Group* g) {
   for (size_t p = 0; p < count; p += L) decodeStep<F>(tb, p, unsigned((keep >> p) & laneBits), g);
 }
 
-// sphereGroup (query_group.h) with lanes F.
+// GroupKernel::sphere (query_group.h) with lanes F.
 template <class F>
 void sphereGroupWith(const GroupTables& tb, const Ray* rays, size_t n, Group* g, LookupQueue* q) {
   constexpr size_t L = F::kLanes;
@@ -477,7 +477,7 @@ void sphereGroupWith(const GroupTables& tb, const Ray* rays, size_t n, Group* g,
   q->segment[q->segments++] = {g, first, 0, g->count};
 }
 
-// lookupQueue (query_group.h) with lanes F.
+// GroupKernel::lookup (query_group.h) with lanes F.
 template <class F>
 void lookupQueueWith(const GroupTables& tb, LookupQueue* q, bool flush) {
   constexpr size_t L = F::kLanes;
@@ -547,7 +547,7 @@ inline F floorV(F x) {
   return sel(lt(x, t), t - F(1.0f), t);
 }
 
-// planGroup (query_group.h) with lanes F: each line mirrors a line of
+// GroupKernel::plan (query_group.h) with lanes F: each line mirrors a line of
 // FieldQuery::Impl::planInterpolated (its kernel weight, toLocal of the sample's frame,
 // hemisphereToSquareFast, the footprint and the sample point's distance along the ray) or of
 // frameFromNormal, with the same binary32 operations in the same order.
@@ -631,8 +631,8 @@ inline void decodeNormalV(F cx, F cy, F* x, F* y, F* z) {
   *z = nz / len;
 }
 
-// blendGroup (query_group.h) with lanes F: each lane accumulates its taps in slot order and each
-// tap's texels (ix, iy), (ix + 1, iy), (ix, iy + 1), (ix + 1, iy + 1) in that order, as
+// GroupKernel::blend (query_group.h) with lanes F: each lane accumulates its taps in slot order and
+// each tap's texels (ix, iy), (ix + 1, iy), (ix, iy + 1), (ix + 1, iy + 1) in that order, as
 // FieldQuery::Impl::blendInterpolated does, with the same binary32 operations (a texel's weight
 // (weight * wx) * wy; t = base + distance, the ray being from outside).
 template <class F>
