@@ -12,11 +12,13 @@ namespace {
 
 struct F8 {
   static constexpr size_t kLanes = 8;
+  using Mask = F8;  // masks are vectors: all-ones or zero per lane
   __m256 v;
   F8() = default;
   F8(__m256 x) : v(x) {}  // NOLINT: implicit, so that intrinsics' results are lanes
   explicit F8(float x) : v(_mm256_set1_ps(x)) {}
   // (Static: they take no lanes to choose an overload by.)
+  static F8 none() { return F8(0.0f); }  // the mask of no lane
   static F8 load(const float* p);
   static F8 loadInt(const int32_t* p);
   static F8 gatherBytes(const uint8_t* base, const int32_t* at);
@@ -45,6 +47,9 @@ inline F8 bor(F8 a, F8 b) { return _mm256_or_ps(a.v, b.v); }
 inline F8 bandnot(F8 a, F8 b) { return _mm256_andnot_ps(a.v, b.v); }  // ~a & b
 inline F8 bnot(F8 a) { return _mm256_xor_ps(a.v, _mm256_castsi256_ps(_mm256_set1_epi32(-1))); }
 inline F8 sel(F8 m, F8 a, F8 b) { return _mm256_blendv_ps(b.v, a.v, m.v); }  // masks are all-ones or zero
+// A mask as a vector, to store it among floats, and back (masks are vectors here).
+inline F8 maskValue(F8 m) { return m; }
+inline F8 valueMask(F8 a) { return a; }
 inline F8 vabs(F8 a) { return _mm256_and_ps(a.v, _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff))); }
 inline F8 vneg(F8 a) { return _mm256_xor_ps(a.v, _mm256_set1_ps(-0.0f)); }
 inline F8 floorPos(F8 a) { return _mm256_cvtepi32_ps(_mm256_cvttps_epi32(a.v)); }  // 0 <= a < 2^31

@@ -18,9 +18,18 @@
 namespace vff::detail {
 namespace {
 
-// Sixteen lanes. Masks are vectors, as in the other kernels: all-ones or zero per lane.
+// A mask of sixteen lanes: an AVX-512 mask register (the other kernels' masks are vectors).
+struct M16 {
+  static constexpr size_t kLanes = 16;
+  using Mask = M16;
+  __mmask16 k;
+  static M16 none() { return {0}; }
+};
+
+// Sixteen lanes.
 struct F16 {
   static constexpr size_t kLanes = 16;
+  using Mask = M16;
   __m512 v;
   F16() = default;
   F16(__m512 x) : v(x) {}  // NOLINT: implicit, so that intrinsics' results are lanes
@@ -34,8 +43,9 @@ struct F16 {
   static uint64_t rayBits(const uint32_t* ray, unsigned bits);
 };
 
-inline __m512 maskVector(__mmask16 k) { return _mm512_castsi512_ps(_mm512_movm_epi32(k)); }
-inline __mmask16 laneMask(F16 m) { return _mm512_movepi32_mask(_mm512_castps_si512(m.v)); }
+// A mask as a vector (all-ones or zero per lane), to store it among floats, and back.
+inline F16 maskValue(M16 m) { return _mm512_castsi512_ps(_mm512_movm_epi32(m.k)); }
+inline M16 valueMask(F16 a) { return {_mm512_movepi32_mask(_mm512_castps_si512(a.v))}; }
 
 inline F16 operator+(F16 a, F16 b) { return _mm512_add_ps(a.v, b.v); }
 inline F16 operator-(F16 a, F16 b) { return _mm512_sub_ps(a.v, b.v); }
@@ -45,25 +55,22 @@ inline F16 vsqrt(F16 a) { return _mm512_sqrt_ps(a.v); }
 inline F16 vrsqrt(F16 a) { return _mm512_rsqrt14_ps(a.v); }  // relative error <= 2^-14
 inline F16 vmin(F16 a, F16 b) { return _mm512_min_ps(a.v, b.v); }  // a < b ? a : b, as SSE2
 inline F16 vmax(F16 a, F16 b) { return _mm512_max_ps(a.v, b.v); }  // a > b ? a : b, as SSE2
-inline F16 gt(F16 a, F16 b) { return maskVector(_mm512_cmp_ps_mask(a.v, b.v, _CMP_GT_OQ)); }
-inline F16 ge(F16 a, F16 b) { return maskVector(_mm512_cmp_ps_mask(a.v, b.v, _CMP_GE_OQ)); }
-inline F16 lt(F16 a, F16 b) { return maskVector(_mm512_cmp_ps_mask(a.v, b.v, _CMP_LT_OQ)); }
-inline F16 le(F16 a, F16 b) { return maskVector(_mm512_cmp_ps_mask(a.v, b.v, _CMP_LE_OQ)); }
-inline F16 eq(F16 a, F16 b) { return maskVector(_mm512_cmp_ps_mask(a.v, b.v, _CMP_EQ_OQ)); }
-inline F16 nlt(F16 a, F16 b) { return maskVector(_mm512_cmp_ps_mask(a.v, b.v, _CMP_NLT_UQ)); }  // !(a < b): true for NaN
-inline F16 ngt(F16 a, F16 b) { return maskVector(_mm512_cmp_ps_mask(a.v, b.v, _CMP_NGT_UQ)); }  // !(a > b): true for NaN
-inline F16 band(F16 a, F16 b) { return _mm512_and_ps(a.v, b.v); }
-inline F16 bor(F16 a, F16 b) { return _mm512_or_ps(a.v, b.v); }
-inline F16 bandnot(F16 a, F16 b) { return _mm512_andnot_ps(a.v, b.v); }  // ~a & b
-inline F16 bnot(F16 a) {
-  const __m512i x = _mm512_castps_si512(a.v);
-  return _mm512_castsi512_ps(_mm512_ternarylogic_epi32(x, x, x, 0x55));  // ~a
-}
-// m ? a : b bit by bit (masks are all-ones or zero per lane).
-inline F16 sel(F16 m, F16 a, F16 b) {
-  return _mm512_castsi512_ps(
-      _mm512_ternarylogic_epi32(_mm512_castps_si512(m.v), _mm512_castps_si512(a.v), _mm512_castps_si512(b.v), 0xCA));
-}
+inline M16 gt(F16 a, F16 b) { return {_mm512_cmp_ps_mask(a.v, b.v, _CMP_GT_OQ)}; }
+inline M16 ge(F16 a, F16 b) { return {_mm512_cmp_ps_mask(a.v, b.v, _CMP_GE_OQ)}; }
+inline M16 lt(F16 a, F16 b) { return {_mm512_cmp_ps_mask(a.v, b.v, _CMP_LT_OQ)}; }
+inline M16 le(F16 a, F16 b) { return {_mm512_cmp_ps_mask(a.v, b.v, _CMP_LE_OQ)}; }
+inline M16 eq(F16 a, F16 b) { return {_mm512_cmp_ps_mask(a.v, b.v, _CMP_EQ_OQ)}; }
+inline M16 nlt(F16 a, F16 b) { return {_mm512_cmp_ps_mask(a.v, b.v, _CMP_NLT_UQ)}; }  // !(a < b): true for NaN
+inline M16 ngt(F16 a, F16 b) { return {_mm512_cmp_ps_mask(a.v, b.v, _CMP_NGT_UQ)}; }  // !(a > b): true for NaN
+inline M16 band(M16 a, M16 b) { return {__mmask16(a.k & b.k)}; }
+inline M16 bor(M16 a, M16 b) { return {__mmask16(a.k | b.k)}; }
+inline M16 bandnot(M16 a, M16 b) { return {__mmask16(~a.k & b.k)}; }  // ~a & b
+inline M16 bnot(M16 a) { return {__mmask16(~a.k)}; }
+// The lanes of a in m (band) or not in m (bandnot), zero elsewhere.
+inline F16 band(M16 m, F16 a) { return _mm512_maskz_mov_ps(m.k, a.v); }
+inline F16 bandnot(M16 m, F16 a) { return _mm512_maskz_mov_ps(__mmask16(~m.k), a.v); }
+// m ? a : b lane by lane.
+inline F16 sel(M16 m, F16 a, F16 b) { return _mm512_mask_blend_ps(m.k, b.v, a.v); }
 inline F16 vabs(F16 a) { return _mm512_abs_ps(a.v); }
 inline F16 vneg(F16 a) { return _mm512_xor_ps(a.v, _mm512_set1_ps(-0.0f)); }
 inline F16 floorPos(F16 a) { return _mm512_cvtepi32_ps(_mm512_cvttps_epi32(a.v)); }  // 0 <= a < 2^31
@@ -71,7 +78,7 @@ inline F16 F16::load(const float* p) { return _mm512_loadu_ps(p); }
 inline F16 F16::loadInt(const int32_t* p) { return _mm512_cvtepi32_ps(_mm512_loadu_si512(p)); }
 inline void store(float* p, F16 a) { _mm512_storeu_ps(p, a.v); }
 inline void storeInt(int32_t* p, F16 a) { _mm512_storeu_si512(p, _mm512_cvttps_epi32(a.v)); }
-inline unsigned movemask(F16 a) { return unsigned(laneMask(a)); }
+inline unsigned movemask(M16 m) { return unsigned(m.k); }
 
 // Stores the lanes of `a` selected by `mask`, in order, at dst[0 ..] (writes 16 floats).
 inline void compress(float* dst, F16 a, unsigned mask) {
@@ -94,16 +101,16 @@ inline void gatherUnit(const float* unit4, F16 k, F16* x, F16* y, F16* z) {
 
 // The words table[stride k + offset] as floats (UINT32_MAX as -1) for the lanes' k
 // (integer-valued floats) in `use`, 0 in the others.
-inline F16 gatherWord(const uint32_t* table, F16 k, int32_t stride, int32_t offset, F16 use) {
+inline F16 gatherWord(const uint32_t* table, F16 k, int32_t stride, int32_t offset, M16 use) {
   const __m512i idx =
       _mm512_add_epi32(_mm512_mullo_epi32(_mm512_cvttps_epi32(k.v), _mm512_set1_epi32(stride)), _mm512_set1_epi32(offset));
-  return _mm512_cvtepi32_ps(_mm512_mask_i32gather_epi32(_mm512_setzero_si512(), laneMask(use), idx, table, 4));
+  return _mm512_cvtepi32_ps(_mm512_mask_i32gather_epi32(_mm512_setzero_si512(), use.k, idx, table, 4));
 }
 
 // The union of the bytes table[idx] over the lanes in `use` (idx: integer-valued floats; reads
 // 4 bytes at table + idx).
-inline unsigned maskUnion(const uint8_t* table, F16 idx, F16 use) {
-  const __mmask16 k = laneMask(use);
+inline unsigned maskUnion(const uint8_t* table, F16 idx, M16 use) {
+  const __mmask16 k = use.k;
   const __m512i words = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), k, _mm512_cvttps_epi32(idx.v), table, 1);
   return unsigned(_mm512_mask_reduce_or_epi32(k, words)) & 0xFFu;
 }

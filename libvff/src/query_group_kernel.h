@@ -7,7 +7,10 @@
 // for AVX2 or AVX-512 can be shared with code that runs on a CPU without it.
 //
 // The vector type H (a float vector with +, -, *, / and the free functions used below, and static
-// load, loadInt, gatherBytes, compressIndex and rayBits; AVX2 and AVX-512: gatherSnorm16Pairs) is
+// load, loadInt, gatherBytes, compressIndex and rayBits; AVX2 and AVX-512: gatherSnorm16Pairs) and
+// its mask type H::Mask (what comparisons give: band, bor, bandnot, bnot, sel and movemask take
+// it; the vector itself, all-ones or zero per lane, in SSE2 and AVX2; a mask register in AVX-512,
+// which ran the AO rays of vff-experiments bench 1.07-1.08x faster than vector masks) are
 // defined by the including file, which runs the kernel on lanes F = Pair<H> or Pair<Pair<H>> (the
 // interpolated planner and blend, planWith and blendWith, on H itself, AVX2 and AVX-512 only): two
 // or four vectors side by side, so that the CPU overlaps their long dependency chains (the nearest
@@ -39,10 +42,12 @@ template <class H>
 struct Pair {
   static constexpr size_t kLanes = 2 * H::kLanes;
   static constexpr unsigned kHalf = (1u << H::kLanes) - 1;  // the first half's bits of a mask
+  using Mask = Pair<typename H::Mask>;
   H a, b;
   Pair() = default;
   Pair(H x, H y) : a(x), b(y) {}
   explicit Pair(float x) : a(x), b(x) {}
+  static Pair none() { return {H::none(), H::none()}; }
   static Pair load(const float* p) { return {H::load(p), H::load(p + H::kLanes)}; }
   static Pair loadInt(const int32_t* p) { return {H::loadInt(p), H::loadInt(p + H::kLanes)}; }
   static Pair gatherBytes(const uint8_t* base, const int32_t* at) {
@@ -61,18 +66,26 @@ template <class H> inline Pair<H> operator+(Pair<H> x, Pair<H> y) { return {x.a 
 template <class H> inline Pair<H> operator-(Pair<H> x, Pair<H> y) { return {x.a - y.a, x.b - y.b}; }
 template <class H> inline Pair<H> operator*(Pair<H> x, Pair<H> y) { return {x.a * y.a, x.b * y.b}; }
 template <class H> inline Pair<H> operator/(Pair<H> x, Pair<H> y) { return {x.a / y.a, x.b / y.b}; }
-#define VFF_PAIR_UNARY(f) \
-  template <class H>      \
-  inline Pair<H> f(Pair<H> x) { return {f(x.a), f(x.b)}; }
-#define VFF_PAIR_BINARY(f) \
-  template <class H>       \
-  inline Pair<H> f(Pair<H> x, Pair<H> y) { return {f(x.a, y.a), f(x.b, y.b)}; }
+// (Lanes or masks: with AVX-512 a comparison gives a mask of another type, and band and bandnot
+// also take a mask and lanes.)
+#define VFF_PAIR_UNARY(f)                                        \
+  template <class H>                                             \
+  inline auto f(Pair<H> x)->Pair<decltype(f(x.a))> {             \
+    return {f(x.a), f(x.b)};                                     \
+  }
+#define VFF_PAIR_BINARY(f)                                       \
+  template <class A, class B>                                    \
+  inline auto f(Pair<A> x, Pair<B> y)->Pair<decltype(f(x.a, y.a))> { \
+    return {f(x.a, y.a), f(x.b, y.b)};                           \
+  }
 VFF_PAIR_UNARY(vsqrt)
 VFF_PAIR_UNARY(vrsqrt)
 VFF_PAIR_UNARY(bnot)
 VFF_PAIR_UNARY(vabs)
 VFF_PAIR_UNARY(vneg)
 VFF_PAIR_UNARY(floorPos)
+VFF_PAIR_UNARY(maskValue)
+VFF_PAIR_UNARY(valueMask)
 VFF_PAIR_BINARY(vmin)
 VFF_PAIR_BINARY(vmax)
 VFF_PAIR_BINARY(gt)
@@ -87,8 +100,8 @@ VFF_PAIR_BINARY(bor)
 VFF_PAIR_BINARY(bandnot)
 #undef VFF_PAIR_UNARY
 #undef VFF_PAIR_BINARY
-template <class H>
-inline Pair<H> sel(Pair<H> m, Pair<H> x, Pair<H> y) {
+template <class M, class H>
+inline Pair<H> sel(Pair<M> m, Pair<H> x, Pair<H> y) {
   return {sel(m.a, x.a, y.a), sel(m.b, x.b, y.b)};
 }
 template <class H>
@@ -115,8 +128,8 @@ inline void gatherUnit(const float* unit4, Pair<H> k, Pair<H>* x, Pair<H>* y, Pa
   gatherUnit(unit4, k.a, &x->a, &y->a, &z->a);
   gatherUnit(unit4, k.b, &x->b, &y->b, &z->b);
 }
-template <class H>
-inline unsigned maskUnion(const uint8_t* table, Pair<H> idx, Pair<H> use) {
+template <class H, class M>
+inline unsigned maskUnion(const uint8_t* table, Pair<H> idx, Pair<M> use) {
   return maskUnion(table, idx.a, use.a) | maskUnion(table, idx.b, use.b);
 }
 template <class H>
@@ -140,7 +153,7 @@ inline F maxStd(F a, F b) {
 template <class F>
 inline F atanUnitV(F t) {
   const F at = vabs(t);
-  const F big = gt(at, F(kTanPi8));
+  const auto big = gt(at, F(kTanPi8));
   const F one(1.0f);
   const F x = sel(big, (at - one) / (at + one), at);
   const F y0 = band(big, F(kQuarterPiF));
@@ -200,13 +213,13 @@ inline void hemisphereToSquareV(DirectionScheme scheme, F lx, F ly, F lz, F* a, 
     const F r = vsqrt(vmax(one - z, zero));
     const F lax = vabs(lx), lay = vabs(ly);
     const F k = r * F(4.0f / 3.14159265358979323846f);
-    const F bigX = gt(lax, lay);
+    const auto bigX = gt(lax, lay);
     const F s = atanUnitV(sel(bigX, ly, lx) / sel(bigX, lx, ly)) * k;
-    const F xNeg = lt(lx, zero), yNeg = lt(ly, zero);
+    const auto xNeg = lt(lx, zero), yNeg = lt(ly, zero);
     *a = sel(bigX, sel(xNeg, vneg(r), r), sel(yNeg, vneg(s), s));
     *b = sel(bigX, sel(xNeg, vneg(s), s), sel(yNeg, vneg(r), r));
     if (kAxis) {
-      const F axis = band(eq(lax, zero), eq(lay, zero));
+      const auto axis = band(eq(lax, zero), eq(lay, zero));
       *a = sel(axis, r, *a);
       *b = sel(axis, zero, *b);
     }
@@ -226,7 +239,7 @@ void sphereStep(const GroupTables& tb, const Ray* rays, Group* g, size_t r0, Loo
 
   // prepare(): the ray's length and unit direction.
   const F len = vsqrt(dx * dx + dy * dy + dz * dz);
-  F live = band(gt(len, zero), le(len, F(3.40282347e38f)));
+  typename F::Mask live = band(gt(len, zero), le(len, F(3.40282347e38f)));
   const F inv = one / len;
   const F wx = dx * inv, wy = dy * inv, wz = dz * inv;
   const F tminL = tmin * len, tmaxL = tmax * len;
@@ -241,7 +254,7 @@ void sphereStep(const GroupTables& tb, const Ray* rays, Group* g, size_t r0, Loo
   const F nbeta = vneg(beta);
   const F t1 = nbeta + sq;
   live = band(live, nlt(t1, zero));
-  const F inside = le(gamma, zero);
+  const auto inside = le(gamma, zero);
   const F t0 = sel(inside, t1, maxStd(nbeta - sq, zero));
   const F lo = sel(inside, maxStd(tminL, F(tb.insideLo)), tminL);
   if (tb.bit1) live = bandnot(inside, live);
@@ -274,7 +287,7 @@ void sphereStep(const GroupTables& tb, const Ray* rays, Group* g, size_t r0, Loo
     compress(g->pt0 + at, t0, bits);
     compress(g->plo + at, lo, bits);
     compress(g->phi + at, tmaxL, bits);
-    compress(g->pinside + at, inside, bits);
+    compress(g->pinside + at, maskValue(inside), bits);
   }
   F::compressIndex(g->ray + at, uint32_t(r0), bits);
   g->count += uint32_t(__builtin_popcount(bits));
@@ -294,15 +307,15 @@ void lookupStep(const GroupTables& tb, size_t p, LookupQueue* q) {
   const F fn(fnS);
   const F ax = vabs(eux), ay = vabs(euy), az = vabs(euz);
   const F l1 = ax + ay + az;
-  F redo = bnot(band(gt(l1, zero), lt(l1, F(3.0e38f))));
+  typename F::Mask redo = bnot(band(gt(l1, zero), lt(l1, F(3.0e38f))));
   const F pa = ax / l1 * fn, pb = ay / l1 * fn;
   const F fa = floorPos(pa), fb = floorPos(pb);
   const F gg(tb.gridGuard);
   redo = bor(redo, bor(bor(lt(pa - fa, gg), lt((fa + one) - pa, gg)), bor(lt(pb - fb, gg), lt((fb + one) - pb, gg))));
   const F a0 = vmin(fa, fn - one), b0 = vmin(fb, fn - one);
   const F h = bandnot(ge(euz, zero), one);  // 0 upper, 1 lower hemisphere
-  const F negX = lt(eux, zero), negY = lt(euy, zero);
-  const F use = bnot(redo);
+  const auto negX = lt(eux, zero), negY = lt(euy, zero);
+  const auto use = bnot(redo);
   // The candidates any lane needs (octaCandidateMasks); lanes not in use look up sample 0.
   const unsigned needed = tb.octaMasks ? maskUnion(tb.octaMasks, b0 * fn + a0, use) : 0xFFu;
   // Each candidate is scored without its table position: in the quadrant frame it is the grid
@@ -322,7 +335,7 @@ void lookupStep(const GroupTables& tb, size_t p, LookupQueue* q) {
     const F y = y0 * (nrThreeHalves - nrHalf * len2 * y0 * y0);  // 1 / |g|: one Newton step
     const F d = sel(le(sum, fn), ((a * ax + b * ay) + c * az) * y, minusInf);
     second = vmax(second, vmin(d, best));
-    const F better = gt(d, best);
+    const auto better = gt(d, best);
     best = vmax(best, d);
     bestA = sel(better, a, bestA);
     bestB = sel(better, b, bestB);
@@ -330,7 +343,7 @@ void lookupStep(const GroupTables& tb, size_t p, LookupQueue* q) {
   // No valid candidate (best - second is NaN) or a near tie: the reference's own scores decide
   // (octaBestCandidate, one lane at a time: well under 1% of random lanes); where there is no
   // valid candidate the lane is redone.
-  F tie = ngt(best - second, F(2.0f * kOctaScoreError) * l1);
+  auto tie = ngt(best - second, F(2.0f * kOctaScoreError) * l1);
   if (const unsigned settle = movemask(bandnot(redo, tie)); settle != 0) {
     alignas(64) float sa[L], sb[L], fa0[L], fb0[L];
     alignas(64) int32_t left[L] = {};
@@ -386,7 +399,7 @@ void lookupStep(const GroupTables& tb, size_t p, LookupQueue* q) {
     return bor(band(lt(v - fv, tg), band(ge(fv, one), le(fv, top))), band(lt((fv + one) - v, tg), le(fv + one, top)));
   };
   redo = bor(redo, bor(nearEdge(x, fx), nearEdge(y, fy)));
-  const F ok = bnot(redo);
+  const auto ok = bnot(redo);
   const F ti = band(ok, vmin(vmax(fx, zero), top)), tj = band(ok, vmin(vmax(fy, zero), top));
   if (packedIndices(tb)) {
     storeInt(reinterpret_cast<int32_t*>(q->k + p), band(ok, bestK));
@@ -423,9 +436,9 @@ void decodeStep(const GroupTables& tb, size_t p, unsigned keep, Group* g) {
   }
   const F d = c * F(tb.distanceScale);
   const F t0 = F::load(g->pt0 + p);
-  const F th = sel(F::load(g->pinside + p), t0 - d, t0 + d);
+  const F th = sel(valueMask(F::load(g->pinside + p)), t0 - d, t0 + d);
   // texel(): a hit unless the code is 255; hitsAt(): !(th < lo || th > hi).
-  const F hit = band(bnot(eq(c, F(255.0f))), band(nlt(th, F::load(g->plo + p)), ngt(th, F::load(g->phi + p))));
+  const auto hit = band(bnot(eq(c, F(255.0f))), band(nlt(th, F::load(g->plo + p)), ngt(th, F::load(g->phi + p))));
   g->hits |= F::rayBits(g->ray + p, movemask(hit) & keep);
 }
 
@@ -566,17 +579,17 @@ void planWith(const PlanTables& tb, const PlanRays& in, PlanBlock* out) {
     const F ox = F::load(in.ox + c0), oy = F::load(in.oy + c0), oz = F::load(in.oz + c0);
     // (k0 < 2^24: exact as a float.)
     const F k0 = F::loadInt(reinterpret_cast<const int32_t*>(in.k0 + c0));
-    const F planned = eq(F::loadInt(reinterpret_cast<const int32_t*>(in.active + c0)), one);
-    F ended = zero;  // lanes whose neighbour list has ended (as planInterpolated's break)
+    const auto planned = eq(F::loadInt(reinterpret_cast<const int32_t*>(in.active + c0)), one);
+    auto ended = F::Mask::none();  // lanes whose neighbour list has ended (as planInterpolated's break)
     for (size_t c = 0; c < kPlanSlots; ++c) {
       // The slot's sample (the nearest, or neighbour c - 1 of it) and its position; lanes without
       // one read sample 0 and are left out.
-      const F active = bandnot(ended, planned);
+      const auto active = bandnot(ended, planned);
       F k = band(active, k0);
       if (c > 0) k = gatherWord(tb.neighbours, k, int32_t(kQueryNeighbours), int32_t(c - 1), active);
-      const F end = band(active, eq(k, F(-1.0f)));  // UINT32_MAX
+      const auto end = band(active, eq(k, F(-1.0f)));  // UINT32_MAX
       ended = bor(ended, end);
-      const F use = bandnot(end, active);
+      const auto use = bandnot(end, active);
       k = band(use, k);
       F ux0, uy0, uz0;
       gatherUnit(tb.unit4, k, &ux0, &uy0, &uz0);
@@ -584,7 +597,7 @@ void planWith(const PlanTables& tb, const PlanRays& in, PlanBlock* out) {
       const F dx = eux - ux0, dy = euy - uy0, dz = euz - uz0;
       const F x = one - (dx * dx + dy * dy + dz * dz) / kr2;
       F weight = sel(gt(x, zero), x * x, zero);
-      F keep = use;
+      auto keep = use;
       if (c == 0)
         weight = maxStd(weight, minWeight);
       else
@@ -621,7 +634,7 @@ inline void decodeNormalV(F cx, F cy, F* x, F* y, F* z) {
   const F one(1.0f), mone(-1.0f), zero(0.0f), snorm(32767.0f);
   const F px = maxStd(cx / snorm, mone), py = maxStd(cy / snorm, mone);
   const F nz = (one - vabs(px)) - vabs(py);
-  const F fold = lt(nz, zero);
+  const auto fold = lt(nz, zero);
   const F ox = (one - vabs(py)) * sel(ge(px, zero), one, mone);
   const F oy = (one - vabs(px)) * sel(ge(py, zero), one, mone);
   const F nx = sel(fold, ox, px), ny = sel(fold, oy, py);
@@ -652,7 +665,7 @@ void blendWith(const BlendTables& tb, const PlanBlock& plan, const BlendRays& in
       }
       if (any == 0) continue;
       // Lanes without this tap read texel 0 of map 0 and add nothing.
-      const F inSlot = eq(F::loadInt(tap), one);
+      const auto inSlot = eq(F::loadInt(tap), one);
       const F k = band(inSlot, F::loadInt(plan.k[c] + c0));
       const F ix = F::loadInt(plan.ix[c] + c0), iy = F::loadInt(plan.iy[c] + c0);
       const F fx = F::load(plan.fx[c] + c0), fy = F::load(plan.fy[c] + c0);
@@ -661,18 +674,18 @@ void blendWith(const BlendTables& tb, const PlanBlock& plan, const BlendRays& in
       for (int dj = 0; dj < 2; ++dj) {
         for (int di = 0; di < 2; ++di) {
           const F bw = weight * wx[di] * wy[dj];
-          const F take = bandnot(le(bw, zero), inSlot);  // (blendInterpolated skips bw <= 0)
+          const auto take = bandnot(le(bw, zero), inSlot);  // (blendInterpolated skips bw <= 0)
           const F ti = vmin(vmax(ix + F(float(di)), zero), top), tj = vmin(vmax(iy + F(float(dj)), zero), top);
           const F texel = band(inSlot, tj * fm + ti);
           alignas(64) int32_t at[L];
           storeTexelIndex(at, k, texel, tb.mapBytes);
           const F code = F::gatherBytes(tb.texels, at);
-          const F hit = bandnot(eq(code, missCode), take);
+          const auto hit = bandnot(eq(code, missCode), take);
           missW = sel(bandnot(hit, take), missW + bw, missW);
           const F t = base + code * scale;
-          const F far = band(hit, gt(t, hi));  // beyond the range: unoccluded
+          const auto far = band(hit, gt(t, hi));  // beyond the range: unoccluded
           farW = sel(far, farW + bw, farW);
-          const F counted = bandnot(bor(far, lt(t, lo)), hit);  // (before the range: left out)
+          const auto counted = bandnot(bor(far, lt(t, lo)), hit);  // (before the range: left out)
           hitW = sel(counted, hitW + bw, hitW);
           tSum = sel(counted, tSum + bw * t, tSum);
           if (tb.normals) {

@@ -11,11 +11,13 @@ namespace {
 
 struct F4 {
   static constexpr size_t kLanes = 4;
+  using Mask = F4;  // masks are vectors: all-ones or zero per lane
   __m128 v;
   F4() = default;
   F4(__m128 x) : v(x) {}  // NOLINT: implicit, so that intrinsics' results are lanes
   explicit F4(float x) : v(_mm_set1_ps(x)) {}
   // (Static: they take no lanes to choose an overload by.)
+  static F4 none() { return F4(0.0f); }  // the mask of no lane
   static F4 load(const float* p);
   static F4 loadInt(const int32_t* p);
   static F4 gatherBytes(const uint8_t* base, const int32_t* at);
@@ -43,6 +45,9 @@ inline F4 bor(F4 a, F4 b) { return _mm_or_ps(a.v, b.v); }
 inline F4 bandnot(F4 a, F4 b) { return _mm_andnot_ps(a.v, b.v); }  // ~a & b
 inline F4 bnot(F4 a) { return _mm_xor_ps(a.v, _mm_castsi128_ps(_mm_set1_epi32(-1))); }
 inline F4 sel(F4 m, F4 a, F4 b) { return _mm_or_ps(_mm_and_ps(m.v, a.v), _mm_andnot_ps(m.v, b.v)); }
+// A mask as a vector, to store it among floats, and back (masks are vectors here).
+inline F4 maskValue(F4 m) { return m; }
+inline F4 valueMask(F4 a) { return a; }
 inline F4 vabs(F4 a) { return _mm_and_ps(a.v, _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff))); }
 inline F4 vneg(F4 a) { return _mm_xor_ps(a.v, _mm_set1_ps(-0.0f)); }
 inline F4 floorPos(F4 a) { return _mm_cvtepi32_ps(_mm_cvttps_epi32(a.v)); }  // 0 <= a < 2^31
