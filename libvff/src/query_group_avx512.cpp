@@ -146,42 +146,41 @@ inline uint64_t F16::rayBits(const uint32_t* ray, unsigned bits) {
 }
 
 // Sixteen rays of eight floats each (origin, direction, tmin, tmax), transposed: lane l of
-// component c is float c of ray l. Three rounds of eight two-vector permutations.
+// component c is float c of ray l. Each 256-bit half of a vector takes one ray (r[i]: rays i and
+// i + 4, r[4 + i]: rays 8 + i and 12 + i, i < 4), so that the eight-by-eight transpose runs
+// within the 128-bit lanes (unpack, then shuffle) and ends with one shuffle of 128-bit lanes
+// per component.
 inline void loadRays(const float* p, F16* ox, F16* oy, F16* oz, F16* dx, F16* dy, F16* dz, F16* tmin, F16* tmax) {
-  // Index tables: entry e of a permutation of (a, b) takes float e' of a (e' < 16) or e' - 16 of b.
-  // Round 1, per pair of loads (rays 4 q .. 4 q + 3): components 0-3 (and 4-7) of the four rays,
-  // component-major: entry 4 c + j = component c (4 + c) of ray j.
-  alignas(64) static constexpr int32_t kLo[16] = {0, 8, 16, 24, 1, 9, 17, 25, 2, 10, 18, 26, 3, 11, 19, 27};
-  alignas(64) static constexpr int32_t kHi[16] = {4, 12, 20, 28, 5, 13, 21, 29, 6, 14, 22, 30, 7, 15, 23, 31};
-  // Round 2, two results of round 1 (rays 0-3 and 4-7 of eight): entry 8 c + j = component c
-  // (or 2 + c) of ray j.
-  alignas(64) static constexpr int32_t kFirst[16] = {0, 1, 2, 3, 16, 17, 18, 19, 4, 5, 6, 7, 20, 21, 22, 23};
-  alignas(64) static constexpr int32_t kSecond[16] = {8, 9, 10, 11, 24, 25, 26, 27, 12, 13, 14, 15, 28, 29, 30, 31};
-  // Round 3, two results of round 2 (rays 0-7 and 8-15): entry l = component 0 (or 1) of ray l.
-  alignas(64) static constexpr int32_t kC0[16] = {0, 1, 2, 3, 4, 5, 6, 7, 16, 17, 18, 19, 20, 21, 22, 23};
-  alignas(64) static constexpr int32_t kC1[16] = {8, 9, 10, 11, 12, 13, 14, 15, 24, 25, 26, 27, 28, 29, 30, 31};
-  const __m512i lo = _mm512_load_si512(kLo), hi = _mm512_load_si512(kHi);
-  const __m512i first = _mm512_load_si512(kFirst), second = _mm512_load_si512(kSecond);
-  const __m512i c0 = _mm512_load_si512(kC0), c1 = _mm512_load_si512(kC1);
-  __m512 r[8], a[4], b[4];
-  for (int i = 0; i < 8; ++i) r[i] = _mm512_loadu_ps(p + 16 * i);  // rays 2 i and 2 i + 1
-  for (int q = 0; q < 4; ++q) {
-    a[q] = _mm512_permutex2var_ps(r[2 * q], lo, r[2 * q + 1]);   // components 0-3 of rays 4 q ..
-    b[q] = _mm512_permutex2var_ps(r[2 * q], hi, r[2 * q + 1]);   // components 4-7
+  __m512 r[8];
+  for (int i = 0; i < 4; ++i) {
+    r[i] = _mm512_insertf32x8(_mm512_castps256_ps512(_mm256_loadu_ps(p + 8 * i)), _mm256_loadu_ps(p + 8 * (i + 4)), 1);
+    r[4 + i] = _mm512_insertf32x8(_mm512_castps256_ps512(_mm256_loadu_ps(p + 8 * (8 + i))),
+                                  _mm256_loadu_ps(p + 8 * (12 + i)), 1);
   }
-  // Rays 0-7 and 8-15: components 0-1, 2-3, 4-5, 6-7.
-  const __m512 a01 = _mm512_permutex2var_ps(a[0], first, a[1]), a23 = _mm512_permutex2var_ps(a[0], second, a[1]);
-  const __m512 b01 = _mm512_permutex2var_ps(b[0], first, b[1]), b23 = _mm512_permutex2var_ps(b[0], second, b[1]);
-  const __m512 c01 = _mm512_permutex2var_ps(a[2], first, a[3]), c23 = _mm512_permutex2var_ps(a[2], second, a[3]);
-  const __m512 d01 = _mm512_permutex2var_ps(b[2], first, b[3]), d23 = _mm512_permutex2var_ps(b[2], second, b[3]);
-  *ox = _mm512_permutex2var_ps(a01, c0, c01);
-  *oy = _mm512_permutex2var_ps(a01, c1, c01);
-  *oz = _mm512_permutex2var_ps(a23, c0, c23);
-  *dx = _mm512_permutex2var_ps(a23, c1, c23);
-  *dy = _mm512_permutex2var_ps(b01, c0, d01);
-  *dz = _mm512_permutex2var_ps(b01, c1, d01);
-  *tmin = _mm512_permutex2var_ps(b23, c0, d23);
-  *tmax = _mm512_permutex2var_ps(b23, c1, d23);
+  // Per 128-bit lane, of rays a and b: (a0 b0 a1 b1) and (a2 b2 a3 b3) (floats 4-7 in the upper
+  // lane of each half).
+  __m512 t[8];
+  for (int q = 0; q < 4; ++q) {
+    t[2 * q] = _mm512_unpacklo_ps(r[2 * q], r[2 * q + 1]);
+    t[2 * q + 1] = _mm512_unpackhi_ps(r[2 * q], r[2 * q + 1]);
+  }
+  // Float c of four rays per 128-bit lane: s[4 h + c] (c < 4) holds float c in lanes 0 and 2,
+  // float c + 4 in lanes 1 and 3, of rays 0-3 and 4-7 (h = 0) or 8-11 and 12-15 (h = 1).
+  __m512 s[8];
+  for (int h = 0; h < 2; ++h) {
+    const __m512 a = t[4 * h], b = t[4 * h + 1], c = t[4 * h + 2], d = t[4 * h + 3];
+    s[4 * h + 0] = _mm512_shuffle_ps(a, c, _MM_SHUFFLE(1, 0, 1, 0));
+    s[4 * h + 1] = _mm512_shuffle_ps(a, c, _MM_SHUFFLE(3, 2, 3, 2));
+    s[4 * h + 2] = _mm512_shuffle_ps(b, d, _MM_SHUFFLE(1, 0, 1, 0));
+    s[4 * h + 3] = _mm512_shuffle_ps(b, d, _MM_SHUFFLE(3, 2, 3, 2));
+  }
+  // Lanes 0 and 2 of each (floats 0-3), or 1 and 3 (floats 4-7), rays 0-15 in order.
+  F16* const low[4] = {ox, oy, oz, dx};
+  F16* const high[4] = {dy, dz, tmin, tmax};
+  for (int c = 0; c < 4; ++c) {
+    *low[c] = _mm512_shuffle_f32x4(s[c], s[4 + c], _MM_SHUFFLE(2, 0, 2, 0));
+    *high[c] = _mm512_shuffle_f32x4(s[c], s[4 + c], _MM_SHUFFLE(3, 1, 3, 1));
+  }
 }
 
 }  // namespace
