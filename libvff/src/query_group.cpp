@@ -64,7 +64,7 @@ const Available& available() noexcept {
 #if defined(VFF_HAVE_AVX512_KERNEL)
     // (libgcc's and compiler-rt's checks include the OS's support for the AVX-512 registers.)
     if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
-        __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw"))
+        __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("bmi2"))
       r.avx512 = &kAvx512;
 #endif
     return r;

@@ -208,8 +208,8 @@ inline size_t texelByte(DistanceEncoding e, uint32_t m, uint32_t i, uint32_t j) 
 // True where the group kernel is implemented (x86-64). Elsewhere the caller uses prepare().
 bool groupKernelAvailable() noexcept;
 // The group kernel that runs: "avx512" (32 lanes in two AVX-512 vectors, where the CPU has
-// AVX-512 F, DQ, VL and BW), "avx2" (32 lanes in four vectors, where it has AVX2), "sse2" (8) or
-// "scalar" (none: prepare() per ray).
+// AVX-512 F, DQ, VL and BW, and BMI2), "avx2" (32 lanes in four vectors, where it has AVX2),
+// "sse2" (8) or "scalar" (none: prepare() per ray).
 const char* groupKernelName() noexcept;
 
 // For tests: force a kernel for the whole process. kAuto (the default) takes the widest the CPU

@@ -25,6 +25,7 @@ struct F8 {
   static void gatherSnorm16Pairs(const uint8_t* base, const int32_t* at, F8* x, F8* y);
   static void compressIndex(uint32_t* dst, uint32_t first, unsigned mask);
   static uint64_t rayBits(const uint32_t* ray, unsigned bits);
+  static uint64_t hitsByRay(const Group& g, uint64_t packed);
 };
 
 inline F8 operator+(F8 a, F8 b) { return _mm256_add_ps(a.v, b.v); }
@@ -157,6 +158,12 @@ inline uint64_t F8::rayBits(const uint32_t* ray, unsigned bits) {
     return uint32_t(_mm_cvtsi128_si32(x));
   };
   return uint64_t(orLanes(lo)) | (uint64_t(orLanes(hi)) << 32);
+}
+// Bit g.ray[p] for every bit p set in `packed` (packed ray p).
+inline uint64_t F8::hitsByRay(const Group& g, uint64_t packed) {
+  uint64_t out = 0;
+  for (size_t p = 0; p < g.count; p += kLanes) out |= rayBits(g.ray + p, unsigned(packed >> p) & ((1u << kLanes) - 1));
+  return out;
 }
 
 // Eight rays of eight floats each (origin, direction, tmin, tmax), transposed.

@@ -1,12 +1,12 @@
 // The group kernel (query_group_kernel.h) on 32 lanes: two vectors of sixteen AVX-512 lanes. This
-// file alone is compiled with -mavx512f -mavx512dq -mavx512vl -mavx512bw (not -mfma: no operation
-// may be fused); query_group.cpp calls it only on a CPU (and OS) with those. Against the AVX2
-// kernel it runs about half the instructions, and its 32 vector registers hold what the AVX2
-// kernel spills to the stack. It constructs no object of a type declared outside it, so that no
+// file alone is compiled with -mavx512f -mavx512dq -mavx512vl -mavx512bw -mbmi2 (not -mfma: no
+// operation may be fused); query_group.cpp calls it only on a CPU (and OS) with those. Against
+// the AVX2 kernel it runs about half the instructions, and its 32 vector registers hold what the
+// AVX2 kernel spills to the stack. It constructs no object of a type declared outside it, so that no
 // inline function compiled here can stand in for the baseline copy used elsewhere.
 #include "query_group.h"
 
-#if defined(__AVX512F__) && defined(__AVX512DQ__) && defined(__AVX512VL__) && defined(__AVX512BW__)
+#if defined(__AVX512F__) && defined(__AVX512DQ__) && defined(__AVX512VL__) && defined(__AVX512BW__) && defined(__BMI2__)
 #if defined(__GNUC__) && !defined(__clang__) && __GNUC__ < 13
 // GCC 12's AVX-512 intrinsics start from _mm512_undefined_ps() and warn that it is uninitialized
 // wherever they are inlined (GCC bug 105593, fixed in GCC 13).
@@ -40,7 +40,7 @@ struct F16 {
   static F16 gatherBytes(const uint8_t* base, const int32_t* at);
   static void gatherSnorm16Pairs(const uint8_t* base, const int32_t* at, F16* x, F16* y);
   static void compressIndex(uint32_t* dst, uint32_t first, unsigned mask);
-  static uint64_t rayBits(const uint32_t* ray, unsigned bits);
+  static uint64_t hitsByRay(const Group& g, uint64_t packed);
 };
 
 // A mask as a vector (all-ones or zero per lane), to store it among floats, and back.
@@ -136,14 +136,10 @@ inline void F16::gatherSnorm16Pairs(const uint8_t* base, const int32_t* at, F16*
   *x = _mm512_cvtepi32_ps(_mm512_srai_epi32(_mm512_slli_epi32(w, 16), 16));
   *y = _mm512_cvtepi32_ps(_mm512_srai_epi32(w, 16));
 }
-// Bit ray[l] for every lane l set in `bits` (ray[l] < 64).
-inline uint64_t F16::rayBits(const uint32_t* ray, unsigned bits) {
-  const __m512i one = _mm512_set1_epi64(1);
-  const __m512i lo = _mm512_sllv_epi64(one, _mm512_cvtepu32_epi64(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(ray))));
-  const __m512i hi = _mm512_sllv_epi64(one, _mm512_cvtepu32_epi64(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(ray + 8))));
-  return uint64_t(_mm512_mask_reduce_or_epi64(__mmask8(bits & 0xFFu), lo)) |
-         uint64_t(_mm512_mask_reduce_or_epi64(__mmask8(bits >> 8), hi));
-}
+// Bit g.ray[p] for every bit p set in `packed` (packed ray p): the packed rays are the rays set in
+// g.reached, in order, so this deposits the bits of `packed` at those of g.reached (BMI2's pdep,
+// which every CPU with AVX-512 BW, DQ and VL has; query_group.cpp checks it too).
+inline uint64_t F16::hitsByRay(const Group& g, uint64_t packed) { return _pdep_u64(packed, g.reached); }
 
 // Sixteen rays of eight floats each (origin, direction, tmin, tmax), transposed: lane l of
 // component c is float c of ray l. Each 256-bit half of a vector takes one ray (r[i]: rays i and

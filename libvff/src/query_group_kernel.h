@@ -7,7 +7,7 @@
 // for AVX2 or AVX-512 can be shared with code that runs on a CPU without it.
 //
 // The vector type H (a float vector with +, -, *, / and the free functions used below, and static
-// load, loadInt, gatherBytes, compressIndex and rayBits; AVX2 and AVX-512: gatherSnorm16Pairs) and
+// load, loadInt, gatherBytes, compressIndex and hitsByRay; AVX2 and AVX-512: gatherSnorm16Pairs) and
 // its mask type H::Mask (what comparisons give: band, bor, bandnot, bnot, sel and movemask take
 // it; the vector itself, all-ones or zero per lane, in SSE2 and AVX2; a mask register in AVX-512,
 // which ran the AO rays of vff-experiments bench 1.07-1.08x faster than vector masks) are
@@ -57,9 +57,7 @@ struct Pair {
     H::compressIndex(dst, first, mask & kHalf);
     H::compressIndex(dst + __builtin_popcount(mask & kHalf), first + uint32_t(H::kLanes), mask >> H::kLanes);
   }
-  static uint64_t rayBits(const uint32_t* ray, unsigned bits) {
-    return H::rayBits(ray, bits & kHalf) | H::rayBits(ray + H::kLanes, bits >> H::kLanes);
-  }
+  static uint64_t hitsByRay(const Group& g, uint64_t packed) { return H::hitsByRay(g, packed); }
 };
 
 template <class H> inline Pair<H> operator+(Pair<H> x, Pair<H> y) { return {x.a + y.a, x.b + y.b}; }
@@ -423,9 +421,9 @@ void lookupStep(const GroupTables& tb, size_t p, LookupQueue* q) {
 
 // GroupKernel::decode (query_group.h) for packed rays p .. p + kLanes - 1, those of `keep` only:
 // whether each texel holds a hit within the ray's range, as FieldQuery::Impl::hitsAt decodes a
-// kUnorm8Diameter texel, into g->hits (by ray).
+// kUnorm8Diameter texel: bit l of the answer for packed ray p + l.
 template <class F>
-void decodeStep(const GroupTables& tb, size_t p, unsigned keep, Group* g) {
+unsigned decodeStep(const GroupTables& tb, size_t p, const Group* g) {
   F c;
   if (tb.texels) {
     c = F::gatherBytes(tb.texels, g->t + p);
@@ -439,7 +437,7 @@ void decodeStep(const GroupTables& tb, size_t p, unsigned keep, Group* g) {
   const F th = sel(valueMask(F::load(g->pinside + p)), t0 - d, t0 + d);
   // texel(): a hit unless the code is 255; hitsAt(): !(th < lo || th > hi).
   const auto hit = band(bnot(eq(c, F(255.0f))), band(nlt(th, F::load(g->plo + p)), ngt(th, F::load(g->phi + p))));
-  g->hits |= F::rayBits(g->ray + p, movemask(hit) & keep);
+  return movemask(hit);
 }
 
 // GroupKernel::decode (query_group.h) with lanes F.
@@ -451,7 +449,7 @@ void decodeGroupWith(const GroupTables& tb, Group* g) {
   if (!tb.decodeHits || tb.octaN == 0 || count == 0) return;
   // Not the padded lanes, nor the redone rays (the caller's).
   const uint64_t all = packedBits(count);
-  const uint64_t keep = all & ~g->redo, laneBits = packedBits(L);
+  const uint64_t keep = all & ~g->redo;
   if (count % L != 0) {  // lanes past `count`: read, then left out of `keep`
     static_assert(Group::kSlack >= L, "a whole vector fits past the last packed ray");
     // (Arrays, not braced lists: a std::initializer_list's inline accessors, emitted here at -O0,
@@ -459,7 +457,9 @@ void decodeGroupWith(const GroupTables& tb, Group* g) {
     void* const tails[] = {g->k + count, g->t + count, g->pt0 + count, g->plo + count, g->phi + count, g->pinside + count};
     for (void* a : tails) std::memset(a, 0, L * 4);  // (4-byte entries)
   }
-  for (size_t p = 0; p < count; p += L) decodeStep<F>(tb, p, unsigned((keep >> p) & laneBits), g);
+  uint64_t hits = 0;  // by packed ray
+  for (size_t p = 0; p < count; p += L) hits |= uint64_t(decodeStep<F>(tb, p, g)) << p;
+  g->hits = F::hitsByRay(*g, hits & keep);
 }
 
 // GroupKernel::sphere (query_group.h) with lanes F.

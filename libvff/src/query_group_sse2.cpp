@@ -23,6 +23,7 @@ struct F4 {
   static F4 gatherBytes(const uint8_t* base, const int32_t* at);
   static void compressIndex(uint32_t* dst, uint32_t first, unsigned mask);
   static uint64_t rayBits(const uint32_t* ray, unsigned bits);
+  static uint64_t hitsByRay(const Group& g, uint64_t packed);
 };
 
 inline F4 operator+(F4 a, F4 b) { return _mm_add_ps(a.v, b.v); }
@@ -109,6 +110,12 @@ inline uint64_t F4::rayBits(const uint32_t* ray, unsigned bits) {
   uint64_t out = 0;
   for (int l = 0; l < 4; ++l)
     if ((bits >> l) & 1u) out |= uint64_t(1) << ray[l];
+  return out;
+}
+// Bit g.ray[p] for every bit p set in `packed` (packed ray p).
+inline uint64_t F4::hitsByRay(const Group& g, uint64_t packed) {
+  uint64_t out = 0;
+  for (size_t p = 0; p < g.count; p += kLanes) out |= rayBits(g.ray + p, unsigned(packed >> p) & ((1u << kLanes) - 1));
   return out;
 }
 
