@@ -12,6 +12,7 @@
 #include "vff/reader.h"
 
 #include "fast_lookup.h"
+#include "huge_pages.h"
 #include "query_group.h"
 
 namespace vff {
@@ -100,6 +101,7 @@ struct FieldQuery::Impl {
   float defaultBias = 0;             // fraction of R
   std::vector<float> chordScale;     // unorm8-chord: 2R cos(alpha) / 254 per texel (M * M)
   uint64_t payload = 0;
+  uint64_t hugePages = 0;  // bytes of the maps on huge pages (build(): adviseHugePages)
 
   Sample texel(uint32_t k, uint32_t i, uint32_t j) const noexcept {
     const uint8_t* map = dist[k];
@@ -293,6 +295,18 @@ void writeHitBytes(uint64_t hits, size_t n, uint8_t* out) {
   for (; r < n; ++r) out[r] = uint8_t((hits >> r) & 1u);
 }
 
+// detail::adviseHugePages over each run of maps that lie back to back; the bytes it got.
+uint64_t adviseHugePages(const std::vector<const uint8_t*>& maps, uint64_t mapBytes) {
+  uint64_t got = 0;
+  for (size_t k = 0; k < maps.size();) {
+    size_t end = k + 1;
+    while (end < maps.size() && maps[end] == maps[end - 1] + mapBytes) ++end;
+    got += detail::adviseHugePages(maps[k], size_t((end - k) * mapBytes));
+    k = end;
+  }
+  return got;
+}
+
 }  // namespace
 
 void FieldQuery::Impl::build() {
@@ -320,6 +334,8 @@ void FieldQuery::Impl::build() {
       blendTables.normalMapBytes = int32_t(normMapBytes);
     }
   }
+  // The maps are read at random: on huge pages, where the OS gives them (huge_pages.h).
+  hugePages = adviseHugePages(dist, distMapBytes) + adviseHugePages(norm, normMapBytes);
   frames.resize(n);
   unit4.assign(size_t(n) * 4, 0.0f);
   for (uint32_t k = 0; k < n; ++k) {
@@ -465,6 +481,7 @@ const PositionSet& FieldQuery::positions() const noexcept {
 }
 bool FieldQuery::hasNormals() const noexcept { return impl_ && !impl_->norm.empty(); }
 uint64_t FieldQuery::payloadBytes() const noexcept { return impl_ ? impl_->payload : 0; }
+uint64_t FieldQuery::hugePageBytes() const noexcept { return impl_ ? impl_->hugePages : 0; }
 
 // The core of every query. Distances below are object-space lengths along the unit direction w;
 // the caller's t is that length divided by |direction|.

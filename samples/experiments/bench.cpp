@@ -98,10 +98,11 @@ int runBench(const Options& o) {
   const vff::FieldQuery& q = (*field)->query;
   const vff::Instance& instance = (*field)->instance;  // q placed in the world
 
-  std::printf("Query benchmark: %s (%zu triangles), field %s (%.2f MiB payload, baked in %.2f s), "
-              "%u rays per set, %u threads, best of %d, batch kernel %s, %u rays per batch call\n\n",
+  std::printf("Query benchmark: %s (%zu triangles), field %s (%.2f MiB payload, %.2f MiB of it on huge pages, baked "
+              "in %.2f s), %u rays per set, %u threads, best of %d, batch kernel %s, %u rays per batch call\n\n",
               o.mesh.c_str(), world->worldMesh.triangleCount(), config.name().c_str(), (*field)->payloadMiB(),
-              (*field)->bakeSeconds, o.benchRays, threads, o.repeat, vff::batchKernelName(), o.benchBatch);
+              double(q.hugePageBytes()) / 1048576.0, (*field)->bakeSeconds, o.benchRays, threads, o.repeat,
+              vff::batchKernelName(), o.benchBatch);
   std::printf("| ray set | query | Mrays/s | x Embree | occluded | agreement with Embree |\n");
   std::printf("|---|---|---:|---:|---:|---:|\n");
 

@@ -3,12 +3,14 @@
 // both reconstructions, normals, transforms, batches and files.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <random>
 #include <vector>
 
+#include "../../libvff/src/huge_pages.h"  // private: detail::adviseHugePages
 #include "embree_reference.h"
 #include "vff/bake/baker.h"
 #include "vff/bake/procedural.h"
@@ -452,6 +454,34 @@ TEST(Query, FilesAnswerLikeTheirMaps) {
     }
     EXPECT_GT(expectBatchesEqualSingleRays(*q, rays), 300);
   }
+}
+
+TEST(Query, HugePagesLeaveTheMapsAsTheyWere) {
+  // 1090 maps of 64 x 64 (4.5 MiB) in caller memory: making the query may move their whole 2 MiB
+  // pages to huge pages (Linux 6.1+), which must change no byte of them and no answer.
+  auto b = bakeShape("torus-knot", 16, 64);
+  const std::vector<uint8_t> before = b->field.distance;
+  auto q = FieldQuery::fromMaps(b->field.field, b->field.distance);
+  ASSERT_TRUE(q.ok()) << q.error().toString();
+  std::printf("maps on huge pages: %llu of %llu bytes\n", static_cast<unsigned long long>(q->hugePageBytes()),
+              static_cast<unsigned long long>(q->payloadBytes()));
+  EXPECT_EQ(q->hugePageBytes() % (uint64_t(2) << 20), 0u);
+  EXPECT_LE(q->hugePageBytes(), q->payloadBytes());
+  EXPECT_TRUE(b->field.distance == before);
+  auto copy = FieldQuery::fromMaps(b->field.field, before);
+  ASSERT_TRUE(copy.ok());
+  Rng rng(29);
+  const Vec3 c = centerOf(b->field.field);
+  const float R = b->field.field.sphere.radius;
+  std::vector<Ray> rays(20000);
+  for (Ray& r : rays) r = Ray{add(c, mul(rng.direction(), 1.5f * R)), rng.direction()};
+  std::vector<uint8_t> x(rays.size()), y(rays.size());
+  q->occluded(rays, x);
+  copy->occluded(rays, y);
+  EXPECT_TRUE(x == y);
+  EXPECT_GT(std::count(x.begin(), x.end(), 1), 1000);
+  // Nothing to move in a range without a whole 2 MiB page.
+  EXPECT_EQ(detail::adviseHugePages(before.data(), 4096), 0u);
 }
 
 TEST(Query, DegenerateRaysMissAndBadPlanesAreErrors) {

@@ -120,9 +120,15 @@ struct QueryHit {
 
 // A query-ready view of one field. Borrows its maps: from a File (which must outlive the
 // FieldQuery) or from caller memory. Holds a small table per positional sample (its position,
-// tangent frame and neighbour list: 84 bytes per map), for octa-hemi2 n <= 128 one byte
-// per cell of the sample grid (n^2 bytes) and, for unorm8-chord, the decode scale of each texel of
-// a map (4 bytes per texel of one map).
+// tangent frame and neighbour list: 84 bytes per map), for octa-hemi2 n <= 128 one byte per cell
+// of the sample grid (n^2 bytes) and, for unorm8-chord, the decode scale of each texel of a map
+// (4 bytes per texel of one map).
+//
+// Queries read the maps at random, so on Linux (6.1 and later) making a FieldQuery asks the
+// kernel to back the whole 2 MiB pages within the maps with huge pages (madvise MADV_COLLAPSE;
+// hugePageBytes() says how many bytes it got): the TLB then covers the field. The bytes stay as
+// they are, and the caller's. The kernel declines for file mappings (a File's stored blocks) and
+// where transparent huge pages are off.
 class FieldQuery {
  public:
   FieldQuery() noexcept;  // empty: every ray misses
@@ -145,6 +151,8 @@ class FieldQuery {
   bool hasNormals() const noexcept;
   // Bytes of the maps this view reads (the field's payload: what a GPU would hold).
   uint64_t payloadBytes() const noexcept;
+  // Bytes of those maps the kernel moved to huge pages when this view was made (see above).
+  uint64_t hugePageBytes() const noexcept;
 
   // Object-space queries.
   QueryHit intersect(const Ray& ray, const QueryOptions& options = {}) const noexcept;
