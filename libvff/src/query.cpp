@@ -218,6 +218,7 @@ struct FieldQuery::Impl {
     // Four groups ahead, or non-temporal requests, made no difference runs could tell from noise).
     constexpr size_t kAhead = 2;
     auto requestRays = [&](size_t first, size_t many) {
+      if (many == 0) return;  // (an empty span's data() may be null)
       const char* p = reinterpret_cast<const char*>(rays.data() + first);
       for (size_t o = 0; o < many * sizeof(Ray); o += 64) __builtin_prefetch(p + o);
     };
