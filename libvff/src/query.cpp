@@ -101,7 +101,7 @@ struct FieldQuery::Impl {
   float defaultBias = 0;             // fraction of R
   std::vector<float> chordScale;     // unorm8-chord: 2R cos(alpha) / 254 per texel (M * M)
   uint64_t payload = 0;
-  uint64_t hugePages = 0;  // bytes of the maps on huge pages (build(): adviseHugePages)
+  uint64_t hugePages = 0;  // bytes of the maps on huge pages (build(): adviseMapRuns)
 
   Sample texel(uint32_t k, uint32_t i, uint32_t j) const noexcept {
     const uint8_t* map = dist[k];
@@ -301,7 +301,7 @@ void writeHitBytes(uint64_t hits, size_t n, uint8_t* out) {
 }
 
 // detail::adviseHugePages over each run of maps that lie back to back; the bytes it got.
-uint64_t adviseHugePages(const std::vector<const uint8_t*>& maps, uint64_t mapBytes) {
+uint64_t adviseMapRuns(const std::vector<const uint8_t*>& maps, uint64_t mapBytes) {
   uint64_t got = 0;
   for (size_t k = 0; k < maps.size();) {
     size_t end = k + 1;
@@ -340,7 +340,7 @@ void FieldQuery::Impl::build() {
     }
   }
   // The maps are read at random: on huge pages, where the OS gives them (huge_pages.h).
-  hugePages = adviseHugePages(dist, distMapBytes) + adviseHugePages(norm, normMapBytes);
+  hugePages = adviseMapRuns(dist, distMapBytes) + adviseMapRuns(norm, normMapBytes);
   frames.resize(n);
   unit4.assign(size_t(n) * 4, 0.0f);
   for (uint32_t k = 0; k < n; ++k) {
@@ -696,10 +696,10 @@ QueryHit FieldQuery::Impl::interpolated(const Ray& ray, const Lookup& l, float* 
 }
 
 // Batches of interpolated lookups. The group kernel finds, for 64 rays at a time, those that reach
-// the sphere and their nearest samples; then 16 at a time are planned together (the kernel's plan(),
-// as planInterpolated() one ray at a time) with all their taps' texels requested from memory, and
-// blended, 16 at a time too where the kernel can (its blend(), as blendInterpolated() one ray at a
-// time). Rays from inside the sphere are answered as kNearest (query()). (Blending a
+// the sphere and their nearest samples; then 16 at a time are planned together (the kernel's
+// plan(), as planInterpolated() one ray at a time) with all their taps' texels requested from
+// memory, and blended, 16 at a time too where the kernel can (its blend(), as blendInterpolated()
+// one ray at a time). Rays from inside the sphere are answered as kNearest (query()). (Blending a
 // block while the next is planned, so that its texels had longer to arrive, gained nothing:
 // in-process A/B on vff-experiments bench rays, 0.96-1.05x.)
 template <class Emit>

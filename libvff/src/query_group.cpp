@@ -46,7 +46,7 @@ constexpr GroupKernel kAvx2{"avx2", sphereGroupAvx2, lookupQueueAvx2, decodeGrou
 #endif
 #if defined(VFF_HAVE_AVX512_KERNEL)
 constexpr GroupKernel kAvx512{"avx512", sphereGroupAvx512, lookupQueueAvx512, decodeGroupAvx512,
-                         planGroupAvx512, blendGroupAvx512};
+                              planGroupAvx512, blendGroupAvx512};
 #endif
 
 // The kernels this CPU runs (decided once): null where it has not the instructions (or this

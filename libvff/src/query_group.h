@@ -90,8 +90,8 @@ struct Group {
   // GroupKernel::decode.
   float pt0[kGroupRays + kSlack], plo[kGroupRays + kSlack], phi[kGroupRays + kSlack], pinside[kGroupRays + kSlack];
   uint64_t redo = 0;    // bit p: the caller must run the reference prepare() on packed ray p
-  // GroupKernel::decode's answer, bit r: ray r hits within its range (hitsAt). Left unset for the rays
-  // in `redo`, which the caller answers.
+  // GroupKernel::decode's answer, bit r: ray r hits within its range (hitsAt). Left unset for the
+  // rays in `redo`, which the caller answers.
   uint64_t hits = 0;
   uint32_t looked = 0;  // packed rays whose texels are known (k, i, j, t, redo): all when == count
 };
@@ -157,8 +157,8 @@ struct PlanRays {
   uint32_t active[kPlanLanes];
 };
 
-// What GroupKernel::blend reads: the distance maps back to back (GroupTables::texels), unorm8-diameter,
-// and the normal maps (oct-snorm16) back to back, or none.
+// What GroupKernel::blend reads: the distance maps back to back (GroupTables::texels),
+// unorm8-diameter, and the normal maps (oct-snorm16) back to back, or none.
 struct BlendTables {
   const uint8_t* texels = nullptr;
   int32_t mapBytes = 0;

@@ -2,8 +2,8 @@
 // file alone is compiled with -mavx512f -mavx512dq -mavx512vl -mavx512bw -mbmi2 (not -mfma: no
 // operation may be fused); query_group.cpp calls it only on a CPU (and OS) with those. Against
 // the AVX2 kernel it runs about half the instructions, and its 32 vector registers hold what the
-// AVX2 kernel spills to the stack. It constructs no object of a type declared outside it, so that no
-// inline function compiled here can stand in for the baseline copy used elsewhere.
+// AVX2 kernel spills to the stack. It constructs no object of a type declared outside it, so that
+// no inline function compiled here can stand in for the baseline copy used elsewhere.
 #include "query_group.h"
 
 #if defined(__AVX512F__) && defined(__AVX512DQ__) && defined(__AVX512VL__) && defined(__AVX512BW__) && defined(__BMI2__)

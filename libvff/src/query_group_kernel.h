@@ -7,8 +7,8 @@
 // for AVX2 or AVX-512 can be shared with code that runs on a CPU without it.
 //
 // The vector type H (a float vector with +, -, *, / and the free functions used below, and static
-// load, loadInt, gatherBytes, compressIndex and hitsByRay; AVX2 and AVX-512: gatherSnorm16Pairs) and
-// its mask type H::Mask (what comparisons give: band, bor, bandnot, bnot, sel and movemask take
+// load, loadInt, gatherBytes, compressIndex and hitsByRay; AVX2 and AVX-512: gatherSnorm16Pairs)
+// and its mask type H::Mask (what comparisons give: band, bor, bandnot, bnot, sel and movemask take
 // it; the vector itself, all-ones or zero per lane, in SSE2 and AVX2; a mask register in AVX-512,
 // which ran the AO rays of vff-experiments bench 1.02-1.03x faster than vector masks) are
 // defined by the including file, which runs the kernel on lanes F = Pair<H> or Pair<Pair<H>> (the
@@ -66,15 +66,15 @@ template <class H> inline Pair<H> operator*(Pair<H> x, Pair<H> y) { return {x.a 
 template <class H> inline Pair<H> operator/(Pair<H> x, Pair<H> y) { return {x.a / y.a, x.b / y.b}; }
 // (Lanes or masks: with AVX-512 a comparison gives a mask of another type, and band and bandnot
 // also take a mask and lanes.)
-#define VFF_PAIR_UNARY(f)                                        \
-  template <class H>                                             \
-  inline auto f(Pair<H> x)->Pair<decltype(f(x.a))> {             \
-    return {f(x.a), f(x.b)};                                     \
+#define VFF_PAIR_UNARY(f)                              \
+  template <class H>                                   \
+  inline auto f(Pair<H> x) -> Pair<decltype(f(x.a))> { \
+    return {f(x.a), f(x.b)};                           \
   }
-#define VFF_PAIR_BINARY(f)                                       \
-  template <class A, class B>                                    \
-  inline auto f(Pair<A> x, Pair<B> y)->Pair<decltype(f(x.a, y.a))> { \
-    return {f(x.a, y.a), f(x.b, y.b)};                           \
+#define VFF_PAIR_BINARY(f)                                             \
+  template <class A, class B>                                          \
+  inline auto f(Pair<A> x, Pair<B> y) -> Pair<decltype(f(x.a, y.a))> { \
+    return {f(x.a, y.a), f(x.b, y.b)};                                 \
   }
 VFF_PAIR_UNARY(vsqrt)
 VFF_PAIR_UNARY(vrsqrt)
