@@ -217,12 +217,13 @@ struct FieldQuery::Impl {
     // each call, not requested before: 1.44x with calls of 256 rays, 1.01-1.09x with 4096.
     // Four groups ahead, or non-temporal requests, made no difference runs could tell from noise).
     constexpr size_t kAhead = 2;
+    // (many >= 1: an empty span's data() may be null. An early return for many == 0 in here
+    // made GCC 12 drop the loops' prefetches altogether: 0.6x.)
     auto requestRays = [&](size_t first, size_t many) {
-      if (many == 0) return;  // (an empty span's data() may be null)
       const char* p = reinterpret_cast<const char*>(rays.data() + first);
       for (size_t o = 0; o < many * sizeof(Ray); o += 64) __builtin_prefetch(p + o);
     };
-    requestRays(0, std::min(rays.size(), kAhead * detail::kGroupRays));
+    if (!rays.empty()) requestRays(0, std::min(rays.size(), kAhead * detail::kGroupRays));
     for (size_t b = 0; b < rays.size(); b += detail::kGroupRays) {
       const size_t n = std::min(detail::kGroupRays, rays.size() - b);
       if (const size_t a = b + kAhead * detail::kGroupRays; a < rays.size())
