@@ -159,12 +159,6 @@ inline uint64_t F8::rayBits(const uint32_t* ray, unsigned bits) {
   };
   return uint64_t(orLanes(lo)) | (uint64_t(orLanes(hi)) << 32);
 }
-// Bit g.ray[p] for every bit p set in `packed` (packed ray p).
-inline uint64_t F8::hitsByRay(const Group& g, uint64_t packed) {
-  uint64_t out = 0;
-  for (size_t p = 0; p < g.count; p += kLanes) out |= rayBits(g.ray + p, unsigned(packed >> p) & ((1u << kLanes) - 1));
-  return out;
-}
 
 // Eight rays of eight floats each (origin, direction, tmin, tmax), transposed.
 inline void loadRays(const float* p, F8* ox, F8* oy, F8* oz, F8* dx, F8* dy, F8* dz, F8* tmin, F8* tmax) {
@@ -192,6 +186,12 @@ inline void loadRays(const float* p, F8* ox, F8* oy, F8* oz, F8* dx, F8* dy, F8*
 }  // namespace vff::detail
 
 #include "query_group_kernel.h"
+
+namespace vff::detail {
+namespace {
+inline uint64_t F8::hitsByRay(const Group& g, uint64_t packed) { return hitsByRayBits<F8>(g, packed); }
+}  // namespace
+}  // namespace vff::detail
 
 namespace vff::detail {
 

@@ -37,6 +37,16 @@
 namespace vff::detail {
 namespace {
 
+// Bit g.ray[p] for every bit p set in `packed` (packed ray p), from H::rayBits a vector at a time
+// (the hitsByRay of lane types without a bit deposit: AVX2, SSE2).
+template <class H>
+uint64_t hitsByRayBits(const Group& g, uint64_t packed) {
+  uint64_t out = 0;
+  for (size_t p = 0; p < g.count; p += H::kLanes)
+    out |= H::rayBits(g.ray + p, unsigned(packed >> p) & ((1u << H::kLanes) - 1));
+  return out;
+}
+
 // Two lane vectors taken as one twice as wide (see the top of the file).
 template <class H>
 struct Pair {

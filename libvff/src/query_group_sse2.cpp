@@ -112,12 +112,6 @@ inline uint64_t F4::rayBits(const uint32_t* ray, unsigned bits) {
     if ((bits >> l) & 1u) out |= uint64_t(1) << ray[l];
   return out;
 }
-// Bit g.ray[p] for every bit p set in `packed` (packed ray p).
-inline uint64_t F4::hitsByRay(const Group& g, uint64_t packed) {
-  uint64_t out = 0;
-  for (size_t p = 0; p < g.count; p += kLanes) out |= rayBits(g.ray + p, unsigned(packed >> p) & ((1u << kLanes) - 1));
-  return out;
-}
 
 // Four rays of eight floats each (origin, direction, tmin, tmax), transposed.
 inline void loadRays(const float* p, F4* ox, F4* oy, F4* oz, F4* dx, F4* dy, F4* dz, F4* tmin, F4* tmax) {
@@ -139,6 +133,12 @@ inline void loadRays(const float* p, F4* ox, F4* oy, F4* oz, F4* dx, F4* dy, F4*
 }  // namespace vff::detail
 
 #include "query_group_kernel.h"
+
+namespace vff::detail {
+namespace {
+inline uint64_t F4::hitsByRay(const Group& g, uint64_t packed) { return hitsByRayBits<F4>(g, packed); }
+}  // namespace
+}  // namespace vff::detail
 
 namespace vff::detail {
 
