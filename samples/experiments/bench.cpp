@@ -22,6 +22,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
+#include <string>
 
 #include "cli.h"
 #include "common.h"
@@ -72,6 +74,32 @@ void inBatches(uint64_t b, uint64_t e, uint64_t batch, Fn&& fn) {
   for (uint64_t x = b; x < e; x += batch) fn(x, std::min(e, x + batch));
 }
 
+// The CPU as Linux names it ("model name", family and model from /proc/cpuinfo), or "unknown CPU".
+std::string cpuName() {
+  std::FILE* f = std::fopen("/proc/cpuinfo", "r");
+  if (!f) return "unknown CPU";
+  std::string name, family, model;
+  char line[512];
+  auto value = [&](const char* key, std::string* out) {
+    const size_t n = std::strlen(key);
+    if (!out->empty() || std::strncmp(line, key, n) != 0) return;
+    const char* colon = std::strchr(line + n, ':');
+    if (!colon) return;
+    std::string v(colon + 1);
+    while (!v.empty() && (v.front() == ' ' || v.front() == '\t')) v.erase(v.begin());
+    while (!v.empty() && (v.back() == '\n' || v.back() == ' ')) v.pop_back();
+    *out = v;
+  };
+  while (std::fgets(line, sizeof line, f)) {
+    value("model name", &name);
+    value("cpu family", &family);
+    value("model\t", &model);
+  }
+  std::fclose(f);
+  if (name.empty()) return "unknown CPU";
+  return family.empty() ? name : name + " (family " + family + ", model " + model + ")";
+}
+
 double seconds(const std::function<void()>& fn) {
   const auto t0 = std::chrono::steady_clock::now();
   fn();
@@ -99,10 +127,10 @@ int runBench(const Options& o) {
   const vff::Instance& instance = (*field)->instance;  // q placed in the world
 
   std::printf("Query benchmark: %s (%zu triangles), field %s (%.2f MiB payload, %.2f MiB of it on huge pages, baked "
-              "in %.2f s), %u rays per set, %u threads, best of %d, batch kernel %s, %u rays per batch call\n\n",
+              "in %.2f s), %u rays per set, %u threads, best of %d, batch kernel %s, %u rays per batch call, %s\n\n",
               o.mesh.c_str(), world->worldMesh.triangleCount(), config.name().c_str(), (*field)->payloadMiB(),
               double(q.hugePageBytes()) / 1048576.0, (*field)->bakeSeconds, o.benchRays, threads, o.repeat,
-              vff::batchKernelName(), o.benchBatch);
+              vff::batchKernelName(), o.benchBatch, cpuName().c_str());
   std::printf("| ray set | query | Mrays/s | x Embree | occluded | agreement with Embree |\n");
   std::printf("|---|---|---:|---:|---:|---:|\n");
 

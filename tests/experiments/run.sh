@@ -27,6 +27,13 @@ case "$case" in
     "$exp" bench --mesh knot.obj --config 1090x16x16 --bench-rays 20000 --repeat 1 -j 2 >stdout.txt 2>stderr.txt \
       || { cat stderr.txt; fail "bench failed"; }
     grep -q "Embree rtcOccluded1" stdout.txt || { cat stdout.txt; fail "bench prints no baseline"; }
+    # The figures name the machine they came from: the CPU ends the header line.
+    cpu=$(sed -n 's/^Query benchmark: .* rays per batch call, //p' stdout.txt)
+    [ -n "$cpu" ] || { head -1 stdout.txt; fail "bench header names no CPU"; }
+    if [ -r /proc/cpuinfo ]; then
+      model=$(sed -n 's/^model name[[:space:]]*: *//p' /proc/cpuinfo | head -1)
+      case "$cpu" in "$model"*) ;; *) fail "bench names the CPU '$cpu', /proc/cpuinfo '$model'" ;; esac
+    fi
     # Calls of 333 rays (groups and lookup vectors cut anywhere): the same occluded and agreement
     # figures as calls of 4096 (tests/unit/test_fast_lookup.cpp compares the answers ray by ray).
     "$exp" bench --mesh knot.obj --config 1090x16x16 --bench-rays 20000 --repeat 1 --batch 333 >small.txt 2>stderr.txt \
