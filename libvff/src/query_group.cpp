@@ -39,7 +39,7 @@ namespace {
 // vff-experiments bench than the one-ray planner, 0.83x, and blending them eight at a time
 // 0.92x on the AO rays, 1.03x on the aimed ones: SSE2 batches plan and blend one ray at a time.
 // With AVX2 the blend kernel ran 0.99x and 1.14x, with AVX-512 1.0-1.05x and 1.35-1.45x:
-// in-process A/B, 2 threads, Zen 4.)
+// in-process A/B, 2 threads, AMD Zen 5.)
 constexpr GroupKernel kSse2{"sse2", sphereGroupSse2, lookupQueueSse2, decodeGroupSse2, nullptr, nullptr};
 #if defined(VFF_HAVE_AVX2_KERNEL)
 constexpr GroupKernel kAvx2{"avx2", sphereGroupAvx2, lookupQueueAvx2, decodeGroupAvx2, planGroupAvx2, blendGroupAvx2};

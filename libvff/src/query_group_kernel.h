@@ -10,13 +10,16 @@
 // load, loadInt, gatherBytes, compressIndex and hitsByRay; AVX2 and AVX-512: gatherSnorm16Pairs)
 // and its mask type H::Mask (what comparisons give: band, bor, bandnot, bnot, sel and movemask take
 // it; the vector itself, all-ones or zero per lane, in SSE2 and AVX2; a mask register in AVX-512,
-// which ran the AO rays of vff-experiments bench 1.02-1.03x faster than vector masks) are
+// fewer instructions than vector masks) are
 // defined by the including file, which runs the kernel on lanes F = Pair<H> or Pair<Pair<H>> (the
 // interpolated planner and blend, planWith and blendWith, on H itself, AVX2 and AVX-512 only): two
 // or four vectors side by side, so that the CPU overlaps their long dependency chains (the nearest
 // sample, then the frame, then the texel). With eight-lane vectors, 32 lanes run 1.2-1.3x faster
 // than 8 on the aimed rays of vff-experiments bench and 1.1x on its AO rays; with four-lane
 // vectors 8 lanes beat 4 and 16; with sixteen-lane vectors 32 lanes beat 16 by about 1.1x.
+// (The in-process A/B figures in the kernel's comments: builds of libvff loaded side by side in
+// one process, taking turns over the bench's rays. Two builds of the same code differ there by
+// up to 3.5% (code placement), so figures within a few percent of 1 do not tell a change apart.)
 // Every line that computes a quantity prepare() also computes mirrors a line
 // of FieldQuery::Impl::prepare() or of fast_lookup.h with the same binary32 operations in the
 // same order (a ? b : c becomes sel(mask, b, c); no operation is fused or reordered), so that a
