@@ -10,7 +10,7 @@
 // load, loadInt, gatherBytes, compressIndex and hitsByRay; AVX2 and AVX-512: gatherSnorm16Pairs)
 // and its mask type H::Mask (what comparisons give: band, bor, bandnot, bnot, sel and movemask take
 // it; the vector itself, all-ones or zero per lane, in SSE2 and AVX2; a mask register in AVX-512,
-// fewer instructions than vector masks) are
+// which takes fewer instructions than vector masks) are
 // defined by the including file, which runs the kernel on lanes F = Pair<H> or Pair<Pair<H>> (the
 // interpolated planner and blend, planWith and blendWith, on H itself, AVX2 and AVX-512 only): two
 // or four vectors side by side, so that the CPU overlaps their long dependency chains (the nearest
