@@ -22,7 +22,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <cstring>
+#include <fstream>
 #include <string>
 
 #include "cli.h"
@@ -76,26 +76,22 @@ void inBatches(uint64_t b, uint64_t e, uint64_t batch, Fn&& fn) {
 
 // The CPU as Linux names it ("model name", family and model from /proc/cpuinfo), or "unknown CPU".
 std::string cpuName() {
-  std::FILE* f = std::fopen("/proc/cpuinfo", "r");
-  if (!f) return "unknown CPU";
-  std::string name, family, model;
-  char line[512];
+  std::ifstream in("/proc/cpuinfo");
+  std::string line, name, family, model;
+  // The value of the first line whose key (the text before the colon, blanks trimmed) is `key`.
   auto value = [&](const char* key, std::string* out) {
-    const size_t n = std::strlen(key);
-    if (!out->empty() || std::strncmp(line, key, n) != 0) return;
-    const char* colon = std::strchr(line + n, ':');
-    if (!colon) return;
-    std::string v(colon + 1);
-    while (!v.empty() && (v.front() == ' ' || v.front() == '\t')) v.erase(v.begin());
-    while (!v.empty() && (v.back() == '\n' || v.back() == ' ')) v.pop_back();
-    *out = v;
+    const size_t colon = line.find(':');
+    if (!out->empty() || colon == std::string::npos) return;
+    const size_t keyEnd = line.find_last_not_of(" \t", colon == 0 ? 0 : colon - 1);
+    if (keyEnd == std::string::npos || line.compare(0, keyEnd + 1, key) != 0) return;
+    const size_t v = line.find_first_not_of(" \t", colon + 1);
+    *out = v == std::string::npos ? std::string() : line.substr(v, line.find_last_not_of(" \t\r") + 1 - v);
   };
-  while (std::fgets(line, sizeof line, f)) {
+  while (std::getline(in, line)) {
     value("model name", &name);
     value("cpu family", &family);
-    value("model\t", &model);
+    value("model", &model);
   }
-  std::fclose(f);
   if (name.empty()) return "unknown CPU";
   return family.empty() ? name : name + " (family " + family + ", model " + model + ")";
 }
