@@ -697,21 +697,22 @@ QueryHit FieldQuery::Impl::interpolated(const Ray& ray, const Lookup& l, float* 
 }
 
 // Batches of interpolated lookups. The group kernel finds, for 64 rays at a time, those that reach
-// the sphere and their nearest samples; then 16 at a time are planned together (the kernel's
-// plan(), as planInterpolated() one ray at a time) with all their taps' texels requested from
-// memory, and blended, 16 at a time too where the kernel can (its blend(), as blendInterpolated()
-// one ray at a time). Rays from inside the sphere are answered as kNearest (query()). (Blending a
-// block while the next is planned, so that its texels had longer to arrive, gained nothing:
-// in-process A/B on vff-experiments bench rays, 0.96-1.05x.)
+// the sphere and their nearest samples; they fill blocks of 16, whatever group they came from (a
+// third of the AO rays reach the sphere: blocks cut at each group's end would run part-empty), and
+// each block is planned together (the kernel's plan(), as planInterpolated() one ray at a time)
+// with all its taps' texels requested from memory, then blended, 16 at a time too where the kernel
+// can (its blend(), as blendInterpolated() one ray at a time). Rays from inside the sphere are
+// answered as kNearest (query()). (Blending a block while the next is planned, so that its texels
+// had longer to arrive, gained nothing: in-process A/B on vff-experiments bench rays, 0.96-1.05x.)
 template <class Emit>
 void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept {
   constexpr size_t kPlanned = detail::kPlanLanes;
   const detail::GroupKernel* kernel = detail::groupKernel();  // (one for the whole batch)
   Lookup l[kPlanned];
   detail::PlanBlock plan{};  // (zeroed: the blend kernel reads every lane of a slot)
-  uint32_t which[kPlanned];
+  size_t which[kPlanned];    // the lanes' rays (indices into rays)
   bool live[kPlanned];
-  auto finish = [&](size_t base, size_t count) {
+  auto finish = [&](size_t count) {
     // The blends of the block's rays from outside the sphere, 16 at once where the kernel can.
     detail::BlendSums sums;
     bool summed = false;
@@ -730,7 +731,7 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
       }
     }
     for (size_t c = 0; c < count; ++c) {
-      const Ray& ray = rays[base + which[c]];
+      const Ray& ray = rays[which[c]];
       float vis = 1.0f;
       QueryHit h;
       if (live[c] && l[c].inside) {
@@ -746,7 +747,7 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
       } else if (live[c]) {
         h = blendInterpolated(ray, l[c], plan, c, &vis);
       }
-      emit(base + which[c], h, vis);
+      emit(which[c], h, vis);
     }
   };
   // Requests the texels of lane c (planned, where its ray starts outside the sphere).
@@ -761,36 +762,54 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
     for (size_t base = 0; base < rays.size(); base += kPlanned) {
       const size_t n = std::min(kPlanned, rays.size() - base);
       for (size_t r = 0; r < n; ++r) {
-        which[r] = uint32_t(r);
+        which[r] = base + r;
         live[r] = prepare(rays[base + r], o, &l[r]);
         if (live[r] && !l[r].inside) planInterpolated(rays[base + r], l[r], &plan, r);
         request(r);
       }
-      finish(base, n);
+      finish(n);
     }
     return;
   }
   const detail::PlanTables tables = planTables();
+  detail::PlanRays in{};  // the block being filled (lanes not planned: zero, inactive)
+  size_t count = 0;       // its lanes filled
+  auto runBlock = [&] {
+    bool any = false;
+    for (size_t c = 0; c < count; ++c) any = any || in.active[c] != 0;
+    if (any && floatMapIndices && kernel->plan) {
+      kernel->plan(tables, in, &plan);
+    } else if (any) {
+      for (size_t c = 0; c < count; ++c) {
+        if (in.active[c])
+          planInterpolated(rays[which[c]], l[c], &plan, c);
+        else
+          plan.mask[c] = 0;
+      }
+    }
+    for (size_t c = 0; c < count; ++c) request(c);
+    finish(count);
+    in = {};
+    count = 0;
+  };
   forEachGroup(*kernel, rays, groupTables(o, false), [&](size_t base, size_t n, detail::Group& g) {
     for (size_t r = 0; r < n; ++r)
       if (!((g.reached >> r) & 1u)) emit(base + r, QueryHit{}, 1.0f);
-    for (uint32_t first = 0; first < g.count; first += kPlanned) {
-      const size_t count = std::min<size_t>(kPlanned, g.count - first);
-      detail::PlanRays in{};  // (lanes not planned: zero, inactive)
-      for (size_t c = 0; c < count; ++c) {
-        const uint32_t p = first + uint32_t(c), r = g.ray[p];
-        const Ray& ray = rays[base + r];
-        which[c] = r;
-        if ((g.redo >> p) & 1u) {
-          live[c] = prepare(ray, o, &l[c]);
-        } else {
-          live[c] = true;
-          lookupFrom(ray, g.len[r], g.t0[r], (g.inside >> r) & 1u, g.lo[r], g.hi[r], &l[c]);
-          l[c].k0 = g.k[p];
-          l[c].i = g.i[p];
-          l[c].j = g.j[p];
-        }
-        if (!live[c] || l[c].inside) continue;
+    for (uint32_t p = 0; p < g.count; ++p) {
+      const size_t c = count;
+      const uint32_t r = g.ray[p];
+      const Ray& ray = rays[base + r];
+      which[c] = base + r;
+      if ((g.redo >> p) & 1u) {
+        live[c] = prepare(ray, o, &l[c]);
+      } else {
+        live[c] = true;
+        lookupFrom(ray, g.len[r], g.t0[r], (g.inside >> r) & 1u, g.lo[r], g.hi[r], &l[c]);
+        l[c].k0 = g.k[p];
+        l[c].i = g.i[p];
+        l[c].j = g.j[p];
+      }
+      if (live[c] && !l[c].inside) {
         in.eux[c] = l[c].eu.x;
         in.euy[c] = l[c].eu.y;
         in.euz[c] = l[c].eu.z;
@@ -806,22 +825,10 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
         in.k0[c] = l[c].k0;
         in.active[c] = 1;
       }
-      bool any = false;
-      for (size_t c = 0; c < count; ++c) any = any || in.active[c] != 0;
-      if (any && floatMapIndices && kernel->plan) {
-        kernel->plan(tables, in, &plan);
-      } else if (any) {
-        for (size_t c = 0; c < count; ++c) {
-          if (in.active[c])
-            planInterpolated(rays[base + which[c]], l[c], &plan, c);
-          else
-            plan.mask[c] = 0;
-        }
-      }
-      for (size_t c = 0; c < count; ++c) request(c);
-      finish(base, count);
+      if (++count == kPlanned) runBlock();
     }
   });
+  if (count) runBlock();
 }
 
 QueryHit FieldQuery::intersect(const Ray& ray, const QueryOptions& options) const noexcept {

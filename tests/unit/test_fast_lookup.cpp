@@ -470,8 +470,9 @@ void checkBatches(detail::KernelChoice) {
         }
         EXPECT_GT(hitCount, rays.size() / 10);  // the test exercises hits, not only misses
       }
-      // Interpolated batches (the group kernel finds the nearest samples) against one-ray calls,
-      // on the field and on the same field with a normal field.
+      // Interpolated batches (the group kernel finds the nearest samples; the rays that reach the
+      // sphere fill blocks of 16 across its groups) against one-ray calls, on the field and on the
+      // same field with a normal field; calls that end within a group and within a block.
       QueryOptions oi = o;
       oi.reconstruction = Reconstruction::kInterpolated;
       FieldDesc fn = f;
@@ -485,6 +486,15 @@ void checkBatches(detail::KernelChoice) {
         std::vector<QueryHit> hits(rays.size());
         field->visibility(rays, vis, oi);
         field->intersect(rays, hits, oi);
+        for (size_t batch : {size_t(7), size_t(65), size_t(200)}) {
+          std::vector<float> part(rays.size());
+          for (size_t b = 0; b < rays.size(); b += batch) {
+            const size_t e = std::min(rays.size(), b + batch);
+            field->visibility(std::span<const Ray>(rays).subspan(b, e - b), std::span<float>(part).subspan(b, e - b), oi);
+          }
+          for (size_t r = 0; r < rays.size(); ++r)
+            ASSERT_EQ(part[r], vis[r]) << "n " << n << " batch " << batch << " ray " << r;
+        }
         for (size_t r = 0; r < rays.size(); ++r) {
           ASSERT_EQ(vis[r], field->visibility(rays[r], oi)) << "n " << n << " ray " << r;
           const QueryHit single = field->intersect(rays[r], oi);
