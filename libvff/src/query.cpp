@@ -292,6 +292,13 @@ struct BitBytes {
 constexpr BitBytes kBitBytes{};
 
 // out[r] = bit r of hits (0 or 1), for r < n <= 64.
+// fn(r) for each r < n whose bit in `bits` is clear: a loop over the set bits of the rest, with no
+// branch per bit (the rays that reach the sphere are random bits of their group).
+template <class Fn>
+void forEachClear(uint64_t bits, size_t n, Fn&& fn) {
+  for (uint64_t m = ~bits & detail::packedBits(n); m != 0; m &= m - 1) fn(size_t(__builtin_ctzll(m)));
+}
+
 void writeHitBytes(uint64_t hits, size_t n, uint8_t* out) {
   size_t r = 0;
   for (; r + 8 <= n; r += 8) {
@@ -793,8 +800,7 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
     count = 0;
   };
   forEachGroup(*kernel, rays, groupTables(o, false), [&](size_t base, size_t n, detail::Group& g) {
-    for (size_t r = 0; r < n; ++r)
-      if (!((g.reached >> r) & 1u)) emit(base + r, QueryHit{}, 1.0f);
+    forEachClear(g.reached, n, [&](size_t r) { emit(base + r, QueryHit{}, 1.0f); });
     for (uint32_t p = 0; p < g.count; ++p) {
       const size_t c = count;
       const uint32_t r = g.ray[p];
@@ -911,10 +917,7 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
   }
   forEachGroup(*kernel, rays, tables, [&](size_t base, size_t n, detail::Group& g) {
     // Every ray misses unless it reaches the sphere.
-    if constexpr (!kHitOnly) {
-      for (size_t r = 0; r < n; ++r)
-        if (!((g.reached >> r) & 1u)) emit(base + r, QueryHit{}, 1.0f);
-    }
+    if constexpr (!kHitOnly) forEachClear(g.reached, n, [&](size_t r) { emit(base + r, QueryHit{}, 1.0f); });
     // The rays the kernel left to the reference.
     uint64_t dead = 0;
     for (uint64_t redo = g.redo; redo != 0; redo &= redo - 1) {
