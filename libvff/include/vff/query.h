@@ -43,11 +43,12 @@
 // time, in AVX-512 or AVX2 vectors where the CPU has them (8 in SSE2 vectors on other x86-64
 // CPUs), the rays that reach the sphere gathered from consecutive groups of 64 so that the
 // vectors are full, and fetch the texels from memory ahead of their use; kInterpolated batches
-// plan 16 rays at once and fetch all their texels, then blend them 16 at once over
-// kUnorm8Diameter fields (in AVX-512 or AVX2 lanes where the CPU has them). They give bit for bit
-// the answers of the one-ray functions, several times faster (vff-experiments bench). Hand them thousands of rays per call
-// where you can: each call ends with its last rays in a part-filled vector (vff-experiments bench
-// --batch 256 against the default 4096). occluded() and visibility() with kNearest are fastest on
+// plan 16 rays at once (also gathered from consecutive groups) and fetch all their texels, then
+// blend them 16 at once over kUnorm8Diameter fields (in AVX-512 or AVX2 lanes where the CPU has
+// them). They give bit for bit the answers of the one-ray functions, several times faster
+// (vff-experiments bench). Hand them thousands of rays per call where you can: each call ends
+// with its last rays in a part-filled vector (vff-experiments bench --batch 256 against the
+// default 4096). occluded() and visibility() with kNearest are fastest on
 // kUnorm8Diameter fields, whose hit flags the group kernel decodes as well. An Instance's kNearest
 // batches are as fast as its field's: the group kernel takes each ray to object space itself.
 #pragma once
