@@ -281,6 +281,13 @@ namespace {
 
 Vec3 toVec(const float c[3]) { return {c[0], c[1], c[2]}; }
 
+// fn(r) for each r < n whose bit in `bits` is clear: a loop over the set bits of the rest, with no
+// branch per bit (the rays that reach the sphere are random bits of their group).
+template <class Fn>
+void forEachClear(uint64_t bits, size_t n, Fn&& fn) {
+  for (uint64_t m = ~bits & detail::packedBits(n); m != 0; m &= m - 1) fn(size_t(__builtin_ctzll(m)));
+}
+
 // For every byte value b, the 8 bytes (bit l of b) for l = 0 .. 7, little-endian.
 struct BitBytes {
   uint64_t word[256];
@@ -292,13 +299,6 @@ struct BitBytes {
 constexpr BitBytes kBitBytes{};
 
 // out[r] = bit r of hits (0 or 1), for r < n <= 64.
-// fn(r) for each r < n whose bit in `bits` is clear: a loop over the set bits of the rest, with no
-// branch per bit (the rays that reach the sphere are random bits of their group).
-template <class Fn>
-void forEachClear(uint64_t bits, size_t n, Fn&& fn) {
-  for (uint64_t m = ~bits & detail::packedBits(n); m != 0; m &= m - 1) fn(size_t(__builtin_ctzll(m)));
-}
-
 void writeHitBytes(uint64_t hits, size_t n, uint8_t* out) {
   size_t r = 0;
   for (; r + 8 <= n; r += 8) {
