@@ -625,6 +625,8 @@ detail::PlanTables FieldQuery::Impl::planTables() const noexcept {
   t.radius = radius;
   t.m = m;
   t.scheme = field.directionScheme;
+  t.texels = blendTables.texels;
+  t.mapBytes = blendTables.mapBytes;
   return t;
 }
 
@@ -784,7 +786,8 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
   auto runBlock = [&] {
     bool any = false;
     for (size_t c = 0; c < count; ++c) any = any || in.active[c] != 0;
-    if (any && floatMapIndices && kernel->plan) {
+    const bool kernelPlans = any && floatMapIndices && kernel->plan;
+    if (kernelPlans) {
       kernel->plan(tables, in, &plan);
     } else if (any) {
       for (size_t c = 0; c < count; ++c) {
@@ -794,7 +797,9 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
           plan.mask[c] = 0;
       }
     }
-    for (size_t c = 0; c < count; ++c) request(c);
+    // (The kernel's plan has requested the texels of its lanes where it knows where they lie.)
+    for (size_t c = 0; c < count; ++c)
+      if (!(kernelPlans && tables.texels && in.active[c])) request(c);
     finish(count);
     in = {};
     count = 0;

@@ -144,6 +144,9 @@ struct PlanTables {
   float radius = 0;
   uint32_t m = 0;  // map resolution
   DirectionScheme scheme = DirectionScheme::kInvalid;
+  // As BlendTables::texels and mapBytes (null: none): the plan requests each tap's two texel rows.
+  const uint8_t* texels = nullptr;
+  int32_t mapBytes = 0;
 };
 
 // The rays to plan, lane by lane (FieldQuery::Impl::Lookup's eu, v, w and k0, and the ray's

@@ -632,6 +632,16 @@ void planWith(const PlanTables& tb, const PlanRays& in, PlanBlock* out) {
       storeInt(out->k[c] + c0, k);
       storeInt(out->ix[c] + c0, fx0);
       storeInt(out->iy[c] + c0, fy0);
+      if (tb.texels) {  // the two texel rows of the footprint, as FieldQuery::Impl::prefetchPlan
+        const F top = fm - one, col = vmin(vmax(fx0, zero), top);
+        alignas(64) int32_t row0[L], row1[L];
+        storeTexelIndex(row0, k, vmin(vmax(fy0, zero), top) * fm + col, tb.mapBytes);
+        storeTexelIndex(row1, k, vmin(vmax(fy0 + one, zero), top) * fm + col, tb.mapBytes);
+        for (unsigned m = bits; m != 0; m &= m - 1) {
+          __builtin_prefetch(tb.texels + row0[__builtin_ctz(m)]);
+          __builtin_prefetch(tb.texels + row1[__builtin_ctz(m)]);
+        }
+      }
       store(out->fx[c] + c0, px - fx0);
       store(out->fy[c] + c0, py - fy0);
       store(out->weight[c] + c0, weight);
