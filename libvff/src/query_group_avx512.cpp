@@ -129,10 +129,11 @@ inline void storeTexelIndex(int32_t* dst, F16 k, F16 t, int32_t mapBytes) {
                                       _mm512_cvttps_epi32(t.v));
   _mm512_storeu_si512(dst, at);
 }
-// The bytes base[at[l]] as floats: sixteen byte loads. They beat a vpgatherdd of the words ending
-// at each byte on the scattered texels of the decode (two in-process A/B runs on AMD Zen 5,
-// vff-experiments bench rays: AO 1.00-1.04x, aimed 1.02-1.11x; loading the sample positions of
-// gatherUnit the same way, with a transpose, gained nothing on the AO rays).
+// The bytes base[at[l]] as floats: sixteen byte loads. They ran no slower than a vpgatherdd of the
+// words ending at each byte on the scattered texels of the decode (two in-process A/B runs on AMD
+// Zen 5, vff-experiments bench rays: AO 1.00-1.04x, within that harness's noise; aimed
+// 1.02-1.11x; loading the sample positions of gatherUnit the same way, with a transpose, gained
+// nothing on the AO rays).
 inline F16 F16::gatherBytes(const uint8_t* base, const int32_t* at) {
   alignas(64) int32_t bytes[16];
   for (int l = 0; l < 16; ++l) bytes[l] = base[at[l]];
