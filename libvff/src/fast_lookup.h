@@ -114,6 +114,21 @@ inline std::vector<uint8_t> octaCandidateMasks(uint32_t un) {
   return masks;
 }
 
+// For n <= kOctaCornerRowsMax: per row b0 of the quadrant's cells, bit a0 set where cell (a0, b0)
+// of octaCandidateMasks(n) may need a candidate other than its four corners (kOctaCandidates 0-3);
+// kOctaCornerRowsMax rows, zero past n. Empty for larger n (or no masks). The AVX-512 kernel
+// looks a lane's row up in two registers instead of gathering the lane's mask: at n = 32 two
+// cells of the 1024 have such a bit, at n = 16 two of 256, below none.
+inline constexpr uint32_t kOctaCornerRowsMax = 32;
+inline std::vector<uint32_t> octaCornerRows(const std::vector<uint8_t>& masks, uint32_t n) {
+  if (n == 0 || n > kOctaCornerRowsMax || masks.size() < size_t(n) * n) return {};
+  std::vector<uint32_t> rows(kOctaCornerRowsMax, 0);
+  for (uint32_t b0 = 0; b0 < n; ++b0)
+    for (uint32_t a0 = 0; a0 < n; ++a0)
+      if (masks[size_t(b0) * n + a0] & ~0x0Fu) rows[b0] |= uint32_t(1) << a0;
+  return rows;
+}
+
 // The nearest of the octa-hemi2 candidates of cell (a0, b0) of q's quadrant (kOctaCandidates,
 // those with |a| + |b| <= n) by binary32 dot products of q with the float table `unit4` (4 floats
 // per sample: x, y, z and padding), ties to the smallest index, as FieldQuery does with the

@@ -94,6 +94,7 @@ struct FieldQuery::Impl {
   std::vector<Frame> frames;         // frame of map k (inward normal)
   std::vector<float> unit4;          // û_k, float, padded to 4 floats per map (for the group kernel)
   std::vector<uint8_t> octaMasks;    // octa-hemi2: detail::octaCandidateMasks (the group kernel)
+  std::vector<uint32_t> octaCornerRows;  // detail::octaCornerRows of octaMasks (n <= 32)
   static constexpr uint32_t kNeighbours = kQueryNeighbours;
   std::vector<uint32_t> neighbours;  // kNeighbours per map; UINT32_MAX pads
   float spacing = 0;                 // mean angular spacing sqrt(4 pi / mapCount)
@@ -360,6 +361,7 @@ void FieldQuery::Impl::build() {
   }
   if (positions.scheme() == PositionScheme::kOctaHemi2) {
     octaMasks = detail::octaCandidateMasks(positions.param());
+    octaCornerRows = detail::octaCornerRows(octaMasks, positions.param());
     if (!octaMasks.empty()) octaMasks.resize(octaMasks.size() + 3, 0);  // GroupTables::octaMasks' padding
   }
   spacing = std::sqrt(4.0f * kPi / float(n));
@@ -864,6 +866,7 @@ detail::GroupTables FieldQuery::Impl::groupTables(const QueryOptions& o, bool de
   t.octaN = positions.scheme() == PositionScheme::kOctaHemi2 ? positions.param() : 0;
   t.unit4 = unit4.data();
   t.octaMasks = octaMasks.empty() ? nullptr : octaMasks.data();
+  t.octaCornerRows = octaCornerRows.empty() ? nullptr : octaCornerRows.data();
   t.scheme = field.directionScheme;
   t.m = m;
   t.bit1 = field.distanceEncoding == DistanceEncoding::kBit1;

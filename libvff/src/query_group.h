@@ -44,6 +44,9 @@ struct GroupTables {
   // octaCandidateMasks(octaN) (fast_lookup.h), then 3 readable bytes (the AVX2 kernel reads the
   // masks 4 bytes at a time); null: all eight.
   const uint8_t* octaMasks = nullptr;
+  // octaCornerRows(octaMasks, octaN) (fast_lookup.h): 32 rows, for octaN <= 32; else null. Lanes
+  // whose cells all have clear bits score the four corners without reading octaMasks (AVX-512).
+  const uint32_t* octaCornerRows = nullptr;
   DirectionScheme scheme = DirectionScheme::kInvalid;
   uint32_t m = 0;                   // map resolution
   bool bit1 = false;                // the distance encoding has no distances (rays from inside miss)

@@ -120,6 +120,9 @@ inline unsigned maskUnion(const uint8_t* table, F8 idx, F8 use) {
   return unsigned(_mm_cvtsi128_si32(x)) & 0xFFu;
 }
 
+// (AVX-512 only: here every lookup reads its cell's mask.)
+inline bool cornersSuffice(const uint32_t*, F8, F8, F8) { return false; }
+
 // k * mapBytes + t for the lanes' samples k and texel bytes t (integer-valued floats), into dst.
 inline void storeTexelIndex(int32_t* dst, F8 k, F8 t, int32_t mapBytes) {
   const __m256i at = _mm256_add_epi32(_mm256_mullo_epi32(_mm256_cvttps_epi32(k.v), _mm256_set1_epi32(mapBytes)),

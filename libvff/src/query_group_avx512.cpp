@@ -129,6 +129,15 @@ inline unsigned maskUnion(const uint8_t* table, F16 idx, M16 use) {
   return unsigned(_mm512_mask_reduce_or_epi32(k, words)) & 0xFFu;
 }
 
+// Whether every lane in `use` lies in a cell (a0, b0) (integer-valued floats, < 32) whose bit a0 of
+// rows[b0] is clear (GroupTables::octaCornerRows: 32 rows, looked up in two registers).
+inline bool cornersSuffice(const uint32_t* rows, F16 a0, F16 b0, M16 use) {
+  const __m512i row = _mm512_permutex2var_epi32(_mm512_loadu_si512(rows), _mm512_cvttps_epi32(b0.v),
+                                                _mm512_loadu_si512(rows + 16));
+  const __m512i bit = _mm512_srlv_epi32(row, _mm512_cvttps_epi32(a0.v));
+  return _mm512_mask_test_epi32_mask(use.k, bit, _mm512_set1_epi32(1)) == 0;
+}
+
 // k * mapBytes + t for the lanes' samples k and texel bytes t (integer-valued floats), into dst.
 inline void storeTexelIndex(int32_t* dst, F16 k, F16 t, int32_t mapBytes) {
   const __m512i at = _mm512_add_epi32(_mm512_mullo_epi32(_mm512_cvttps_epi32(k.v), _mm512_set1_epi32(mapBytes)),

@@ -143,6 +143,10 @@ template <class H, class M>
 inline unsigned maskUnion(const uint8_t* table, Pair<H> idx, Pair<M> use) {
   return maskUnion(table, idx.a, use.a) | maskUnion(table, idx.b, use.b);
 }
+template <class H, class M>
+inline bool cornersSuffice(const uint32_t* rows, Pair<H> a0, Pair<H> b0, Pair<M> use) {
+  return cornersSuffice(rows, a0.a, b0.a, use.a) && cornersSuffice(rows, a0.b, b0.b, use.b);
+}
 template <class H>
 inline void storeTexelIndex(int32_t* dst, Pair<H> k, Pair<H> t, int32_t mapBytes) {
   storeTexelIndex(dst, k.a, t.a, mapBytes);
@@ -327,8 +331,12 @@ void lookupStep(const GroupTables& tb, size_t p, LookupQueue* q) {
   const F h = bandnot(ge(euz, zero), one);  // 0 upper, 1 lower hemisphere
   const auto negX = lt(eux, zero), negY = lt(euy, zero);
   const auto use = bnot(redo);
-  // The candidates any lane needs (octaCandidateMasks); lanes not in use look up sample 0.
-  const unsigned needed = tb.octaMasks ? maskUnion(tb.octaMasks, b0 * fn + a0, use) : 0xFFu;
+  // The candidates any lane needs (octaCandidateMasks); lanes not in use look up sample 0. Where
+  // no lane's cell needs more than its four corners (octaCornerRows), the masks are not read.
+  const unsigned needed = !tb.octaMasks ? 0xFFu
+                          : tb.octaCornerRows && cornersSuffice(tb.octaCornerRows, a0, b0, use)
+                              ? 0x0Fu
+                              : maskUnion(tb.octaMasks, b0 * fn + a0, use);
   // Each candidate is scored without its table position: in the quadrant frame it is the grid
   // point g = (a, b, n - |a| - |b|), and its score g.(|x|, |y|, |z|) / |g| is the reference's
   // unit(k).eu (octaNearestFast) to within kOctaScoreError l1 (fast_lookup.h). The best score

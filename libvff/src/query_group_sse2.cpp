@@ -94,6 +94,9 @@ inline unsigned maskUnion(const uint8_t* table, F4 idx, F4 use) {
   return u;
 }
 
+// (AVX-512 only: here every lookup reads its cell's mask.)
+inline bool cornersSuffice(const uint32_t*, F4, F4, F4) { return false; }
+
 // k * mapBytes + t for the lanes' samples k and texel bytes t (integer-valued floats), into dst.
 inline void storeTexelIndex(int32_t* dst, F4 k, F4 t, int32_t mapBytes) {
   alignas(16) int32_t ki[4], ti[4];

@@ -194,6 +194,29 @@ TEST(FastLookup, CandidateMasksKeepTheNearest) {
   }
 }
 
+TEST(FastLookup, CornerRowsMarkTheCellsThatNeedMoreThanTheirCorners) {
+  for (uint32_t n = 1; n <= 40; ++n) {
+    const std::vector<uint8_t> masks = detail::octaCandidateMasks(n);
+    const std::vector<uint32_t> rows = detail::octaCornerRows(masks, n);
+    if (n > detail::kOctaCornerRowsMax) {
+      EXPECT_TRUE(rows.empty()) << "n " << n;
+      continue;
+    }
+    ASSERT_EQ(rows.size(), size_t(detail::kOctaCornerRowsMax)) << "n " << n;
+    size_t marked = 0;
+    for (uint32_t b0 = 0; b0 < detail::kOctaCornerRowsMax; ++b0)
+      for (uint32_t a0 = 0; a0 < 32; ++a0) {
+        const bool bit = (rows[b0] >> a0) & 1u;
+        const bool more = a0 < n && b0 < n && (masks[size_t(b0) * n + a0] & ~0x0Fu) != 0;
+        ASSERT_EQ(bit, more) << "n " << n << " cell " << a0 << " " << b0;
+        marked += bit && a0 + b0 < n;
+      }
+    if (n == 32) {
+      EXPECT_EQ(marked, size_t(2)) << "cells of the face";  // (a0, b0) = (30, 0) and (0, 30)
+    }
+  }
+}
+
 TEST(FastLookup, TexelEqualsTheReferenceWhereverItAnswers) {
   std::mt19937 rng(3);
   std::normal_distribution<float> g;
@@ -362,6 +385,34 @@ std::vector<Ray> tieRays(const FieldDesc& f, const PositionSet& ps, const std::v
   return rays;
 }
 
+// Rays aimed at the centre whose entry points lie in the octa-hemi2 cells that may need a
+// candidate other than their four corners (octaCandidateMasks), in every quadrant and hemisphere:
+// the AVX-512 kernel reads the masks for these lanes (octaCornerRows), and the corners alone for
+// the others. (At n <= 32 those candidates enter the masks through the masks' safety margin only:
+// no ray found in 20000 per cell has one as its nearest, so no test can tell the two paths apart
+// by their answers; these rays run the masks' path.)
+std::vector<Ray> cornerCellRays(const FieldDesc& f, uint32_t n, uint32_t seed) {
+  const std::vector<uint8_t> masks = detail::octaCandidateMasks(n);
+  const Vec3 c{f.sphere.center[0], f.sphere.center[1], f.sphere.center[2]};
+  const float r = f.sphere.radius;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  std::vector<Ray> rays;
+  for (uint32_t b0 = 0; b0 < n && !masks.empty(); ++b0)
+    for (uint32_t a0 = 0; a0 + b0 < n; ++a0) {
+      if (!(masks[size_t(b0) * n + a0] & ~0x0Fu)) continue;
+      for (int s = 0; s < 400; ++s) {
+        const float a = float(a0) + u01(rng), b = float(b0) + u01(rng);
+        if (a + b > float(n)) continue;
+        Vec3 e{(s & 1) ? -a : a, (s & 2) ? -b : b, ((s & 4) ? -1.0f : 1.0f) * (float(n) - a - b)};
+        const float el = std::sqrt(dot3(e, e));
+        e = {e.x / el, e.y / el, e.z / el};
+        rays.push_back({{c.x + 1.5f * r * e.x, c.y + 1.5f * r * e.y, c.z + 1.5f * r * e.z}, {-e.x, -e.y, -e.z}});
+      }
+    }
+  return rays;
+}
+
 // `rays` spread out, every `every`-th of count rays, the others leaving the sphere behind them
 // (origin outside, pointing away): groups where a ray or two reach the sphere, whose lookups wait
 // in the batch's queue over many groups (and fill its ring of groups in flight).
@@ -439,6 +490,11 @@ void checkBatches(detail::KernelChoice) {
         const std::vector<Ray> ties = tieRays(f, *ps, unit, 9000, n + 7);
         rays.insert(rays.end(), ties.begin(), ties.end());
       }
+      const std::vector<Ray> corner = cornerCellRays(f, n, n + 11);
+      if (n == 32) {
+        EXPECT_GT(corner.size(), size_t(500)) << "n 32: two cells need more than their corners";
+      }
+      rays.insert(rays.end(), corner.begin(), corner.end());
       const std::vector<Ray> sparse = sparseRays(f, rays, 37, 20000);
       rays.insert(rays.end(), sparse.begin(), sparse.end());
       QueryOptions o;
