@@ -133,9 +133,10 @@ inline std::vector<uint32_t> octaCornerRows(const std::vector<uint8_t>& masks, u
 // those with |a| + |b| <= n) by binary32 dot products of q with the float table `unit4` (4 floats
 // per sample: x, y, z and padding), ties to the smallest index, as FieldQuery does with the
 // reference candidates: its index in *k and its grid point in the quadrant frame in (*a, *b).
-// False when no candidate lies on the grid.
+// False when no candidate lies on the grid. `only`: the candidates to score (bit c for
+// kOctaCandidates[c]); the cell's octaCandidateMasks entry gives the same answer as all eight.
 inline bool octaBestCandidate(int32_t n, const float* unit4, float qx, float qy, float qz, int32_t a0, int32_t b0,
-                              uint32_t* k, int32_t* a, int32_t* b) noexcept {
+                              uint32_t* k, int32_t* a, int32_t* b, unsigned only = 0xFFu) noexcept {
   const int32_t h = qz >= 0 ? 0 : 1;
   const int32_t si = qx < 0 ? -1 : 1, sj = qy < 0 ? -1 : 1;
   const int32_t hemi = 2 * n * n + 2 * n + 1;
@@ -144,8 +145,9 @@ inline bool octaBestCandidate(int32_t n, const float* unit4, float qx, float qy,
   *k = 0;
   *a = a0;
   *b = b0;
-  for (const auto& c : kOctaCandidates) {
-    const int32_t ca = a0 + c[0], cb = b0 + c[1];
+  for (unsigned ci = 0; ci < 8; ++ci) {
+    if (!((only >> ci) & 1u)) continue;
+    const int32_t ca = a0 + kOctaCandidates[ci][0], cb = b0 + kOctaCandidates[ci][1];
     const int32_t aa = ca < 0 ? -ca : ca, ab = cb < 0 ? -cb : cb;
     if (aa + ab > n) continue;
     const int32_t i = si * ca, j = sj * cb;

@@ -374,8 +374,10 @@ void lookupStep(const GroupTables& tb, size_t p, LookupQueue* q) {
       const unsigned l = unsigned(__builtin_ctz(bits));
       uint32_t k;
       int32_t wa, wb;
-      if (octaBestCandidate(int32_t(tb.octaN), tb.unit4, q->eux[p + l], q->euy[p + l], q->euz[p + l],
-                            int32_t(fa0[l]), int32_t(fb0[l]), &k, &wa, &wb)) {
+      const int32_t ca0 = int32_t(fa0[l]), cb0 = int32_t(fb0[l]);
+      const unsigned only = tb.octaMasks ? tb.octaMasks[size_t(cb0) * tb.octaN + size_t(ca0)] : 0xFFu;
+      if (octaBestCandidate(int32_t(tb.octaN), tb.unit4, q->eux[p + l], q->euy[p + l], q->euz[p + l], ca0, cb0, &k,
+                            &wa, &wb, only)) {
         sa[l] = float(wa);
         sb[l] = float(wb);
       } else {

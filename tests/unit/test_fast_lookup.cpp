@@ -153,6 +153,12 @@ TEST(FastLookup, CandidateMasksKeepTheNearest) {
     ASSERT_EQ(masks.size(), size_t(n) * n);
     size_t kept = 0;
     for (uint8_t m : masks) kept += size_t(__builtin_popcount(m));
+    std::vector<float> unit4(unit.size() * 4, 0.0f);
+    for (size_t k = 0; k < unit.size(); ++k) {
+      unit4[k * 4] = unit[k].x;
+      unit4[k * 4 + 1] = unit[k].y;
+      unit4[k * 4 + 2] = unit[k].z;
+    }
     // Random directions, and some in every cell of the quadrant.
     std::vector<Vec3> dirs = testDirections(n, 100000);
     std::mt19937 rng(n);
@@ -188,6 +194,14 @@ TEST(FastLookup, CandidateMasksKeepTheNearest) {
         found = found || (std::abs(ca) == ra && std::abs(cb) == rb);
       }
       ASSERT_TRUE(found) << "n " << n << " cell " << a0 << " " << b0 << " direction " << d.x << " " << d.y << " " << d.z;
+      // The binary32 scores of the cell's mask pick what those of all eight candidates pick.
+      uint32_t kAll = 0, kMask = 0;
+      int32_t aAll = 0, bAll = 0, aMask = 0, bMask = 0;
+      const bool all = detail::octaBestCandidate(int32_t(n), unit4.data(), d.x, d.y, d.z, a0, b0, &kAll, &aAll, &bAll);
+      const bool mask = detail::octaBestCandidate(int32_t(n), unit4.data(), d.x, d.y, d.z, a0, b0, &kMask, &aMask,
+                                                  &bMask, masks[size_t(b0) * n + size_t(a0)]);
+      ASSERT_EQ(all, mask) << "n " << n << " cell " << a0 << " " << b0;
+      ASSERT_EQ(kAll, kMask) << "n " << n << " cell " << a0 << " " << b0;
     }
     // Away from the poles of the octahedron a cell needs its four corners only.
     EXPECT_LT(kept, size_t(n) * n * 5) << "n " << n;
