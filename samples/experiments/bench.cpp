@@ -5,8 +5,9 @@
 //          1e-4 R, cosine-weighted directions, tmax = aoDistance * R (the inter-object AO rays);
 //   aimed  origins outside the bounding sphere (1.05 R to 3 R from its centre, uniform directions),
 //          each aimed at a uniform point inside the sphere, tmax infinite.
-// Measured in one run on the same threads (rays handed out in chunks of 4096), best of --repeat
-// (the six take turns in every repetition):
+// Measured in one run on the same threads (rays handed out in chunks of 4096; each pass timed from
+// the moment all its threads run to the moment the last one ends: timedParallelFor), best of
+// --repeat (the six take turns in every repetition):
 //   (a) Embree rtcOccluded1 against the mesh (world space)
 //   (b) FieldQuery::occluded, batch, kNearest (object space: the same rays, transformed beforehand;
 //       --batch rays per call, 4096 by default)
@@ -96,12 +97,6 @@ std::string cpuName() {
   return family.empty() ? name : name + " (family " + family + ", model " + model + ")";
 }
 
-double seconds(const std::function<void()>& fn) {
-  const auto t0 = std::chrono::steady_clock::now();
-  fn();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 }  // namespace
 
 int runBench(const Options& o) {
@@ -156,18 +151,14 @@ int runBench(const Options& o) {
     std::vector<uint8_t> placed(n);
     double ta = 1e30, tb = 1e30, tc = 1e30, td = 1e30, te = 1e30, tm = 1e30, ta1 = 1e30, tb1 = 1e30;
     auto embree = [&](unsigned t) {
-      return seconds([&] {
-        parallelFor(n, kChunk, t, [&](uint64_t b, uint64_t e) {
-          for (uint64_t i = b; i < e; ++i) ref[i] = exact->occluded(set.world[i]) ? 1 : 0;
-        });
+      return timedParallelFor(n, kChunk, t, [&](uint64_t b, uint64_t e) {
+        for (uint64_t i = b; i < e; ++i) ref[i] = exact->occluded(set.world[i]) ? 1 : 0;
       });
     };
     auto batch = [&](unsigned t) {
-      return seconds([&] {
-        parallelFor(n, kChunk, t, [&](uint64_t b, uint64_t e) {
-          inBatches(b, e, o.benchBatch, [&](uint64_t x, uint64_t y) {
-            q.occluded(rays.subspan(x, y - x), std::span<uint8_t>(nearest).subspan(x, y - x), qn);
-          });
+      return timedParallelFor(n, kChunk, t, [&](uint64_t b, uint64_t e) {
+        inBatches(b, e, o.benchBatch, [&](uint64_t x, uint64_t y) {
+          q.occluded(rays.subspan(x, y - x), std::span<uint8_t>(nearest).subspan(x, y - x), qn);
         });
       });
     };
@@ -178,34 +169,26 @@ int runBench(const Options& o) {
         ta1 = std::min(ta1, embree(1));
         tb1 = std::min(tb1, batch(1));
       }
-      tc = std::min(tc, seconds([&] {
-        parallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
-          for (uint64_t i = b; i < e; ++i) single[i] = q.occluded(set.object[i], qn) ? 1 : 0;
+      tc = std::min(tc, timedParallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
+        for (uint64_t i = b; i < e; ++i) single[i] = q.occluded(set.object[i], qn) ? 1 : 0;
+      }));
+      td = std::min(td, timedParallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
+        inBatches(b, e, o.benchBatch, [&](uint64_t x, uint64_t y) {
+          q.visibility(rays.subspan(x, y - x), std::span<float>(vis).subspan(x, y - x), qi);
         });
       }));
-      td = std::min(td, seconds([&] {
-        parallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
-          inBatches(b, e, o.benchBatch, [&](uint64_t x, uint64_t y) {
-            q.visibility(rays.subspan(x, y - x), std::span<float>(vis).subspan(x, y - x), qi);
-          });
+      te = std::min(te, timedParallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
+        inBatches(b, e, o.benchBatch, [&](uint64_t x, uint64_t y) {
+          instance.occluded(std::span<const vff::Ray>(set.world).subspan(x, y - x),
+                            std::span<uint8_t>(placed).subspan(x, y - x), qn);
         });
       }));
-      te = std::min(te, seconds([&] {
-        parallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
-          inBatches(b, e, o.benchBatch, [&](uint64_t x, uint64_t y) {
-            instance.occluded(std::span<const vff::Ray>(set.world).subspan(x, y - x),
-                              std::span<uint8_t>(placed).subspan(x, y - x), qn);
-          });
-        });
-      }));
-      tm = std::min(tm, seconds([&] {
-        parallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
-          for (uint64_t g = b; g < e; g += 64) {
-            const uint64_t ge = std::min(e, g + 64);
-            for (uint64_t i = g; i < ge; ++i) __builtin_prefetch(maps.data() + at[i]);
-            for (uint64_t i = g; i < ge; ++i) read[i] = maps[at[i]];
-          }
-        });
+      tm = std::min(tm, timedParallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
+        for (uint64_t g = b; g < e; g += 64) {
+          const uint64_t ge = std::min(e, g + 64);
+          for (uint64_t i = g; i < ge; ++i) __builtin_prefetch(maps.data() + at[i]);
+          for (uint64_t i = g; i < ge; ++i) read[i] = maps[at[i]];
+        }
       }));
     }
 

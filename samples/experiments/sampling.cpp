@@ -1,6 +1,7 @@
 // sampling.cpp - per-pixel random numbers, hemisphere and sphere sampling, the thread pool loop.
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <thread>
 
 #include "common.h"
@@ -76,6 +77,39 @@ void parallelFor(uint64_t count, uint64_t chunk, unsigned threads,
   for (unsigned i = 1; i < threads; ++i) pool.emplace_back(worker);
   worker();
   for (auto& t : pool) t.join();
+}
+
+double timedParallelFor(uint64_t count, uint64_t chunk, unsigned threads,
+                        const std::function<void(uint64_t, uint64_t)>& fn) {
+  using Clock = std::chrono::steady_clock;
+  threads = resolveThreads(threads);
+  chunk = std::max<uint64_t>(1, chunk);
+  std::atomic<uint64_t> next{0};
+  std::atomic<unsigned> started{0};
+  std::atomic<bool> go{false};
+  Clock::time_point start;
+  std::vector<Clock::time_point> end(threads);
+  auto worker = [&](unsigned w) {
+    started.fetch_add(1);
+    if (w == 0) {  // the clock starts once every worker is running
+      while (started.load() < threads) std::this_thread::yield();
+      start = Clock::now();
+      go.store(true);
+    } else {
+      while (!go.load()) std::this_thread::yield();
+    }
+    for (;;) {
+      const uint64_t begin = next.fetch_add(chunk);
+      if (begin >= count) break;
+      fn(begin, std::min(count, begin + chunk));
+    }
+    end[w] = Clock::now();
+  };
+  std::vector<std::thread> pool;
+  for (unsigned i = 1; i < threads; ++i) pool.emplace_back(worker, i);
+  worker(0);
+  for (auto& t : pool) t.join();
+  return std::chrono::duration<double>(*std::max_element(end.begin(), end.end()) - start).count();
 }
 
 }  // namespace vffx
