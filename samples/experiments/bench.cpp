@@ -21,7 +21,6 @@
 // repetitions: the ratio per core, and how each scales with the threads.
 // plus the agreement of (b), (c), (d) > 0.5 and (e) with (a): the fraction of rays with the same answer.
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <string>
