@@ -117,8 +117,8 @@ inline std::vector<uint8_t> octaCandidateMasks(uint32_t un) {
 // For n <= kOctaCornerRowsMax: per row b0 of the quadrant's cells, bit a0 set where cell (a0, b0)
 // of octaCandidateMasks(n) may need a candidate other than its four corners (kOctaCandidates 0-3);
 // kOctaCornerRowsMax rows, zero past n. Empty for larger n (or no masks). The AVX-512 kernel
-// looks a lane's row up in two registers instead of gathering the lane's mask: at n = 32 two of
-// the face's 528 cells (a0 + b0 < n) have such a bit, at n = 16 two of 136, below none (the
+// looks a lane's row up in two registers instead of gathering the lane's mask: two of the face's
+// cells (a0 + b0 < n) have such a bit for 10 <= n <= 32 (528 cells at n = 32), none below (the
 // cells past the face, which no lane reaches, have theirs too).
 inline constexpr uint32_t kOctaCornerRowsMax = 32;
 inline std::vector<uint32_t> octaCornerRows(const std::vector<uint8_t>& masks, uint32_t n) {

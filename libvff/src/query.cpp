@@ -219,8 +219,9 @@ struct FieldQuery::Impl {
     // Four groups ahead made no difference runs could tell from noise). They are requested as
     // non-temporal: read once, they then take less of the cache the texels share with them (AMD
     // Zen 5, the bench's 64 MiB ray sets, in-process A/B (its noise: query_group_kernel.h): AO
-    // rays 1.04-1.08x with 2 threads, aimed rays 1.04-1.13x; with the kernel's changes of the same
-    // version, in separate runs taking turns: AO 1.01-1.08x, aimed 1.02-1.09x, 2 threads).
+    // rays 1.04-1.08x with 2 threads, aimed rays 1.04-1.13x. There the two builds share the cache,
+    // so that this change reaches the other build too: README.md gives the bench's figures for
+    // this version against the one before, run alternately).
     constexpr size_t kAhead = 2;
     // (many >= 1: an empty span's data() may be null. An early return for many == 0 in here
     // made GCC 12 drop the loops' prefetches altogether: 0.6x.)

@@ -100,9 +100,9 @@ inline void F16::compressIndex(uint32_t* dst, uint32_t first, unsigned mask) {
 }
 
 // Positions unit4[4 k .. 4 k + 2] of the lanes' samples k (integer-valued floats): (x, y) as one
-// 8-byte word per lane, two gathers of eight, and z by a gather of sixteen. (Gathers cost about
-// one load per lane here: three gathers of sixteen, 48 lanes, ran slower; vff-experiments bench
-// rays in an in-process A/B, one thread: aimed 1.03-1.04x, AO 1.00-1.02x.)
+// 8-byte word per lane, two gathers of eight, and z by a gather of sixteen: 32 lanes gathered
+// instead of 48 for three gathers of sixteen (vff-experiments bench rays in an in-process A/B, one
+// thread: aimed 1.03-1.04x, AO 1.00-1.02x).
 inline void gatherUnit(const float* unit4, F16 k, F16* x, F16* y, F16* z) {
   const __m512i ki = _mm512_cvttps_epi32(k.v);
   const __m512i pair = _mm512_slli_epi32(ki, 1);  // the index of (x, y) in 8-byte words

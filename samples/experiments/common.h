@@ -63,13 +63,14 @@ Vec3 uniformSphere(float u1, float u2);
 void orthonormalBasis(Vec3 n, Vec3* b, Vec3* c);
 
 // ---- Threads ------------------------------------------------------------------------------------
-// Runs fn(begin, end) over [0, count) in chunks handed out to `threads` workers (0: hardware).
+// Runs fn(begin, end) over [0, count) in chunks handed out to `threads` workers (0: hardware):
+// timedParallelFor without the time.
 void parallelFor(uint64_t count, uint64_t chunk, unsigned threads,
                  const std::function<void(uint64_t, uint64_t)>& fn);
 // parallelFor, timed for a benchmark: the seconds from the moment every worker has started (they
 // wait for each other) to the moment the last one finishes. Starting and joining the threads is
-// left out: here it takes 25-120 microseconds, 1-2% of the bench's fastest passes (a few ms) and
-// a tenth of that of Embree's, so that timing it would favour the slower query.
+// left out: a fixed cost per pass, it would weigh ten times more on the field's batch passes (a
+// few ms in vff-experiments bench) than on Embree's, and so favour the slower query.
 double timedParallelFor(uint64_t count, uint64_t chunk, unsigned threads,
                         const std::function<void(uint64_t, uint64_t)>& fn);
 unsigned resolveThreads(unsigned threads);

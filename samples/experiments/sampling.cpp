@@ -63,20 +63,7 @@ unsigned resolveThreads(unsigned threads) {
 
 void parallelFor(uint64_t count, uint64_t chunk, unsigned threads,
                  const std::function<void(uint64_t, uint64_t)>& fn) {
-  threads = resolveThreads(threads);
-  chunk = std::max<uint64_t>(1, chunk);
-  std::atomic<uint64_t> next{0};
-  auto worker = [&] {
-    for (;;) {
-      const uint64_t begin = next.fetch_add(chunk);
-      if (begin >= count) return;
-      fn(begin, std::min(count, begin + chunk));
-    }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned i = 1; i < threads; ++i) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
+  timedParallelFor(count, chunk, threads, fn);
 }
 
 double timedParallelFor(uint64_t count, uint64_t chunk, unsigned threads,
