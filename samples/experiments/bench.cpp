@@ -19,7 +19,9 @@
 //       then read (as the batch does): the memory floor of any lookup into a table this size
 // and, when more than one thread runs, (a) and (b) again on one thread, (a1) and (b1), in the same
 // repetitions: the ratio per core, and how each scales with the threads.
-// plus the agreement of (b), (c), (d) > 0.5 and (e) with (a): the fraction of rays with the same answer.
+// plus the agreement of (b), (c), (d) > 0.5 and (e) with (a): the fraction of rays with the same answer,
+// and each query's throughput as a share of (m) ("of floor"): how far it stands from what this
+// machine's memory allows, a figure that carries across CPUs better than the ratio to Embree.
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
@@ -121,8 +123,8 @@ int runBench(const Options& o) {
               o.mesh.c_str(), world->worldMesh.triangleCount(), config.name().c_str(), (*field)->payloadMiB(),
               double(q.hugePageBytes()) / 1048576.0, (*field)->bakeSeconds, o.benchRays, threads, o.repeat,
               vff::batchKernelName(), o.benchBatch, cpuName().c_str());
-  std::printf("| ray set | query | Mrays/s | x Embree | occluded | agreement with Embree |\n");
-  std::printf("|---|---|---:|---:|---:|---:|\n");
+  std::printf("| ray set | query | Mrays/s | x Embree | occluded | agreement with Embree | of floor (m) |\n");
+  std::printf("|---|---|---:|---:|---:|---:|---:|\n");
 
   for (RaySet set : {makeAoRays(*world, o.benchRays, o.aoDistance), makeAimedRays(*world, o.benchRays)}) {
     set.object.resize(set.world.size());
@@ -206,8 +208,8 @@ int runBench(const Options& o) {
     }
     const double mr = double(n) / 1e6;
     auto row = [&](const char* query, double t, uint64_t occ, const std::string& agree) {
-      std::printf("| %s | %s | %.2f | %.2f | %.1f%% | %s |\n", set.name.c_str(), query, mr / t, ta / t,
-                  100.0 * double(occ) / double(n), agree.c_str());
+      std::printf("| %s | %s | %.2f | %.2f | %.1f%% | %s | %.0f%% |\n", set.name.c_str(), query, mr / t, ta / t,
+                  100.0 * double(occ) / double(n), agree.c_str(), 100.0 * tm / t);
     };
     auto pct = [&](uint64_t k) {
       char buf[32];
@@ -219,13 +221,13 @@ int runBench(const Options& o) {
     row("(c) field occluded, single ray, nearest", tc, occC, pct(agreeC));
     row("(d) field visibility, batch, interpolated", td, occD, pct(agreeD) + " (visibility < 0.5)");
     row("(e) instance occluded, batch, nearest, world rays", te, occE, pct(agreeE));
-    std::printf("| %s | (m) no query: one random read of the maps per ray | %.2f | %.2f | - | - |\n", set.name.c_str(),
+    std::printf("| %s | (m) no query: one random read of the maps per ray | %.2f | %.2f | - | - | 100%% |\n", set.name.c_str(),
                 mr / tm, ta / tm);
     if (threads > 1) {
       // (The same answers as (a) and (b): the queries are deterministic.)
-      std::printf("| %s | (a1) Embree rtcOccluded1, 1 thread | %.2f | 1.00 | %.1f%% | - |\n", set.name.c_str(), mr / ta1,
+      std::printf("| %s | (a1) Embree rtcOccluded1, 1 thread | %.2f | 1.00 | %.1f%% | - | - |\n", set.name.c_str(), mr / ta1,
                   100.0 * double(occA) / double(n));
-      std::printf("| %s | (b1) field occluded, batch, nearest, 1 thread | %.2f | %.2f | %.1f%% | %s |\n", set.name.c_str(),
+      std::printf("| %s | (b1) field occluded, batch, nearest, 1 thread | %.2f | %.2f | %.1f%% | %s | - |\n", set.name.c_str(),
                   mr / tb1, ta1 / tb1, 100.0 * double(occB) / double(n), pct(agreeB).c_str());
     }
   }
