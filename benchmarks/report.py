@@ -1,0 +1,412 @@
+#!/usr/bin/env python3
+"""benchmarks/report.py - the results files of benchmarks/run.sh, and the README's tables.
+
+  python3 benchmarks/report.py compose RAWDIR OUT.md   the results file from run.sh's raw outputs
+  python3 benchmarks/report.py readme [--check] [README.md]
+                                                       README's figures from benchmarks/results/
+  python3 benchmarks/report.py check RESULTS.md        parses a results file back: every step there
+  python3 benchmarks/report.py cpu                     this machine's CPU, as the results name it
+  python3 benchmarks/report.py slug MACHINE.txt        a results file's name: <cpu>-<date>
+
+A results file holds the machine, a summary in rounded tables, and the full output of every
+benchmark command in fenced blocks; `readme` reads those blocks back with the same parsers, so every
+figure in README.md comes from a committed results file. `readme --check` exits 1 when README.md's
+block differs from what the results files give (the hygiene test runs it).
+
+Exit codes: 0 ok, 1 usage or README out of date, 2 a file cannot be read or written, 3 a results
+file or an output that does not parse.
+"""
+import glob
+import os
+import re
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BEGIN = "<!-- benchmarks:begin: made by `python3 benchmarks/report.py readme`; do not edit -->"
+END = "<!-- benchmarks:end -->"
+STEPS = ["bake", "query", "accuracy-ao", "accuracy-intra-ao", "accuracy-shadows", "accuracy-reflections",
+         "compression", "gpu"]
+
+
+class ParseError(Exception):
+    pass
+
+
+def cpu_name():
+    """'model name (family F, model M)' from /proc/cpuinfo, as vff-experiments bench prints it."""
+    name = family = model = ""
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8", errors="replace") as f:
+            for line in f:
+                key, _, value = line.partition(":")
+                key, value = key.strip(), value.strip()
+                if key == "model name" and not name:
+                    name = value
+                elif key == "cpu family" and not family:
+                    family = value
+                elif key == "model" and not model:
+                    model = value
+    except OSError:
+        pass
+    if not name:
+        return "unknown CPU"
+    return f"{name} (family {family}, model {model})" if family else name
+
+
+def slug(machine):
+    s = re.sub(r"[^a-z0-9]+", "-", machine["cpu"].lower().replace("family ", "f").replace("model ", "m"))
+    return f"{s.strip('-')}-{machine['date']}"
+
+
+# ---- parsers of each command's output --------------------------------------------------------
+
+def number(s):
+    return float(s.strip().rstrip("%x"))
+
+
+def md_rows(text):
+    """The data rows of the Markdown tables in text, as lists of stripped cells."""
+    rows = []
+    for line in text.splitlines():
+        line = line.strip()
+        if line.startswith("|") and not re.match(r"^\|[-:| ]+\|$", line):
+            rows.append([c.strip() for c in line.strip("|").split("|")])
+    return rows
+
+
+def parse_bake(text):
+    m = {k: re.search(p, text) for k, p in {
+        "raw": r"embree raw\s+([\d.]+) s\s+([\d.]+) Mrays/s",
+        "bake": r"\nbake\s+([\d.]+) s\s+([\d.]+) Mrays/s",
+        "ratio": r"ratio\s+([\d.]+)",
+        "peak": r"peak memory\s+([\d.]+) MiB",
+    }.items()}
+    if not all(m.values()):
+        raise ParseError("vff-bake --benchmark output lacks " + ", ".join(k for k, v in m.items() if not v))
+    rays = re.search(r"([\d,]+|[\d.e+]+) rays", text)
+    return {"raw": float(m["raw"].group(2)), "bake": float(m["bake"].group(2)), "bake_s": float(m["bake"].group(1)),
+            "ratio": float(m["ratio"].group(1)), "peak": float(m["peak"].group(1)),
+            "rays": rays.group(1) if rays else "-"}
+
+
+def parse_query(text):
+    head = re.search(r"^Query benchmark: .*?, (\d+) threads, .*?batch kernel (\S+),", text, re.M)
+    if not head:
+        raise ParseError("vff-experiments bench output lacks its header line")
+    sets = {}
+    for r in md_rows(text):
+        if len(r) < 7 or r[0] == "ray set":
+            continue
+        key = re.match(r"\((\w+)\)", r[1])
+        if key:
+            sets.setdefault(r[0], {})[key.group(1)] = {"mrays": number(r[2]), "x": number(r[3]), "floor": r[6]}
+    for name, q in sets.items():
+        for k in ("a", "b", "d", "m"):
+            if k not in q:
+                raise ParseError(f"vff-experiments bench output lacks row ({k}) of ray set {name}")
+    if not sets:
+        raise ParseError("vff-experiments bench output has no table")
+    return {"threads": int(head.group(1)), "kernel": head.group(2), "sets": sets}
+
+
+def parse_accuracy(text):
+    rows = []
+    for r in md_rows(text):
+        if len(r) != 6 or r[0] == "configuration":
+            continue
+        rows.append({"config": r[0], "reconstruction": r[1], "mib": number(r[2]),
+                     "rms": None if r[3].startswith("(") else number(r[3]), "time": number(r[5])})
+    if not rows or not rows[0]["config"].startswith("exact"):
+        raise ParseError("experiment output has no table starting with the exact row")
+    return rows
+
+
+CODEC_ROW = re.compile(r"^\s+(.+?)\s+(\d+)\s+([\d.]+)\s+([\d.]+)\s+([\d.]+)\s+([\d.]+)(?:\s\s(.*))?$")
+
+
+def parse_compression(text):
+    payload = re.search(r"distance payload (.+)$", text, re.M)
+    rows = []
+    for line in text.splitlines():
+        m = CODEC_ROW.match(line)
+        if m and "none" not in line.split()[-1:]:
+            rows.append({"codec": m.group(1), "bytes": int(m.group(2)), "ratio": float(m.group(3)),
+                         "vs_zstd": float(m.group(4)), "compress": float(m.group(5)),
+                         "decompress": float(m.group(6)), "note": (m.group(7) or "").strip()})
+    if not rows or not payload:
+        raise ParseError("vff-compress --benchmark output has no codec table")
+    return {"payload": payload.group(1).strip(), "rows": rows}
+
+
+def parse_gpu(text):
+    """The renderer, and per query the rays/s of the largest ray count with the AO image's RMS."""
+    gpu = re.search(r"GL_RENDERER: (.*)\)$", text, re.M)
+    queries_text, _, render_text = text.partition("ground AO")
+    queries = {}
+    for line in queries_text.splitlines():
+        m = re.match(r"^\| 2\^(\d+) \| ([^|]+?) \| ([\d.e+]+) \| ([\d.e+]+) \| ([\d.]+) \|.*?(\d+)\)?$", line)
+        if m and int(m.group(1)) >= queries.get(m.group(2), {}).get("log2", -1):
+            queries[m.group(2)] = {"log2": int(m.group(1)), "gpu": float(m.group(3)), "cpu": float(m.group(4)),
+                                   "ratio": float(m.group(5)), "differing": int(m.group(6))}
+    for r in md_rows(render_text):
+        if len(r) == 6 and r[0] in queries:
+            queries[r[0]]["rms"] = r[5]
+    if not gpu or not queries or any("rms" not in q for q in queries.values()):
+        raise ParseError("vff-gpu-bench output lacks its GL_RENDERER, its queries or its AO table")
+    return {"gpu": gpu.group(1), "queries": queries}
+
+
+PARSERS = {"bake": parse_bake, "query": parse_query, "compression": parse_compression, "gpu": parse_gpu}
+
+
+def parse_step(name, text):
+    return (PARSERS.get(name) or parse_accuracy)(text)
+
+
+# ---- the summary tables ----------------------------------------------------------------------
+
+def fmt(v, digits=0):
+    return f"{v:,.{digits}f}"
+
+
+def rate(v):
+    """Mrays/s or MB/s, rounded to what the run-to-run noise leaves meaningful."""
+    return fmt(v, 1 if v < 10 else 0)
+
+
+def bake_table(m, b):
+    return [f"| mesh | field | Embree alone, Mrays/s | whole bake, Mrays/s | bake / Embree | peak memory |",
+            "|---|---|---:|---:|---:|---:|",
+            f"| {m['mesh']} | {m['field']} | {rate(b['raw'])} | {rate(b['bake'])} | {b['ratio']:.2f} | "
+            f"{fmt(b['peak'])} MiB |"]
+
+
+def query_rows(m, q, with_cpu):
+    out = []
+    for name, s in q["sets"].items():
+        cells = ([f"{m['cpu']}, {m['cores']} cores"] if with_cpu else []) + [
+            name, rate(s["a"]["mrays"]), rate(s["b"]["mrays"]), f"{s['b']['x']:.1f}x",
+            rate(s["m"]["mrays"]), s["b"]["floor"], f"{s['d']['x']:.1f}x"]
+        out.append("| " + " | ".join(cells) + " |")
+    return out
+
+
+def query_header(with_cpu):
+    cols = (["CPU"] if with_cpu else []) + [
+        "ray set", "Embree, Mrays/s", "field batch (b), Mrays/s", "(b) x Embree", "memory floor (m), Mrays/s",
+        "(b) share of floor", "interpolated (d) x Embree"]
+    return ["| " + " | ".join(cols) + " |", "|" + "---|" * (2 if with_cpu else 1) + "---:|" * (len(cols) - (2 if with_cpu else 1))]
+
+
+def accuracy_table(steps):
+    lines = ["| experiment | field | memory MiB | RMS nearest | RMS interpolated | time s: exact / nearest |",
+             "|---|---|---:|---:|---:|---:|"]
+    for name in STEPS:
+        if not name.startswith("accuracy-") or name not in steps:
+            continue
+        rows = steps[name]
+        exact = rows[0]
+        configs = []
+        for r in rows[1:]:
+            if r["config"] not in configs:
+                configs.append(r["config"])
+        for c in configs:
+            by = {r["reconstruction"]: r for r in rows if r["config"] == c}
+            near, interp = by.get("nearest"), by.get("interpolated")
+            first = near or interp
+            lines.append(f"| {name[len('accuracy-'):]} | {c} | {first['mib']:.1f} | "
+                         f"{near['rms']:.2f} | " if near else f"| {name[len('accuracy-'):]} | {c} | {first['mib']:.1f} | - | ")
+            lines[-1] += (f"{interp['rms']:.2f} | " if interp else "- | ") + \
+                f"{exact['time']:.2f} / {first['time']:.2f} |"
+    return lines
+
+
+def compression_table(c):
+    lines = ["| codec | bytes / payload | bytes / zstd -19's | decompression, MB/s (1 core) |",
+             "|---|---:|---:|---:|"]
+    for r in c["rows"]:
+        lossy = " (lossy)" if r["note"] == "lossy" else ""
+        lines.append(f"| {r['codec']}{lossy} | {1 / r['ratio']:.3f} | "
+                     f"{r['vs_zstd']:.2f} | {rate(r['decompress'])} |")
+    return lines
+
+
+def gpu_table(g):
+    lines = ["| query | rays | GPU, Mrays/s | CPU, Mrays/s | GPU / CPU | answers differing | AO image RMS, GPU vs CPU |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
+    for name, q in g["queries"].items():
+        lines.append(f"| {name} | 2^{q['log2']} | {rate(q['gpu'] / 1e6)} | {rate(q['cpu'] / 1e6)} | {q['ratio']:.2f} | "
+                     f"{q['differing']} | {q['rms']} |")
+    return lines
+
+
+def sections(machine, steps, heading, queries=None):
+    """The summary's tables, one per topic; `queries` (a list of (machine, query)) replaces the
+    query table of this run by one row per ray set of each CPU on record."""
+    out = []
+    if "bake" in steps:
+        out += [f"{heading} Bake speed", "", *bake_table(machine, steps["bake"]), ""]
+    if queries:
+        out += [f"{heading} Query speed, each CPU on record (its newest results file)", "", *query_header(True)]
+        for m, q in queries:
+            out += query_rows(m, q, True)
+        out += ["", "Threads and batch kernel: " + "; ".join(f"{m['cpu']}: {q['threads']}, {q['kernel']}"
+                                                          for m, q in queries) + ".", ""]
+    elif "query" in steps:
+        q = steps["query"]
+        out += [f"{heading} Query speed ({q['threads']} threads, {q['kernel']} kernel)", "",
+                *query_header(False), *query_rows(machine, q, False), ""]
+    if any(k.startswith("accuracy-") for k in steps):
+        out += [f"{heading} Accuracy against exact Embree casts (8-bit scale)", "", *accuracy_table(steps), ""]
+    if "compression" in steps:
+        c = steps["compression"]
+        out += [f"{heading} Compression of the distance payload ({c['payload']})", "", *compression_table(c), ""]
+    if "gpu" in steps:
+        out += [f"{heading} GPU ({steps['gpu']['gpu']})", "", *gpu_table(steps["gpu"]), ""]
+    return out
+
+
+# ---- results files ---------------------------------------------------------------------------
+
+def read_machine(path):
+    machine = {}
+    with open(path, encoding="utf-8") as f:
+        for line in f:
+            k, _, v = line.rstrip("\n").partition("=")
+            if k:
+                machine[k] = v
+    for k in ("date", "commit", "cpu", "cores", "mesh", "field"):
+        if k not in machine:
+            raise ParseError(f"{path}: no '{k}='")
+    return machine
+
+
+def compose(rawdir, out):
+    machine = read_machine(os.path.join(rawdir, "machine.txt"))
+    steps, texts = {}, {}
+    for name in STEPS:
+        path = os.path.join(rawdir, name + ".txt")
+        if not os.path.exists(path):
+            continue
+        with open(path, encoding="utf-8") as f:
+            texts[name] = f.read()
+        with open(os.path.join(rawdir, name + ".cmd"), encoding="utf-8") as f:
+            texts[name + ".cmd"] = f.read().strip()
+        try:
+            steps[name] = parse_step(name, texts[name])
+        except ParseError as e:
+            raise ParseError(f"{path}: {e}") from None
+    lines = [f"# vff benchmarks: {machine['cpu']}, {machine['date']}", "",
+             "Written by `bash benchmarks/run.sh`" + (" --quick (tiny sizes: the figures mean nothing)"
+                                                       if machine.get("quick") == "1" else "") + ".", "",
+             "| | |", "|---|---|"]
+    for k in ("commit", "cpu", "cores", "kernel", "compiler", "build_type", "embree", "mesh", "field"):
+        if k in machine:
+            lines.append(f"| {k} | {machine[k]} |")
+    lines += ["", "## Summary", "", *sections(machine, steps, "###"), "## Full output", ""]
+    for name in STEPS:
+        if name in texts:
+            lines += [f"### {name}", "", "`" + texts[name + ".cmd"] + "`", "", "```text", texts[name].rstrip("\n"),
+                      "```", ""]
+    skip = os.path.join(rawdir, "gpu.skip")
+    if "gpu" not in texts and os.path.exists(skip):
+        with open(skip, encoding="utf-8") as f:
+            lines += ["### gpu", "", "Not run: " + (f.read().strip() or "vff-gpu-bench failed to start") + ".", ""]
+    with open(out, "w", encoding="utf-8") as f:
+        f.write("\n".join(lines))
+
+
+def read_results(path):
+    """(machine, steps) of a results file, parsed back from its full-output blocks."""
+    with open(path, encoding="utf-8") as f:
+        text = f.read()
+    machine = {}
+    head = re.search(r"^# vff benchmarks: (.*), (\d{4}-\d\d-\d\d)$", text, re.M)
+    if not head:
+        raise ParseError(f"{path}: no '# vff benchmarks: CPU, DATE' heading")
+    machine["cpu"], machine["date"] = head.group(1), head.group(2)
+    for k, v in re.findall(r"^\| (\w+) \| (.*) \|$", text, re.M):
+        machine.setdefault(k, v)
+    machine["quick"] = "1" if "--quick" in text.split("## Summary")[0] else "0"
+    steps = {}
+    for name, body in re.findall(r"^### ([\w-]+)\n\n`[^\n]*`\n\n```text\n(.*?)\n```$", text, re.M | re.S):
+        try:
+            steps[name] = parse_step(name, body)
+        except ParseError as e:
+            raise ParseError(f"{path}, {name}: {e}") from None
+    return machine, steps
+
+
+def readme_block(results_dir):
+    runs = [(p, *read_results(p)) for p in sorted(glob.glob(os.path.join(results_dir, "*.md")))]
+    runs = sorted((r for r in runs if r[1].get("quick") != "1"), key=lambda r: (r[1]["date"], r[0]))
+    if not runs:
+        raise ParseError(f"{results_dir}: no results file")
+    path, machine, steps = runs[-1]
+    latest = {m["cpu"]: (m, s["query"]) for _, m, s in runs if "query" in s}
+    rel = os.path.relpath(path, ROOT)
+    lines = [BEGIN, "",
+             f"From [{rel}]({rel}) ({machine['cpu']}, {machine['cores']} cores, commit {machine['commit']}, "
+             f"{machine['mesh']}, field {machine['field']}), but the query table, which has a row per CPU on "
+             "record. Figures differ between CPUs: `bash benchmarks/run.sh` measures yours.", ""]
+    return "\n".join(lines + sections(machine, steps, "####", list(latest.values())) + [END])
+
+
+def readme(args):
+    check = "--check" in args
+    args = [a for a in args if a != "--check"]
+    path = args[0] if args else os.path.join(ROOT, "README.md")
+    with open(path, encoding="utf-8") as f:
+        text = f.read()
+    if text.count(BEGIN) != 1 or text.count(END) != 1:
+        print(f"report.py: error: {path}: needs one '{BEGIN}' line and one '{END}' line", file=sys.stderr)
+        return 3
+    block = readme_block(os.path.join(ROOT, "benchmarks", "results"))
+    start, end = text.index(BEGIN), text.index(END) + len(END)
+    new = text[:start] + block + text[end:]
+    if check:
+        if new != text:
+            print(f"report.py: {path}: its benchmark tables differ from benchmarks/results/ "
+                  "(run python3 benchmarks/report.py readme)", file=sys.stderr)
+            return 1
+        print(f"report.py: {path}: benchmark tables match benchmarks/results/")
+        return 0
+    if new != text:
+        with open(path + ".tmp", "w", encoding="utf-8") as f:
+            f.write(new)
+        os.replace(path + ".tmp", path)
+    return 0
+
+
+def main(argv):
+    if len(argv) >= 2 and argv[1] == "cpu":
+        print(cpu_name())
+        return 0
+    if len(argv) == 3 and argv[1] == "slug":
+        print(slug(read_machine(argv[2])))
+        return 0
+    if len(argv) == 4 and argv[1] == "compose":
+        compose(argv[2], argv[3])
+        return 0
+    if len(argv) == 3 and argv[1] == "check":
+        machine, steps = read_results(argv[2])
+        missing = [n for n in STEPS if n != "gpu" and n not in steps]
+        if missing:
+            raise ParseError(f"{argv[2]}: no output of " + ", ".join(missing))
+        print(f"report.py: {argv[2]}: {machine['cpu']}, {machine['date']}: " + ", ".join(steps))
+        return 0
+    if len(argv) >= 2 and argv[1] == "readme":
+        return readme(argv[2:])
+    print(__doc__.strip().split("\n\n")[1], file=sys.stderr)
+    return 1
+
+
+if __name__ == "__main__":
+    try:
+        sys.exit(main(sys.argv))
+    except ParseError as e:
+        print(f"report.py: error: {e}", file=sys.stderr)
+        sys.exit(3)
+    except OSError as e:
+        print(f"report.py: error: {e.filename}: {e.strerror}", file=sys.stderr)
+        sys.exit(2)

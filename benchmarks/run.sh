@@ -1,0 +1,133 @@
+#!/usr/bin/env bash
+# benchmarks/run.sh - runs every benchmark of vff and writes one results file.
+#
+#   bash benchmarks/run.sh [--build DIR] [--mesh FILE] [--out FILE] [--quick]
+#
+# Without --build it sets up and builds as scripts/main.sh does (Release preset, into build/).
+# With the bunny of Debian's glmark2-data (or --mesh) it runs:
+#   bake         vff-bake --benchmark: the whole bake against Embree alone on the bake's rays
+#   query        vff-experiments bench: field queries against Embree and against the memory floor
+#   accuracy     vff-experiments ao, intra-ao, shadows, reflections: fields against exact casts
+#   compression  vff-compress --benchmark: the hits-med codec against zstd, xz and OpenEXR's
+#   gpu          vff-gpu-bench, where a headless OpenGL 4.3 context opens (it names the renderer)
+# and writes benchmarks/results/<cpu>-<date>.md (or --out): the machine, the commit, a summary in
+# rounded tables (README.md copies it: python3 benchmarks/report.py readme) and the full output of
+# every command. --quick runs each at a tiny size: a check that the whole chain works, whose
+# figures mean nothing. Run it on a quiet machine: the query figures move with the memory's load.
+# Exit codes: 0 written, 1 usage, 2 a file cannot be read or written, 4 a benchmark failed.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+prog="benchmarks/run.sh"
+build="" mesh="/usr/share/glmark2/models/bunny.obj" out="" quick=0
+usage() { echo "usage: $prog [--build DIR] [--mesh FILE] [--out FILE] [--quick]" >&2; exit 1; }
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --build) [[ $# -ge 2 ]] || usage; build="$2"; shift 2 ;;
+    --mesh) [[ $# -ge 2 ]] || usage; mesh="$2"; shift 2 ;;
+    --out) [[ $# -ge 2 ]] || usage; out="$2"; shift 2 ;;
+    --quick) quick=1; shift ;;
+    -h|--help) echo "usage: $prog [--build DIR] [--mesh FILE] [--out FILE] [--quick]"; exit 0 ;;
+    *) usage ;;
+  esac
+done
+
+if [[ -z $build ]]; then
+  cd "$root"
+  bash scripts/setup.sh
+  cmake --preset release >/dev/null
+  cmake --build --preset release -j "$(nproc)"
+  build="$root/build"
+fi
+build="$(cd "$build" && pwd)"
+[[ -r $mesh ]] || { echo "$prog: error: $mesh: cannot read the mesh (Debian package glmark2-data, or --mesh)" >&2; exit 2; }
+mesh="$(cd "$(dirname "$mesh")" && pwd)/$(basename "$mesh")"
+bake="$build/tools/vff-bake/vff-bake"
+compress="$build/tools/vff-compress/vff-compress"
+experiments="$build/samples/experiments/vff-experiments"
+gpubench="$build/gpu/vff-gpu-bench"
+for t in "$bake" "$compress" "$experiments"; do
+  [[ -x $t ]] || { echo "$prog: error: $t: not built" >&2; exit 2; }
+done
+
+raw="$(mktemp -d)"
+trap 'rm -rf "$raw"' EXIT
+
+if ((quick)); then
+  config=(-n 8 -m 16) field=290x16x16 expargs=(--size 48 --rays 8 --config 290x16x16)
+  benchargs=(--config 290x16x16 --bench-rays 20000 --repeat 1) bakerepeat=1 compressrepeat=1
+  gpuargs=(--size 64 --spp 4)
+else
+  # The paper's configuration: octa-hemi2 n = 32 (4226 maps) of 64 x 64, unorm8-diameter.
+  config=(-n 32 -m 64) field=4226x64x64 expargs=()
+  benchargs=(--repeat 5) bakerepeat=3 compressrepeat=3
+  gpuargs=()
+fi
+
+# step NAME COMMAND...: runs COMMAND with its output in $raw/NAME.txt and its command line in
+# $raw/NAME.cmd (paths relative to the build folder, so that results files name no machine path).
+# A command that fails ends the run with exit 4, unless its stderr matches $skip_if: then
+# $raw/NAME.skip says why it did not run.
+skip_if=""
+step() {
+  local name="$1"; shift
+  local shown="${*//$build\//}"
+  shown="${shown//$raw\//}"
+  shown="${shown//$raw/.}"
+  shown="${shown//$(dirname "$mesh")\//}"
+  echo "== $name: $shown" >&2
+  local t0=$SECONDS
+  if ! "$@" >"$raw/$name.txt" 2>"$raw/$name.err"; then
+    rm -f "$raw/$name.txt"
+    if [[ -n $skip_if ]] && grep -q "$skip_if" "$raw/$name.err"; then
+      grep -m1 "$skip_if" "$raw/$name.err" | sed 's/^[^:]*: //' >"$raw/$name.skip"
+      echo "   skipped: $(cat "$raw/$name.skip")" >&2
+      return 0
+    fi
+    cat "$raw/$name.err" >&2
+    echo "$prog: error: $name failed: $shown" >&2
+    exit 4
+  fi
+  sed -i -e "s|$build/||g" -e "s|$raw/||g" -e "s|$(dirname "$mesh")/||g" "$raw/$name.txt"
+  printf '%s\n' "$shown" >"$raw/$name.cmd"
+  echo "   $((SECONDS - t0)) s" >&2
+}
+
+step bake "$bake" "$mesh" --benchmark "${config[@]}" --repeat "$bakerepeat"
+step query "$experiments" bench --mesh "$mesh" "${benchargs[@]}"
+for e in ao intra-ao shadows reflections; do
+  step "accuracy-$e" "$experiments" "$e" --mesh "$mesh" "${expargs[@]}" -o "$raw/experiments"
+done
+"$bake" "$mesh" -o "$raw/field.vff" "${config[@]}" -q
+step compression "$compress" --benchmark "$raw/field.vff" --repeat "$compressrepeat" --tmp "$raw"
+# The GPU bench where it is built and a headless OpenGL 4.3 context opens; otherwise the results
+# file says why it did not run.
+if [[ -x $gpubench ]]; then
+  skip_if="no headless OpenGL" step gpu "$gpubench" --field "$raw/field.vff" "${gpuargs[@]}"
+else
+  echo "vff-gpu-bench is not built (no OpenGL or EGL development files)" >"$raw/gpu.skip"
+fi
+
+# The machine and the build.
+cpu="$(python3 "$root/benchmarks/report.py" cpu)"
+commit="$(git -C "$root" rev-parse --short=12 HEAD 2>/dev/null || echo unknown)"
+[[ -z "$(git -C "$root" status --porcelain --untracked-files=no 2>/dev/null)" ]] || commit="$commit (with uncommitted changes)"
+{
+  echo "date=$(date -u +%Y-%m-%d)"
+  echo "commit=$commit"
+  echo "cpu=$cpu"
+  echo "cores=$(nproc)"
+  echo "kernel=$(uname -sr)"
+  cxx="$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$build/CMakeCache.txt" | head -1)"
+  echo "compiler=$("${cxx:-c++}" --version 2>/dev/null | head -1 || echo unknown)"
+  echo "build_type=$(sed -n 's/^CMAKE_BUILD_TYPE:[A-Z]*=//p' "$build/CMakeCache.txt" | head -1)"
+  echo "embree=$(dpkg-query -W -f='${Version}' libembree3-3 2>/dev/null || echo unknown)"
+  echo "mesh=$(basename "$mesh")"
+  echo "field=$field"
+  echo "quick=$quick"
+} >"$raw/machine.txt"
+if [[ -z $out ]]; then
+  out="$root/benchmarks/results/$(python3 "$root/benchmarks/report.py" slug "$raw/machine.txt").md"
+fi
+python3 "$root/benchmarks/report.py" compose "$raw" "$out.tmp"
+mv "$out.tmp" "$out"
+echo "wrote $out" >&2

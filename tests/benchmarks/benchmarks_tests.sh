@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# benchmarks_tests.sh - benchmarks/run.sh writes a results file that benchmarks/report.py reads back,
+# and README.md's tables are the ones the committed results files give.
+#
+# Every function named test_* is one ctest case (tests/benchmarks/CMakeLists.txt); environment:
+#   VFF_SOURCE_DIR, VFF_BUILD_DIR  the source and build folders; PYTHON  python3;
+#   MESHGEN  vff-procedural-mesh;  WORK  a scratch folder of this test.
+set -euo pipefail
+: "${VFF_SOURCE_DIR:?}" "${VFF_BUILD_DIR:?}" "${PYTHON:?}" "${MESHGEN:?}" "${WORK:?}"
+source "$(dirname "${BASH_SOURCE[0]}")/../common/cli_harness.sh"
+report="$VFF_SOURCE_DIR/benchmarks/report.py"
+
+test_quick_run_writes_a_results_file() {
+  "$MESHGEN" torus-knot "$WORK/knot.obj" >/dev/null
+  run bash "$VFF_SOURCE_DIR/benchmarks/run.sh" --quick --build "$VFF_BUILD_DIR" --mesh "$WORK/knot.obj" \
+    --out "$WORK/r.md"
+  expect_rc 0
+  [[ -s $WORK/r.md && ! -e $WORK/r.md.tmp ]] || fail "no results file, or its temporary left behind"
+  cpu=$("$PYTHON" "$report" cpu)
+  grep -q -F "# vff benchmarks: $cpu, $(date -u +%Y-%m-%d)" "$WORK/r.md" || fail "the heading names another CPU or date"
+  for h in "### Bake speed" "### Query speed" "### Accuracy against exact Embree casts" "### Compression"; do
+    grep -q -F "$h" "$WORK/r.md" || fail "results file lacks '$h'"
+  done
+  # The query table gives each ray set's share of the memory floor, a percentage.
+  for set in ao aimed; do
+    grep -q -E "^\| $set \| [0-9.,]+ \| [0-9.,]+ \| [0-9.]+x \| [0-9.,]+ \| [0-9]+% \|" "$WORK/r.md" \
+      || fail "no query row with a share of the floor for the $set rays"
+  done
+  # The GPU bench ran (a table naming the renderer) or the file says why not.
+  grep -q -E "^### GPU \(|^Not run: " "$WORK/r.md" || fail "the results file says nothing of the GPU bench"
+  # No machine path: the commands are shown relative to the build folder.
+  ! grep -q -F "$VFF_BUILD_DIR" "$WORK/r.md" || fail "the results file names the build folder"
+  ! grep -q -F "$WORK" "$WORK/r.md" || fail "the results file names the scratch folder"
+  run "$PYTHON" "$report" check "$WORK/r.md"
+  expect_rc 0
+  expect_out "bake, query, accuracy-ao, accuracy-intra-ao, accuracy-shadows, accuracy-reflections, compression"
+}
+
+test_report_rejects_an_output_that_does_not_parse() {
+  printf '# vff benchmarks: Some CPU, 2026-01-01\n\n### query\n\n`vff-experiments bench`\n\n```text\nno table\n```\n' \
+    >"$WORK/bad.md"
+  run "$PYTHON" "$report" check "$WORK/bad.md"
+  expect_rc 3
+  expect_err "bad.md, query: vff-experiments bench output lacks its header line"
+  printf 'no heading\n' >"$WORK/none.md"
+  run "$PYTHON" "$report" check "$WORK/none.md"
+  expect_rc 3
+  expect_err "none.md: no '# vff benchmarks: CPU, DATE' heading"
+}
+
+test_run_refuses_a_missing_mesh() {
+  run bash "$VFF_SOURCE_DIR/benchmarks/run.sh" --quick --build "$VFF_BUILD_DIR" --mesh "$WORK/nothere.obj" \
+    --out "$WORK/r.md"
+  expect_rc 2
+  expect_err "nothere.obj: cannot read the mesh"
+  [[ ! -e $WORK/r.md ]] || fail "a results file was written"
+}
+
+run_test "$1"
