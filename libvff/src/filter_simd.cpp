@@ -11,8 +11,8 @@
 //   1. each lane's residuals of the row are put at the x of its hits, in the transposed layout (one
 //      vector per x). Each map's residuals lie contiguous in the stream, map after map, so a lane
 //      starts where the previous lane's map ends. With SSSE3 (nearly every x86-64 processor, checked
-//      at run time), PSHUFB spreads them 8 texels at a time; with SSE2 alone, a scalar store per hit
-//      (the lanes then take a quarter longer on the bunny: the per-hit loops' exits mispredict);
+//      at run time: filter_simd_ssse3.cpp), PSHUFB spreads them 8 texels at a time; with SSE2
+//      alone, a scalar store per hit (slower: the per-hit loops' exits mispredict);
 //   2. x walks the row 16 texels at a time: MED prediction from a (left), b (up) and c (up-left),
 //      255 standing for a miss or a texel outside the map as in the spec, + residual, 255 where the
 //      mask has a miss; the 16 result vectors are transposed back into 16 map rows and stored.
@@ -22,11 +22,13 @@
 #if VFF_HITS_MED_LANES
 
 #include <emmintrin.h>  // SSE2
-#include <tmmintrin.h>  // SSSE3, behind a run-time check
 
 #include <bit>
 #include <cstring>
 #include <vector>
+
+#include "cpu_features.h"
+#include "filter_lanes.h"
 
 namespace vff::detail {
 
@@ -46,19 +48,6 @@ uint64_t countHits(const uint8_t* mask, uint64_t n) noexcept {
   return uint64_t(_mm_cvtsi128_si64(sum)) + uint64_t(_mm_cvtsi128_si64(_mm_unpackhi_epi64(sum, sum)));
 }
 
-// Transposes a 16 x 16 byte matrix (v[i] byte j becomes v[j] byte i). Each round interleaves row i
-// with row i + 8, which rotates the 8-bit (row, byte) index left by one; four rounds swap its halves.
-inline void transpose16(__m128i v[16]) noexcept {
-  for (int round = 0; round < 4; ++round) {
-    __m128i t[16];
-    for (int i = 0; i < 8; ++i) {
-      t[2 * i] = _mm_unpacklo_epi8(v[i], v[i + 8]);
-      t[2 * i + 1] = _mm_unpackhi_epi8(v[i], v[i + 8]);
-    }
-    for (int i = 0; i < 16; ++i) v[i] = t[i];
-  }
-}
-
 // The mask bits of x .. x + 63 of a row (x + 64 <= M) or x .. M - 1 (fewer when M is not a
 // multiple of 64; rows start on a byte, M being a multiple of 16, and end on one).
 inline uint64_t rowBits(const uint8_t* row, uint32_t x, uint32_t M) noexcept {
@@ -66,18 +55,6 @@ inline uint64_t rowBits(const uint8_t* row, uint32_t x, uint32_t M) noexcept {
   std::memcpy(&bits, row + x / 8, M - x >= 64 ? 8 : (M - x) / 8);  // little-endian, as le.h assumes
   return bits;
 }
-
-// One row of a group: each lane's mask bits and next residual.
-struct GroupRow {
-  const uint8_t* mask[kHitsMedLanes];  // lane i's mask bits of the row
-  const uint8_t* res[kHitsMedLanes];   // lane i's next residual; advanced past the row's
-  const uint8_t* end;                  // the end of the stream
-  uint32_t M;
-};
-
-// Puts each lane's residuals of the row at the x of its hits (resT[x] byte i; the bytes at misses
-// are left as they were). Two ways: a scalar store per hit (SSE2), or PSHUFB (SSSE3).
-using ExpandResiduals = void (*)(GroupRow& row, uint8_t* scratch, __m128i* resT);
 
 void scatterResiduals(GroupRow& row, uint8_t* /*scratch*/, __m128i* resT) {
   uint8_t* out = reinterpret_cast<uint8_t*>(resT);
@@ -88,53 +65,6 @@ void scatterResiduals(GroupRow& row, uint8_t* /*scratch*/, __m128i* resT) {
       for (uint64_t b = rowBits(row.mask[i], x0, row.M); b; b &= b - 1)
         out[(x0 + uint32_t(std::countr_zero(b))) * 16 + i] = *r++;
     row.res[i] = r;
-  }
-}
-
-// For each mask byte, the PSHUFB control that spreads the next residuals over its hits (0x80, a
-// zero, at its misses), and how many residuals it takes.
-struct SpreadTable {
-  uint8_t shuffle[256][8];
-  uint8_t count[256];
-};
-constexpr SpreadTable makeSpreadTable() {
-  SpreadTable t{};
-  for (uint32_t m = 0; m < 256; ++m) {
-    uint8_t k = 0;
-    for (uint32_t j = 0; j < 8; ++j) t.shuffle[m][j] = (m >> j) & 1 ? k++ : 0x80;
-    t.count[m] = k;
-  }
-  return t;
-}
-constexpr SpreadTable kSpread = makeSpreadTable();
-
-// Each lane's row spread 8 texels at a time into `scratch` (16 rows of M bytes, then M + 8 for a
-// row's residuals at the end of the stream), then transposed: no branch per hit, and 8 texels for a
-// few instructions.
-__attribute__((target("ssse3"))) void shuffleResiduals(GroupRow& row, uint8_t* scratch, __m128i* resT) {
-  const uint32_t M = row.M;
-  for (uint32_t i = 0; i < kHitsMedLanes; ++i) {
-    // A row takes at most M residuals, so each 8-byte load stays inside the row's M bytes; near the
-    // end of the stream those are copied first, so that no load passes it.
-    const uint8_t* r = row.res[i];
-    if (uint64_t(row.end - r) < M) r = static_cast<uint8_t*>(std::memcpy(scratch + 16 * M, r, size_t(row.end - r)));
-    const uint8_t* const from = r;
-    uint8_t* out = scratch + i * M;
-    for (uint32_t k = 0; k < M / 8; ++k) {
-      const uint8_t m = row.mask[i][k];
-      const __m128i v = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(r));
-      const __m128i spread = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(kSpread.shuffle[m]));
-      _mm_storel_epi64(reinterpret_cast<__m128i*>(out + 8 * k), _mm_shuffle_epi8(v, spread));
-      r += kSpread.count[m];
-    }
-    row.res[i] += r - from;
-  }
-  for (uint32_t x0 = 0; x0 < M; x0 += 16) {
-    __m128i t[16];
-    for (uint32_t i = 0; i < kHitsMedLanes; ++i)
-      t[i] = _mm_loadu_si128(reinterpret_cast<const __m128i*>(scratch + i * M + x0));
-    transpose16(t);
-    for (uint32_t x = 0; x < 16; ++x) resT[x0 + x] = t[x];
   }
 }
 
@@ -232,13 +162,21 @@ bool decodeGroup(ExpandResiduals expand, const uint8_t* mask, const uint8_t* con
 }  // namespace
 
 bool hitsMedLanesSsse3() noexcept {
-  static const bool has = __builtin_cpu_supports("ssse3");
-  return has;
+#if defined(VFF_HAVE_SSSE3_LANES)
+  return cpuFeatures().ssse3;
+#else
+  return false;
+#endif
 }
 
 HitsMedProgress unapplyHitsMedLanes(std::span<const uint8_t> filtered, const uint8_t* residuals, uint32_t M,
                                     uint64_t mapCount, uint8_t* raw, bool ssse3) {
-  const ExpandResiduals expand = ssse3 ? shuffleResiduals : scatterResiduals;
+#if defined(VFF_HAVE_SSSE3_LANES)
+  const ExpandResiduals expand = ssse3 ? shuffleResidualsSsse3 : scatterResiduals;
+#else
+  const ExpandResiduals expand = scatterResiduals;
+  (void)ssse3;
+#endif
   const uint8_t* mask = filtered.data();
   const uint64_t mapMaskBytes = uint64_t(M) * M / 8;  // a multiple of 32: maps start on a byte
   struct alignas(16) Vec {  // storage for __m128i (which a std::vector would lose the attributes of)

@@ -12,10 +12,7 @@ namespace vff::detail {
 // Returns the bytes now backed by huge pages (0 where it declined).
 //
 // FieldQuery reads its maps at random: with 4 KiB pages a field of 16.5 MiB spans more pages than
-// the CPU's TLB holds (the nearest batches of vff-experiments bench, AO rays, 1 and 2 threads,
-// AMD Zen 5: 1.02-1.06x in an in-process A/B, within that harness's noise (see
-// query_group_kernel.h); Embree, its baseline, takes huge pages on Linux by default). Collapsing
-// 16 MiB took 7 ms.
+// the CPU's TLB holds (Embree, its baseline, takes huge pages on Linux by default).
 size_t adviseHugePages(const void* p, size_t n) noexcept;
 
 }  // namespace vff::detail

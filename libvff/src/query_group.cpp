@@ -4,6 +4,8 @@
 
 #include <atomic>
 
+#include "cpu_features.h"
+
 namespace vff::detail {
 
 namespace {
@@ -35,11 +37,9 @@ void blendGroupAvx512(const BlendTables& tables, const PlanBlock& plans, const B
 
 namespace {
 
-// (Planning interpolated lookups four lanes at a time ran slower on the AO rays of
-// vff-experiments bench than the one-ray planner, 0.83x, and blending them eight at a time
-// 0.92x on the AO rays, 1.03x on the aimed ones: SSE2 batches plan and blend one ray at a time.
-// With AVX2 the blend kernel ran 0.99x and 1.14x, with AVX-512 1.0-1.05x and 1.35-1.45x:
-// in-process A/B, 2 threads, AMD Zen 5.)
+// (SSE2 batches plan and blend one ray at a time: planning four lanes at a time, and blending
+// eight, did not beat the one-ray planner and blend on vff-experiments bench's rays; the AVX2 and
+// AVX-512 kernels plan and blend in their lanes.)
 constexpr GroupKernel kSse2{"sse2", sphereGroupSse2, lookupQueueSse2, decodeGroupSse2, nullptr, nullptr};
 #if defined(VFF_HAVE_AVX2_KERNEL)
 constexpr GroupKernel kAvx2{"avx2", sphereGroupAvx2, lookupQueueAvx2, decodeGroupAvx2, planGroupAvx2, blendGroupAvx2};
@@ -58,14 +58,12 @@ struct Available {
 const Available& available() noexcept {
   static const Available a = [] {
     Available r;
+    [[maybe_unused]] const CpuFeatures& cpu = cpuFeatures();
 #if defined(VFF_HAVE_AVX2_KERNEL)
-    if (__builtin_cpu_supports("avx2")) r.avx2 = &kAvx2;
+    if (cpu.avx2) r.avx2 = &kAvx2;
 #endif
 #if defined(VFF_HAVE_AVX512_KERNEL)
-    // (libgcc's and compiler-rt's checks include the OS's support for the AVX-512 registers.)
-    if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
-        __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("bmi2"))
-      r.avx512 = &kAvx512;
+    if (cpu.avx512) r.avx512 = &kAvx512;
 #endif
     return r;
   }();

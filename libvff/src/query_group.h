@@ -65,7 +65,7 @@ struct GroupTables {
   // Also decode the hit flags (Group::hits), as FieldQuery::Impl::hitsAt does: kUnorm8Diameter
   // maps with byteTexels only, whose distance is code * distanceScale (code 255: a miss).
   bool decodeHits = false;
-  float distanceScale = 0;  // 2 R / 254, as FieldQuery::Impl::texel computes it
+  float distanceScale = 0;  // FieldQuery::Impl::distanceStep: quantizationStep (encoding.h) of 2 R
   // The rays are in world space (Instance batches): each lane first goes to object space as
   // RigidTransform::toObjectPoint and toObjectVector take a ray, with the same binary32 operations.
   bool toObject = false;
@@ -169,7 +169,7 @@ struct BlendTables {
   const uint8_t* texels = nullptr;
   int32_t mapBytes = 0;
   uint32_t m = 0;
-  float distanceScale = 0;  // 2 R / 254: a code's distance
+  float distanceScale = 0;  // a code's distance: FieldQuery::Impl::distanceStep (quantizationStep)
   const uint8_t* normals = nullptr;  // null: no normal field
   int32_t normalMapBytes = 0;
 };

@@ -327,7 +327,7 @@ RefHit referenceLookup(const FieldDesc& f, const std::vector<Vec3>& unit, const 
   squareToTexel(hemisphereToSquare(f.directionScheme, toLocal(ps.frame(k), v)), f.mapResolution, &i, &j);
   const uint32_t code = dist[size_t(k) * f.mapResolution * f.mapResolution + size_t(j) * f.mapResolution + i];
   if (code == 255) return {};
-  const float d = float(code) * (2.0f * r / 254.0f);
+  const float d = float(code) * quantizationStep(f.distanceEncoding, r, 1.0f);  // (the query's scale)
   const float t = inside ? t0 - d : t0 + d;
   if (t < lo || t > hi) return {};
   return {true, t / len};

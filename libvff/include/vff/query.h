@@ -45,8 +45,8 @@
 // vectors are full, and fetch the texels from memory ahead of their use; kInterpolated batches
 // plan 16 rays at once (also gathered from consecutive groups) and fetch all their texels, then
 // blend them 16 at once over kUnorm8Diameter fields (in AVX-512 or AVX2 lanes where the CPU has
-// them). They give bit for bit the answers of the one-ray functions, several times faster
-// (vff-experiments bench). Hand them thousands of rays per call where you can: each call ends
+// them). They give bit for bit the answers of the one-ray functions, in a fraction of their time
+// (vff-experiments bench measures it). Hand them thousands of rays per call where you can: each call ends
 // with its last rays in a part-filled vector (vff-experiments bench --batch 256 against the
 // default 4096). occluded() and visibility() with kNearest are fastest on
 // kUnorm8Diameter fields, whose hit flags the group kernel decodes as well. An Instance's kNearest
