@@ -132,8 +132,9 @@ void appendMaps(std::string& s, const BuiltValid& v) {
     std::string normals;
     for (uint32_t t = 0; t < m * m; ++t) {
       const uint32_t i = t % m, j = t / m;
-      const uint32_t code = f.distanceEncoding == DistanceEncoding::kBc4Diameter ? referenceBc4Code(dmap, m, i, j)
-                                                                                : loadCode(f.distanceEncoding, dmap, m, i, j);
+      const uint32_t code = f.distanceEncoding == DistanceEncoding::kBc4Diameter
+                                ? referenceBc4Code(dmap, m, i, j)
+                                : loadCode(f.distanceEncoding, dmap, m, i, j);
       const Texel tx =
           decodeDistance(f.distanceEncoding, code, f.sphere.radius, texelDirection(f.directionScheme, m, i, j).z);
       if (t % m == 0) s += t ? "\n                  " : "";

@@ -74,8 +74,8 @@ class Mutations {
   // zstd frame: a stream that is not what a writer makes.
   void refilter(uint32_t id, std::string name, std::string what, std::function<void(Bytes&)> change) {
     add(id, std::move(name), H, std::move(what), [change](Vff& v) {
-      Bytes stream = zstdContent(std::span<const uint8_t>(v.b).subspan(v.block(kTagDistance, 0),
-                                                                         v.blockSize(kTagDistance, 0)));
+      Bytes stream =
+          zstdContent(std::span<const uint8_t>(v.b).subspan(v.block(kTagDistance, 0), v.blockSize(kTagDistance, 0)));
       change(stream);
       v.replaceLastBlock(kTagDistance, zstdFrame(stream));
     });
@@ -116,9 +116,9 @@ void addIdentityAndHeader(Mutations& g) {
   });
   g.add(3005, "checksum-flipped", A, "headerChecksum with bit 0 flipped", [](Vff& v) { v.b[56] ^= 1; });
   g.add(3005, "table-edit-unsealed", A, "DIST entry checksum changed, header checksum left stale",
-      [&](Vff& v) { v.b[v.entry(D) + 40] ^= 1; });
+        [&](Vff& v) { v.b[v.entry(D) + 40] ^= 1; });
   g.add(3006, "table-past-eof", A, "sectionTableOffset at the end of the file",
-      [](Vff& v) { st64(v.b, 40, v.b.size()); });
+        [](Vff& v) { st64(v.b, 40, v.b.size()); });
   g.add(3007, "count-0", A, "sectionCount 0 (header re-sealed)", [](Vff& v) {
     st32(v.b, 48, 0);
     v.sealHeader();
@@ -162,11 +162,11 @@ void addSections(Mutations& g) {
     v.sealHeader();
   });
   g.add(4008, "dist-stale-after-block-edit", A,
-      "a DIST block byte changed and its block checksum re-sealed, the section checksum left stale", [&](Vff& v) {
-        v.b[v.block(D, 0) + 100] ^= 0x5A;
-        v.sealBlocks();
-        v.sealHeader();
-      });
+        "a DIST block byte changed and its block checksum re-sealed, the section checksum left stale", [&](Vff& v) {
+          v.b[v.block(D, 0) + 100] ^= 0x5A;
+          v.sealBlocks();
+          v.sealHeader();
+        });
   g.add(4009, "entry-reserved", A, "DIST entry reserved u32 at +36 is 1", [&](Vff& v) {
     st32(v.b, v.entry(D) + 36, 1);
     v.sealAll();
@@ -181,14 +181,14 @@ void addSections(Mutations& g) {
     v.sealAll();
   });
   g.add(4012, "after-table", A, "a nonzero byte in the padding after the section table (no checksum covers it)",
-      [](Vff& v) { v.b[1000] = 1; });
+        [](Vff& v) { v.b[1000] = 1; });
   g.add(4012, "in-plane-section", Z, "a nonzero byte between the DIST block index and the first block (re-sealed)",
-      [&](Vff& v) {
-        const uint64_t indexEnd = v.sec(D) + kPlaneHeaderSize + uint64_t(v.blockCount(D)) * kBlockEntrySize;
-        if (v.block(D, 0) <= indexEnd) die("in-plane-section: no gap after the block index");
-        v.b[indexEnd] = 1;
-        v.sealAll();
-      });
+        [&](Vff& v) {
+          const uint64_t indexEnd = v.sec(D) + kPlaneHeaderSize + uint64_t(v.blockCount(D)) * kBlockEntrySize;
+          if (v.block(D, 0) <= indexEnd) die("in-plane-section: no gap after the block index");
+          v.b[indexEnd] = 1;
+          v.sealAll();
+        });
   g.add(4013, "layt-version-2", A, "LAYT sectionVersion 2", [&](Vff& v) {
     st16(v.b, v.entry(L) + 34, 2);
     v.sealAll();
@@ -204,89 +204,90 @@ void addFieldDescription(Mutations& g) {
   g.fdsc(5001, "radius-nan", "sphere radius NaN", [](Vff& v, uint64_t p) { st32(v.b, p + kFdscRadius, 0x7FC00000u); });
   g.fdsc(5002, "scheme-0", "positionScheme 0 (invalid)", [](Vff& v, uint64_t p) { st32(v.b, p + kFdscScheme, 0); });
   g.fdsc(5003, "map-count-11", "mapCount 11 where octa-hemi2 n=1 yields 10",
-       [](Vff& v, uint64_t p) { st32(v.b, p + kFdscMapCount, 11); });
+         [](Vff& v, uint64_t p) { st32(v.b, p + kFdscMapCount, 11); });
   g.fdsc(5004, "direction-3", "directionScheme 3 (unknown)",
-       [](Vff& v, uint64_t p) { st32(v.b, p + kFdscDirection, 3); });
+         [](Vff& v, uint64_t p) { st32(v.b, p + kFdscDirection, 3); });
   g.fdsc(
       5005, "bit1-resolution-12", "bit1 with mapResolution 12 (not a multiple of 8)",
       [](Vff& v, uint64_t p) { st32(v.b, p + kFdscResolution, 12); }, B);
   g.fdsc(5006, "frame-2", "frame convention 2 (unknown)", [](Vff& v, uint64_t p) { st32(v.b, p + kFdscFrame, 2); });
-  g.fdsc(5007, "encoding-6", "distanceEncoding 6 (unknown)", [](Vff& v, uint64_t p) { st32(v.b, p + kFdscEncoding, 6); });
+  g.fdsc(5007, "encoding-6", "distanceEncoding 6 (unknown)",
+         [](Vff& v, uint64_t p) { st32(v.b, p + kFdscEncoding, 6); });
   g.fdsc(
       5005, "bc4-resolution-18", "bc4-diameter with mapResolution 18 (not a multiple of 4)",
       [](Vff& v, uint64_t p) { st32(v.b, p + kFdscResolution, 18); }, C);
   g.fdsc(5008, "miss-code-0", "unorm8-diameter with missCode 0 (255 is reserved)",
-       [](Vff& v, uint64_t p) { st32(v.b, p + kFdscMiss, 0); });
+         [](Vff& v, uint64_t p) { st32(v.b, p + kFdscMiss, 0); });
   g.fdsc(5009, "normal-encoding-2", "normalEncoding 2 (unknown)",
-       [](Vff& v, uint64_t p) { st32(v.b, p + kFdscNormals, 2); });
+         [](Vff& v, uint64_t p) { st32(v.b, p + kFdscNormals, 2); });
   g.fdsc(5010, "reserved-52", "FDSC reserved u32 at 52 is 1", [](Vff& v, uint64_t p) { st32(v.b, p + 52, 1); });
   g.fdsc(5011, "payload-above-limit",
-       "fibonacci n=1000, unorm16 4096x4096 maps with normals: 100 GB of payload, above the default 64 GiB",
-       [](Vff& v, uint64_t p) {
-         st32(v.b, p + kFdscScheme, uint32_t(PositionScheme::kSphericalFibonacci));
-         st32(v.b, p + kFdscParam, 1000);
-         st32(v.b, p + kFdscMapCount, 1000);
-         st32(v.b, p + kFdscResolution, 4096);
-         st32(v.b, p + kFdscEncoding, uint32_t(DistanceEncoding::kUnorm16Diameter));
-         st32(v.b, p + kFdscMiss, 65535);
-         st32(v.b, p + kFdscNormals, uint32_t(NormalEncoding::kOctSnorm16));
-       });
+         "fibonacci n=1000, unorm16 4096x4096 maps with normals: 100 GB of payload, above the default 64 GiB",
+         [](Vff& v, uint64_t p) {
+           st32(v.b, p + kFdscScheme, uint32_t(PositionScheme::kSphericalFibonacci));
+           st32(v.b, p + kFdscParam, 1000);
+           st32(v.b, p + kFdscMapCount, 1000);
+           st32(v.b, p + kFdscResolution, 4096);
+           st32(v.b, p + kFdscEncoding, uint32_t(DistanceEncoding::kUnorm16Diameter));
+           st32(v.b, p + kFdscMiss, 65535);
+           st32(v.b, p + kFdscNormals, uint32_t(NormalEncoding::kOctSnorm16));
+         });
 }
 
 // 6xxx: planes and blocks (each edit re-seals unless it is about a checksum).
 void addPlanesAndBlocks(Mutations& g) {
   g.edit(6001, "map-count", A, "DIST plane header mapCount 11", [&](Vff& v) { st32(v.b, v.sec(D), 11); });
   g.edit(6002, "encoding-without-norm", A, "FDSC normalEncoding oct-snorm16 without a NORM section",
-       [&](Vff& v) { st32(v.b, v.sec(F) + kFdscNormals, 1); });
+         [&](Vff& v) { st32(v.b, v.sec(F) + kFdscNormals, 1); });
   g.edit(6003, "block-past-section", A, "DIST block 0 offset past the section end",
-       [&](Vff& v) { st64(v.b, v.blockEntry(D, 0), v.secSize(D) + 64); });
+         [&](Vff& v) { st64(v.b, v.blockEntry(D, 0), v.secSize(D) + 64); });
   g.edit(6004, "block-misaligned", S, "DIST block 1 offset moved by 32 bytes",
-       [&](Vff& v) { st64(v.b, v.blockEntry(D, 1), v.blockRel(D, 1) + 32); });
+         [&](Vff& v) { st64(v.b, v.blockEntry(D, 1), v.blockRel(D, 1) + 32); });
   g.edit(6005, "blocks-overlap", S, "DIST block 1 offset equal to block 0's",
-       [&](Vff& v) { st64(v.b, v.blockEntry(D, 1), v.blockRel(D, 0)); });
+         [&](Vff& v) { st64(v.b, v.blockEntry(D, 1), v.blockRel(D, 0)); });
   g.edit(6006, "raw-size", Z, "zstd DIST block 0 rawSize 64 bytes too large",
-       [&](Vff& v) { st32(v.b, v.blockEntry(D, 0) + 16, ld32(v.b, v.blockEntry(D, 0) + 16) + 64); });
+         [&](Vff& v) { st32(v.b, v.blockEntry(D, 0) + 16, ld32(v.b, v.blockEntry(D, 0) + 16) + 64); });
   g.edit(6007, "codec-2", A, "DIST block 0 codec 2 (unknown)", [&](Vff& v) { v.b[v.blockEntry(D, 0) + 20] = 2; });
   g.edit(6008, "filter-2", H, "DIST block 0 filter 2 (unknown)", [&](Vff& v) { v.b[v.blockEntry(D, 0) + 21] = 2; });
   g.edit(6008, "filter-on-stored-block", A, "DIST block 0 (stored) with filter 1 hits-med, filters bit set",
-       [&](Vff& v) {
-         v.b[v.blockEntry(D, 0) + 21] = 1;
-         st64(v.b, 24, ld64(v.b, 24) | kFeatureFilters);
-       });
+         [&](Vff& v) {
+           v.b[v.blockEntry(D, 0) + 21] = 1;
+           st64(v.b, 24, ld64(v.b, 24) | kFeatureFilters);
+         });
   g.edit(6008, "filter-on-normals", Z, "NORM block 0 (zstd) with filter 1 hits-med, filters bit set", [&](Vff& v) {
     v.b[v.blockEntry(NM, 0) + 21] = 1;
     st64(v.b, 24, ld64(v.b, 24) | kFeatureFilters);
   });
   g.edit(6008, "filter-on-unorm16", "u16d-zstd-normals-gutter2",
-       "unorm16-diameter DIST block 0 (zstd) with filter 1 hits-med, filters bit set", [&](Vff& v) {
-         if (v.b[v.blockEntry(D, 0) + 20] != 1) die("filter-on-unorm16: DIST block 0 is not zstd");
-         v.b[v.blockEntry(D, 0) + 21] = 1;
-         st64(v.b, 24, ld64(v.b, 24) | kFeatureFilters);
-       });
+         "unorm16-diameter DIST block 0 (zstd) with filter 1 hits-med, filters bit set", [&](Vff& v) {
+           if (v.b[v.blockEntry(D, 0) + 20] != 1) die("filter-on-unorm16: DIST block 0 is not zstd");
+           v.b[v.blockEntry(D, 0) + 21] = 1;
+           st64(v.b, 24, ld64(v.b, 24) | kFeatureFilters);
+         });
   g.add(6009, "checksum-field", A, "DIST block 0 checksum bit 0 flipped (section and header re-sealed)", [&](Vff& v) {
     v.b[v.blockEntry(D, 0) + 24] ^= 1;
     v.sealSections();
     v.sealHeader();
   });
   g.add(6009, "data-unsealed", A, "a DIST block byte changed, block checksum left stale (section, header re-sealed)",
-      [&](Vff& v) {
-        v.b[v.block(D, 0) + 100] ^= 0x5A;
-        v.sealSections();
-        v.sealHeader();
-      });
+        [&](Vff& v) {
+          v.b[v.block(D, 0) + 100] ^= 0x5A;
+          v.sealSections();
+          v.sealHeader();
+        });
   g.edit(6010, "not-a-zstd-frame", Z, "zstd DIST block 0 with a broken frame magic (checksums re-sealed)",
-       [&](Vff& v) { v.b[v.block(D, 0)] ^= 0xFF; });
+         [&](Vff& v) { v.b[v.block(D, 0)] ^= 0xFF; });
   g.edit(6010, "trailing-byte", Z, "a zstd DIST block whose storedSize takes one padding byte after its frame",
-       [&](Vff& v) {
-         for (uint32_t i = 0; i + 1 < v.blockCount(D); ++i) {
-           const uint64_t end = v.blockRel(D, i) + v.blockSize(D, i);
-           if (v.b[v.blockEntry(D, i) + 20] == 1 && end % kBlockAlignment != 0) {
-             st64(v.b, v.blockEntry(D, i) + 8, v.blockSize(D, i) + 1);
-             return;
+         [&](Vff& v) {
+           for (uint32_t i = 0; i + 1 < v.blockCount(D); ++i) {
+             const uint64_t end = v.blockRel(D, i) + v.blockSize(D, i);
+             if (v.b[v.blockEntry(D, i) + 20] == 1 && end % kBlockAlignment != 0) {
+               st64(v.b, v.blockEntry(D, i) + 8, v.blockSize(D, i) + 1);
+               return;
+             }
            }
-         }
-         die("trailing-byte: no zstd block with a gap after it");
-       });
+           die("trailing-byte: no zstd block with a gap after it");
+         });
 }
 
 // 6xxx, continued: hits-med streams that are not what a writer makes, feature bits, a reserved byte and
@@ -294,37 +295,37 @@ void addPlanesAndBlocks(Mutations& g) {
 void addFiltersAndFeatures(Mutations& g) {
   const uint64_t hMaskBytes = g.valid(H).content.distance.size() / 8;
   g.refilter(6010, "hits-med-missing-residual", "hits-med stream without its last residual",
-           [](Bytes& s) { s.pop_back(); });
+             [](Bytes& s) { s.pop_back(); });
   g.refilter(6010, "hits-med-extra-residual", "hits-med stream with one residual more than the mask has hits",
-           [](Bytes& s) { s.push_back(0); });
+             [](Bytes& s) { s.push_back(0); });
   g.refilter(6010, "hits-med-hit-decodes-to-miss",
-           "the first residual changed so that the first hit decodes to 255, the miss code", [&](Bytes& s) {
-             const Bytes& raw = g.valid(H).content.distance;
-             const uint32_t m = g.valid(H).c.field.mapResolution;
-             for (uint32_t t = 0; t < m * m; ++t)
-               if (raw[t] != 255) {
-                 s[hMaskBytes] = uint8_t(255 - hitsMedPrediction(raw.data(), m, t % m, t / m, 0));
-                 return;
-               }
-             die("hits-med-hit-decodes-to-miss: map 0 has no hit");
-           });
+             "the first residual changed so that the first hit decodes to 255, the miss code", [&](Bytes& s) {
+               const Bytes& raw = g.valid(H).content.distance;
+               const uint32_t m = g.valid(H).c.field.mapResolution;
+               for (uint32_t t = 0; t < m * m; ++t)
+                 if (raw[t] != 255) {
+                   s[hMaskBytes] = uint8_t(255 - hitsMedPrediction(raw.data(), m, t % m, t / m, 0));
+                   return;
+                 }
+               die("hits-med-hit-decodes-to-miss: map 0 has no hit");
+             });
   g.refilter(6010, "hits-med-frame-too-large",
-           "the zstd frame declares rawSize + rawSize/8 + 1 bytes, one more than any hits-med stream of the block",
-           [&](Bytes& s) { s.resize(g.valid(H).content.distance.size() + hMaskBytes + 1, 0); });
+             "the zstd frame declares rawSize + rawSize/8 + 1 bytes, one more than any hits-med stream of the block",
+             [&](Bytes& s) { s.resize(g.valid(H).content.distance.size() + hMaskBytes + 1, 0); });
   g.edit(6012, "filter-without-feature-bit", H, "a filtered block, incompatFeatures filters bit (1) clear",
-       [&](Vff& v) { st64(v.b, 24, kFeatureZstd); });
+         [&](Vff& v) { st64(v.b, 24, kFeatureZstd); });
   g.edit(6011, "reserved", A, "DIST block entry reserved byte 22 is 1",
-       [&](Vff& v) { v.b[v.blockEntry(D, 0) + 22] = 1; });
+         [&](Vff& v) { v.b[v.blockEntry(D, 0) + 22] = 1; });
   g.edit(6012, "zstd-without-feature-bit", Z, "zstd sections and blocks, incompatFeatures zstd bit clear",
-       [&](Vff& v) { st64(v.b, 24, 0); });
+         [&](Vff& v) { st64(v.b, 24, 0); });
   g.edit(6012, "bc4-without-feature-bit", C, "bc4-diameter field, incompatFeatures bit 2 (bc4) clear",
-       [&](Vff& v) { st64(v.b, 24, ld64(v.b, 24) & ~kFeatureBc4); });
+         [&](Vff& v) { st64(v.b, 24, ld64(v.b, 24) & ~kFeatureBc4); });
   g.edit(6008, "filter-on-bc4", C, "bc4-diameter DIST block 0 (zstd) with filter 1 hits-med, filters bit set",
-       [&](Vff& v) {
-         if (v.b[v.blockEntry(D, 0) + 20] != 1) die("filter-on-bc4: DIST block 0 is not zstd");
-         v.b[v.blockEntry(D, 0) + 21] = 1;
-         st64(v.b, 24, ld64(v.b, 24) | kFeatureFilters);
-       });
+         [&](Vff& v) {
+           if (v.b[v.blockEntry(D, 0) + 20] != 1) die("filter-on-bc4: DIST block 0 is not zstd");
+           v.b[v.blockEntry(D, 0) + 21] = 1;
+           st64(v.b, 24, ld64(v.b, 24) | kFeatureFilters);
+         });
   g.edit(6013, "normal-of-miss", S, "a nonzero normal at a texel whose distance is a miss", [&](Vff& v) {
     const uint64_t dist = v.block(D, 0), norm = v.block(NM, 0);
     for (uint32_t t = 0; t < 64; ++t)
@@ -349,7 +350,7 @@ void addLayoutAndMetadata(Mutations& g) {
   });
   g.meta(8001, "invalid-utf8", "metadata with the invalid UTF-8 sequence C3 28 in a string", "{\"a\":\"\xC3\x28\"}");
   g.meta(8001, "too-deep", "metadata nesting 65 levels (the reader's limit is 64)",
-       "{\"a\":" + std::string(64, '[') + std::string(64, ']') + "}");
+         "{\"a\":" + std::string(64, '[') + std::string(64, ']') + "}");
   g.meta(8002, "array", "metadata '[1,2]' (valid JSON, not an object)", "[1,2]");
 }
 

@@ -83,7 +83,8 @@ std::vector<Bytes> composeSlices(const FieldDesc& f, const LayoutDesc& l, const 
         for (uint32_t bx = 0; bx < bw; ++bx) {
           const uint64_t map = uint64_t(s) * perSlice + (by * 4 / l.tileSize) * l.tilesPerRow + bx * 4 / l.tileSize;
           if (map >= f.mapCount) continue;
-          const uint64_t from = map * mapBytes + 8 * (uint64_t((by * 4 % l.tileSize) / 4) * mb + (bx * 4 % l.tileSize) / 4);
+          const uint64_t from =
+              map * mapBytes + 8 * (uint64_t((by * 4 % l.tileSize) / 4) * mb + (bx * 4 % l.tileSize) / 4);
           std::copy_n(&src[from], 8, &slice[8 * (uint64_t(by) * bw + bx)]);
         }
       out.push_back(std::move(slice));

@@ -112,8 +112,10 @@ Content makeContent(const FieldDesc& f) {
         const bool hit = disc >= 0;
         const double t = hit ? -bq - std::sqrt(disc) : 0.0;
         const uint32_t code = encodeDistance(f.distanceEncoding, hit, float(t), f.sphere.radius, ll.z);
-        if (bc4) c.codes[(uint64_t(k) * m + j) * m + i] = uint8_t(code);
-        else storeCode(f.distanceEncoding, map, m, i, j, code);
+        if (bc4)
+          c.codes[(uint64_t(k) * m + j) * m + i] = uint8_t(code);
+        else
+          storeCode(f.distanceEncoding, map, m, i, j, code);
         (hit ? c.hits : c.misses)++;
         if (hit && withNormals) {
           const D3 nn = normalize(origin + w * t - inner);

@@ -223,8 +223,8 @@ void checkHitsMed(const BuiltValid& v, const Vff& file) {
     const uint64_t first = uint64_t(b) * g * mb;
     const uint64_t size = std::min<uint64_t>(uint64_t(g) * mb, v.content.distance.size() - first);
     const auto raw = std::span<const uint8_t>(v.content.distance).subspan(first, size);
-    const auto stored = std::span<const uint8_t>(v.bytes).subspan(file.block(kTagDistance, b),
-                                                                   file.blockSize(kTagDistance, b));
+    const auto stored =
+        std::span<const uint8_t>(v.bytes).subspan(file.block(kTagDistance, b), file.blockSize(kTagDistance, b));
     if (zstdContent(stored) != hitsMedStream(raw, v.c.field.mapResolution))
       fail(n + ": distance block " + std::to_string(b) + " does not hold the hits-med stream of its maps");
   }
