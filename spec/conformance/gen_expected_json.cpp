@@ -147,7 +147,11 @@ void appendMaps(std::string& s, const BuiltValid& v) {
         if (t % m == 0) normals += t ? "\n                 " : "";
         if (tx.hit) {
           const Vec3 n = decodeNormal(&v.content.normals[k * nBytes + uint64_t(t) * 4]);
-          normals += "[" + jfix(n.x) + "," + jfix(n.y) + "," + jfix(n.z) + "]";
+          // Appended piece by piece: GCC 12 warns (-Wrestrict, a false positive) on "[" + std::string
+          // in this function.
+          normals += '[';
+          normals += jfix(n.x) + "," + jfix(n.y) + "," + jfix(n.z);
+          normals += ']';
         } else {
           normals += "null";
         }
@@ -155,8 +159,12 @@ void appendMaps(std::string& s, const BuiltValid& v) {
       }
     }
     s += "]";
-    if (nBytes) s += ",\n     \"normals\": [" + normals + "]";
-    s += "}" + std::string(k + 1 < f.mapCount ? "," : "") + "\n";
+    if (nBytes) {
+      s += ",\n     \"normals\": [";
+      s += normals;
+      s += ']';
+    }
+    s += k + 1 < f.mapCount ? "},\n" : "}\n";
   }
   s += "  ],\n";
 }
