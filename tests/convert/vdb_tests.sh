@@ -13,34 +13,17 @@ set -euo pipefail
 : "${VFF_CONVERT:?}" "${VFF_INSPECT:?}" "${CHECK:?}" "${VDB_CHECK:?}" "${WORK:?}"
 
 # ---- Helpers ---------------------------------------------------------------------------------------
-source "$(dirname "${BASH_SOURCE[0]}")/../common/cli_harness.sh"
-convert() { run "$VFF_CONVERT" "$@"; }
-# field OUT ENCODING [ARGS...]: writes a test field (convert_check.cpp: every code value, ~1/8 misses).
-field() { "$CHECK" write "$@" || fail "convert_check write $*"; }
+source "$(dirname "${BASH_SOURCE[0]}")/convert_harness.sh"  # convert, field, same, no_leftovers
 # verify FIELD VDB: the export holds exactly the field's slices and metadata (vdb_check.cpp).
 verify() {
   run "$VDB_CHECK" verify "$1" "$2"
   [[ $RC -eq 0 ]] || { show; fail "$2 does not hold $1"; }
-}
-same() {
-  run "$CHECK" compare "$@"
-  [[ $RC -eq 0 ]] || { show; fail "fields differ: $*"; }
 }
 need_vdb_print() {
   if [[ -z ${VDB_PRINT:-} || ! -x ${VDB_PRINT:-} ]]; then
     echo "SKIP: vdb_print not found (Debian package libopenvdb-tools, installed by scripts/setup.sh)"
     exit 0
   fi
-}
-no_leftovers() {
-  local f left=""
-  for f in "$WORK"/* "$WORK"/.[!.]*; do
-    [[ -e $f ]] || continue
-    local b=${f##*/} keep=0 k
-    for k in out err "$@"; do [[ $b == "$k" ]] && keep=1; done
-    [[ $keep -eq 1 ]] || left+=" $b"
-  done
-  [[ -z $left ]] || fail "files left behind:$left"
 }
 # vdb_round_trip ENCODING [FIELD ARGS...]: vff -> vdb (checked voxel by voxel) -> vff gives the same bytes.
 vdb_round_trip() {

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# hygiene_tests.sh - properties of the built library that no unit test sees.
+# hygiene_tests.sh - properties of the built library that no unit test sees (label hygiene).
 #
 # Every function named test_* is one ctest case (tests/hygiene/CMakeLists.txt); environment:
 #   NM           the toolchain's nm

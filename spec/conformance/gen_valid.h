@@ -1,0 +1,45 @@
+// gen_valid.h - the valid conformance vectors: what each covers, how it is written, what a reader
+// must decode from it (expected.json) and the generator's check that libvff reads it back
+// (vff-conformance-gen only; see generate.cpp).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "gen_bytes.h"
+#include "gen_scene.h"
+#include "vff/vff.h"
+
+namespace vff::gen {
+
+// What is done to the written file before it is stored.
+enum class Post { kNone, kUnknownOptional, kUnknownCopySafe, kRoCompat };
+
+struct ValidCase {
+  std::string name;
+  std::string description;
+  FieldDesc field;
+  WriteOptions options;
+  bool metadata = false;
+  Post post = Post::kNone;
+};
+
+struct BuiltValid {
+  ValidCase c;
+  Content content;
+  LayoutDesc layout;
+  std::string metadata;  // canonical text
+  Bytes bytes;
+  bool zstd = false;
+};
+
+// Every valid vector, in the order they are written.
+std::vector<ValidCase> validCases();
+// Writes the vector with libvff's writer, then applies its Post step.
+BuiltValid buildValid(const ValidCase& c);
+// Reads a valid vector back with libvff and compares it with the source data (fail() on a difference).
+void checkValid(const BuiltValid& v);
+// The expected.json of a valid vector (gen_expected_json.cpp).
+std::string expectedJson(const BuiltValid& v);
+
+}  // namespace vff::gen
