@@ -289,15 +289,8 @@ TEST(GlslLayout, PositionsBlockIsOneVec4Array) {
 // ---- What the loader fills in, against libvff ------------------------------------------------------
 
 FieldDesc makeField(PositionScheme p, uint32_t n, DirectionScheme d, DistanceEncoding e, uint32_t m, float radius) {
-  FieldDesc f;
-  f.sphere = {{0.25f, -1.5f, 3.0f}, radius};
-  f.positionScheme = p;
-  f.positionParam = n;
-  f.mapCount = positionCount(p, n).value();
-  f.directionScheme = d;
-  f.mapResolution = m;
-  f.distanceEncoding = e;
-  return f;
+  return {.sphere = {{0.25f, -1.5f, 3.0f}, radius}, .positionScheme = p, .positionParam = n,
+          .mapCount = positionCount(p, n).value(), .directionScheme = d, .mapResolution = m, .distanceEncoding = e};
 }
 
 TEST(GlslLayout, DistanceScaleIsQuantizationStep) {
