@@ -17,9 +17,10 @@
 // * a uniform buffer holding a FieldBlock (std140, the shader's VffFieldBlock);
 // * a shader storage buffer with the binary32 unit vector of every positional sample
 //   (vff::PositionSet::position), one vec4 each; for unorm8-chord followed by the decode scale
-//   2R cos(alpha) / 254 (vff::quantizationStep) of every texel of a map (M * M floats, padded to a multiple of 4); then,
-//   from vec4 FieldBlock::neighbourOffset, the neighbour lists (neighbourLists below) as floats,
-//   two vec4 per map, -1 for padding (indices below 2^24 are exact in binary32);
+//   2R cos(alpha) / 254 (vff::quantizationStep) of every texel of a map (M * M floats, padded to a
+//   multiple of 4); then, from vec4 FieldBlock::neighbourOffset, the neighbour lists
+//   (neighbourLists below) as floats, two vec4 per map, -1 for padding (indices below 2^24 are
+//   exact in binary32);
 // * when the field has a normal plane (oct-snorm16): its packed slices, same layout and target as
 //   the distance slices, internal format GL_RG16I (the raw snorm16 pairs; the shader converts them
 //   exactly as vff::decodeNormal does, not through GL's snorm conversion).
