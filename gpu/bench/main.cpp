@@ -75,13 +75,16 @@ int usage() {
   return 1;
 }
 
-}  // namespace
+// ---- Options -------------------------------------------------------------------------------------
 
-int main(int argc, char** argv) {
-  using namespace vff;
+struct BenchOptions {
   std::string fieldPath, meshPath = "/usr/share/glmark2/models/bunny.obj";
   int size = 512, spp = 256;
   unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+};
+
+// Parses the command line into *o; returns an exit code to stop with (0 after --help), or -1 to run.
+int parseOptions(int argc, char** argv, BenchOptions* o) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> const char* { return i + 1 < argc ? argv[++i] : nullptr; };
@@ -90,92 +93,271 @@ int main(int argc, char** argv) {
       usage();
       return 0;
     } else if (a == "--field" && (v = next())) {
-      fieldPath = v;
+      o->fieldPath = v;
     } else if (a == "--mesh" && (v = next())) {
-      meshPath = v;
+      o->meshPath = v;
     } else if (a == "--size" && (v = next())) {
-      size = std::atoi(v);
+      o->size = std::atoi(v);
     } else if (a == "--spp" && (v = next())) {
-      spp = std::atoi(v);
+      o->spp = std::atoi(v);
     } else if (a == "--threads" && (v = next())) {
-      threads = unsigned(std::max(1, std::atoi(v)));
+      o->threads = unsigned(std::max(1, std::atoi(v)));
     } else {
       return usage();
     }
   }
-  if (size < 8 || size % 8 != 0 || spp < 1) {
+  if (o->size < 8 || o->size % 8 != 0 || o->spp < 1) {
     std::fprintf(stderr, "vff-gpu-bench: --size must be a positive multiple of 8 and --spp positive\n");
     return 1;
   }
+  return -1;
+}
+
+// ---- The field -----------------------------------------------------------------------------------
+
+int fail(const vff::Error& e, int code) {
+  std::fprintf(stderr, "vff-gpu-bench: %s\n", e.toString().c_str());
+  return code;
+}
+
+// Bakes MESH (or the procedural torus knot when it does not exist) as samples/experiments does, into
+// *file, with the ground height (the mesh's lowest point). Returns an exit code, 0 on success.
+int bakeField(const std::string& meshPath, vff::Result<vff::File>* file, float* groundY) {
+  using namespace vff;
+  bake::Mesh mesh;
+  std::string name = meshPath;
+  if (std::filesystem::exists(meshPath)) {
+    auto m = bake::loadMesh(meshPath);
+    if (!m) return fail(m.error(), 2);
+    mesh = std::move(*m);
+  } else {
+    mesh = bake::makeShape("torus-knot");
+    name = "torus-knot (procedural; " + meshPath + " not found)";
+  }
+  *groundY = INFINITY;
+  for (size_t v = 1; v < mesh.positions.size(); v += 3) *groundY = std::min(*groundY, mesh.positions[v]);
+  auto scene = bake::Scene::create(mesh);
+  if (!scene) return fail(scene.error(), 4);
+  bake::BakeOptions bo;
+  bo.positionScheme = PositionScheme::kOctaHemi2;
+  bo.positionParam = 32;
+  bo.mapResolution = 64;
+  bo.encoding = DistanceEncoding::kUnorm8Diameter;
+  const auto t0 = Clock::now();
+  auto baked = bake::bakeField(*scene, bo);
+  if (!baked) return fail(baked.error(), 4);
+  auto bytes = writeMemory(baked->field, baked->distance);
+  if (!bytes) return fail(bytes.error(), 4);
+  *file = File::openBuffer(std::move(*bytes));
+  std::printf("field: %s baked in %.1f s\n", name.c_str(), seconds(t0, Clock::now()));
+  return 0;
+}
+
+// --field's file, or the baked default, with the ground height. Returns an exit code, 0 on success.
+int openField(const BenchOptions& o, vff::Result<vff::File>* file, float* groundY) {
+  if (o.fieldPath.empty()) return bakeField(o.meshPath, file, groundY);
+  *file = vff::File::open(o.fieldPath);
+  if (!*file) return fail(file->error(), 2);
+  *groundY = (*file)->field().sphere.center[1] - (*file)->field().sphere.radius;
+  std::printf("field: %s\n", o.fieldPath.c_str());
+  return 0;
+}
+
+// ---- Queries per second --------------------------------------------------------------------------
+
+// n random rays: origins 1.05-3 R from the centre towards points within 1.1 R, unit directions, tmax
+// 2 R; for the CPU (rays) and the shader's BenchRay (rayData, 8 floats each).
+void makeRandomRays(const vff::FieldDesc& f, size_t n, uint64_t seed, std::vector<vff::Ray>* rays,
+                    std::vector<float>* rayData) {
+  using vff::Vec3;
+  const Vec3 c{f.sphere.center[0], f.sphere.center[1], f.sphere.center[2]};
+  const float R = f.sphere.radius;
+  std::mt19937_64 g{seed};
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  auto dir = [&] {
+    const float z = 2 * u(g) - 1, phi = 6.2831853f * u(g);
+    const float r = std::sqrt(std::max(0.0f, 1 - z * z));
+    return Vec3{r * std::cos(phi), r * std::sin(phi), z};
+  };
+  rayData->assign(n * 8, 0.0f);
+  rays->assign(n, vff::Ray{});
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 a = dir(), b = dir();
+    const float s = R * (1.05f + 2.0f * u(g)), s2 = R * 1.1f * std::cbrt(u(g));
+    const Vec3 o{c.x + a.x * s, c.y + a.y * s, c.z + a.z * s};
+    const Vec3 d{c.x + b.x * s2 - o.x, c.y + b.y * s2 - o.y, c.z + b.z * s2 - o.z};
+    const float l = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    const Vec3 w{d.x / l, d.y / l, d.z / l};
+    (*rays)[i] = vff::Ray{o, w, 0.0f, 2.0f * R};
+    float* r = &(*rayData)[i * 8];
+    r[0] = o.x, r[1] = o.y, r[2] = o.z, r[3] = 2.0f * R, r[4] = w.x, r[5] = w.y, r[6] = w.z, r[7] = 0;
+  }
+}
+
+// The GPU's best of 2 runs over n rays (bound at 5 and 6; the program in use), in seconds; the
+// answers in *results.
+double timeGpuRays(size_t n, GLuint resultBuffer, std::vector<float>* results) {
+  double best = 1e30;
+  for (int rep = 0; rep < 2; ++rep) {
+    glFinish();
+    const auto t0 = Clock::now();
+    // At most 2^20 rays per dispatch (GL guarantees 65535 work groups per dimension).
+    for (size_t first = 0; first < n; first += size_t(1) << 20) {
+      glUniform1ui(1, GLuint(first));
+      glDispatchCompute(GLuint((std::min(n - first, size_t(1) << 20) + 63) / 64), 1, 1);
+    }
+    glFinish();
+    best = std::min(best, seconds(t0, Clock::now()));
+  }
+  results->assign(n, 0.0f);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, resultBuffer);
+  glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(n * 4), results->data());
+  return best;
+}
+
+// The CPU's time over the rays, in seconds, with the batch calls, 4096 rays at a time (kNearest
+// visibility: 0 or 1, as !occluded()); the answers in *results.
+double timeCpuRays(const vff::FieldQuery& cpu, const std::vector<vff::Ray>& rays, bool interp, unsigned threads,
+                   std::vector<float>* results) {
+  const size_t n = rays.size();
+  results->assign(n, 0.0f);
+  std::span<float> out(*results);
+  vff::QueryOptions qo;
+  qo.reconstruction = interp ? vff::Reconstruction::kInterpolated : vff::Reconstruction::kNearest;
+  const auto c0 = Clock::now();
+  parallel(threads, n, [&](size_t b, size_t e) {
+    for (size_t first = b; first < e; first += 4096) {
+      const size_t count = std::min<size_t>(4096, e - first);
+      cpu.visibility(std::span<const vff::Ray>(rays.data() + first, count), out.subspan(first, count), qo);
+    }
+  });
+  return seconds(c0, Clock::now());
+}
+
+void benchQueries(const vff::FieldDesc& f, const vff::gl::GpuField& gpu, const vff::FieldQuery& cpu, GLuint rayProg,
+                  unsigned threads) {
+  std::printf("\nfield queries/s (random rays: origins 1.05-3 R from the centre towards points within 1.1 R, tmax 2 R;\n"
+              "GPU wall time around dispatch + glFinish, best of 2; CPU on %u thread(s))\n", threads);
+  std::printf("| rays | query | GPU rays/s | CPU rays/s | GPU/CPU |\n|---|---|---|---|---|\n");
+  for (int logN = 20; logN <= 22; ++logN) {
+    const size_t n = size_t(1) << logN;
+    std::vector<float> rayData;
+    std::vector<vff::Ray> rays;
+    makeRandomRays(f, n, uint64_t(logN), &rays, &rayData);
+    GLuint bufs[2];
+    glGenBuffers(2, bufs);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[0]);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(rayData.size() * 4), rayData.data(), GL_STATIC_DRAW);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(n * 4), nullptr, GL_STREAM_READ);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, bufs[0]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, bufs[1]);
+    gpu.bind();
+    glUseProgram(rayProg);
+    for (int interp = 0; interp < 2; ++interp) {
+      glUniform1i(0, interp);
+      std::vector<float> gres, cres;
+      const double best = timeGpuRays(n, bufs[1], &gres);
+      const double cpuS = timeCpuRays(cpu, rays, interp != 0, threads, &cres);
+      size_t differ = 0;
+      for (size_t i = 0; i < n; ++i) differ += std::fabs(gres[i] - cres[i]) > 1e-4f;
+      std::printf("| 2^%d | %s | %.3g | %.3g | %.2f |   (answers differing by > 1e-4: %zu)\n", logN,
+                  interp ? "interpolated visibility" : "nearest occluded", double(n) / best, double(n) / cpuS,
+                  cpuS / best, differ);
+      std::fflush(stdout);
+    }
+    glDeleteBuffers(2, bufs);
+  }
+}
+
+// ---- AO render -----------------------------------------------------------------------------------
+
+// The GPU's AO image (buffers bound at 5, 6, 7; the program in use), in *image; returns seconds.
+double renderGpuAo(const vff::gpubench::AoScene& s, int spp, int interp, GLuint imageBuffer, std::vector<float>* image) {
+  const int size = s.size;
+  glUniform1i(0, size);
+  glUniform1i(1, spp);
+  glUniform1i(2, interp);
+  glUniform1f(3, s.eps);
+  glUniform1f(4, s.tmax);
+  // A warm-up dispatch (drivers such as llvmpipe compile the shader at its first use), then
+  // bands of 64 rows per dispatch (keeps single dispatches short on slow drivers).
+  glUniform1i(5, 0);
+  glDispatchCompute(1, 1, 1);
+  glFinish();
+  const auto t0 = Clock::now();
+  for (int row = 0; row < size; row += 64) {
+    glUniform1i(5, row);
+    glDispatchCompute(GLuint(size / 8), GLuint(std::min(64, size - row) / 8), 1);
+  }
+  glFinish();
+  const double gpuS = seconds(t0, Clock::now());
+  image->assign(size_t(size) * size, 0.0f);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, imageBuffer);
+  glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(image->size() * 4), image->data());
+  return gpuS;
+}
+
+void benchAo(const vff::FieldDesc& f, float groundY, const vff::gl::GpuField& gpu, const vff::FieldQuery& cpu,
+             GLuint aoProg, const BenchOptions& o) {
+  using namespace vff;
+  const int size = o.size, spp = o.spp;
+  const gpubench::AoScene s = gpubench::makeAoScene(f, groundY, size);
+  GLuint bufs[3];
+  glGenBuffers(3, bufs);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[0]);
+  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(s.gbuffer.size() * 4), s.gbuffer.data(), GL_STATIC_DRAW);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
+  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(s.directions.size() * 4), s.directions.data(), GL_STATIC_DRAW);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[2]);
+  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(size_t(size) * size * 4), nullptr, GL_STREAM_READ);
+  for (int b = 0; b < 3; ++b) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, GLuint(5 + b), bufs[b]);
+  gpu.bind();
+  glUseProgram(aoProg);
+  std::printf("\nground AO %dx%d, %d rays/px (%.3g rays), tmax 2 R; GPU vs CPU image on the 8-bit scale\n", size, size,
+              spp, double(size) * size * spp);
+  std::printf("| query | GPU s | CPU s | GPU/CPU | max | RMS |\n|---|---|---|---|---|---|\n");
+  for (int interp = 0; interp < 2; ++interp) {
+    std::vector<float> g;
+    const double gpuS = renderGpuAo(s, spp, interp, bufs[2], &g);
+    const auto c0 = Clock::now();
+    const std::vector<float> cimg =
+        gpubench::cpuAo(cpu, s, spp, interp ? Reconstruction::kInterpolated : Reconstruction::kNearest, o.threads);
+    const double cpuS = seconds(c0, Clock::now());
+    const gpubench::AoDiff d = gpubench::compareAo(cimg, g);
+    std::printf("| %s | %.2f | %.2f | %.2f | %.0f | %.4f |\n", interp ? "interpolated visibility" : "nearest occluded", gpuS,
+                cpuS, cpuS / gpuS, d.max, d.rms);
+    std::fflush(stdout);
+  }
+  glDeleteBuffers(3, bufs);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace vff;
+  BenchOptions o;
+  if (const int code = parseOptions(argc, argv, &o); code >= 0) return code;
   const test::HeadlessGl& gl = test::headlessGl();
   if (!gl.ok) {
     std::fprintf(stderr, "vff-gpu-bench: no headless OpenGL 4.3 context: %s\n", gl.error.c_str());
     return 4;
   }
   std::printf("GPU: %s (GL_RENDERER: %s)\n", gl.renderer.c_str(), reinterpret_cast<const char*>(glGetString(GL_RENDERER)));
-  std::printf("CPU baseline: vff::FieldQuery on %u thread(s)\n", threads);
+  std::printf("CPU baseline: vff::FieldQuery on %u thread(s)\n", o.threads);
 
-  // The field, and the ground height (the mesh's lowest point).
   Result<File> file = makeError(Code::kInvalidArgument, "no field");
   float groundY = 0;
-  if (!fieldPath.empty()) {
-    file = File::open(fieldPath);
-    if (!file) {
-      std::fprintf(stderr, "vff-gpu-bench: %s\n", file.error().toString().c_str());
-      return 2;
-    }
-    groundY = file->field().sphere.center[1] - file->field().sphere.radius;
-    std::printf("field: %s\n", fieldPath.c_str());
-  } else {
-    bake::Mesh mesh;
-    std::string name = meshPath;
-    if (std::filesystem::exists(meshPath)) {
-      auto m = bake::loadMesh(meshPath);
-      if (!m) {
-        std::fprintf(stderr, "vff-gpu-bench: %s\n", m.error().toString().c_str());
-        return 2;
-      }
-      mesh = std::move(*m);
-    } else {
-      mesh = bake::makeShape("torus-knot");
-      name = "torus-knot (procedural; " + meshPath + " not found)";
-    }
-    groundY = INFINITY;
-    for (size_t v = 1; v < mesh.positions.size(); v += 3) groundY = std::min(groundY, mesh.positions[v]);
-    auto scene = bake::Scene::create(mesh);
-    if (!scene) {
-      std::fprintf(stderr, "vff-gpu-bench: %s\n", scene.error().toString().c_str());
-      return 4;
-    }
-    bake::BakeOptions bo;
-    bo.positionScheme = PositionScheme::kOctaHemi2;
-    bo.positionParam = 32;
-    bo.mapResolution = 64;
-    bo.encoding = DistanceEncoding::kUnorm8Diameter;
-    const auto t0 = Clock::now();
-    auto baked = bake::bakeField(*scene, bo);
-    if (!baked) {
-      std::fprintf(stderr, "vff-gpu-bench: %s\n", baked.error().toString().c_str());
-      return 4;
-    }
-    auto bytes = writeMemory(baked->field, baked->distance);
-    if (!bytes) {
-      std::fprintf(stderr, "vff-gpu-bench: %s\n", bytes.error().toString().c_str());
-      return 4;
-    }
-    file = File::openBuffer(std::move(*bytes));
-    std::printf("field: %s baked in %.1f s\n", name.c_str(), seconds(t0, Clock::now()));
-  }
+  if (const int code = openField(o, &file, &groundY); code != 0) return code;
   if (!file) return 4;
   const FieldDesc& f = file->field();
   std::printf("  %u maps, %ux%u, distance encoding %u, R = %g\n", f.mapCount, f.mapResolution, f.mapResolution,
               unsigned(f.distanceEncoding), double(f.sphere.radius));
   auto gpu = gl::loadField(*file);
   auto cpu = FieldQuery::fromFile(*file);
-  if (!gpu || !cpu) {
-    std::fprintf(stderr, "vff-gpu-bench: %s\n", (!gpu ? gpu.error() : cpu.error()).toString().c_str());
-    return 4;
-  }
+  if (!gpu || !cpu) return fail(!gpu ? gpu.error() : cpu.error(), 4);
   if (file->layout().target == LayoutTarget::kTexture3D) {
     std::fprintf(stderr, "vff-gpu-bench: 3D-texture layouts are not benchmarked\n");
     return 4;
@@ -188,132 +370,8 @@ int main(int argc, char** argv) {
     return 4;
   }
 
-  // ---- Queries per second ----
-  const Vec3 c{f.sphere.center[0], f.sphere.center[1], f.sphere.center[2]};
-  const float R = f.sphere.radius;
-  std::printf("\nfield queries/s (random rays: origins 1.05-3 R from the centre towards points within 1.1 R, tmax 2 R;\n"
-              "GPU wall time around dispatch + glFinish, best of 2; CPU on %u thread(s))\n", threads);
-  std::printf("| rays | query | GPU rays/s | CPU rays/s | GPU/CPU |\n|---|---|---|---|---|\n");
-  for (int logN = 20; logN <= 22; ++logN) {
-    const size_t n = size_t(1) << logN;
-    std::mt19937_64 g{uint64_t(logN)};
-    std::uniform_real_distribution<float> u(0.0f, 1.0f);
-    auto dir = [&] {
-      const float z = 2 * u(g) - 1, phi = 6.2831853f * u(g);
-      const float r = std::sqrt(std::max(0.0f, 1 - z * z));
-      return Vec3{r * std::cos(phi), r * std::sin(phi), z};
-    };
-    std::vector<float> rayData(n * 8);
-    std::vector<Ray> rays(n);
-    for (size_t i = 0; i < n; ++i) {
-      const Vec3 a = dir(), b = dir();
-      const float s = R * (1.05f + 2.0f * u(g)), s2 = R * 1.1f * std::cbrt(u(g));
-      const Vec3 o{c.x + a.x * s, c.y + a.y * s, c.z + a.z * s};
-      const Vec3 d{c.x + b.x * s2 - o.x, c.y + b.y * s2 - o.y, c.z + b.z * s2 - o.z};
-      const float l = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
-      const Vec3 w{d.x / l, d.y / l, d.z / l};
-      rays[i] = Ray{o, w, 0.0f, 2.0f * R};
-      float* r = &rayData[i * 8];
-      r[0] = o.x, r[1] = o.y, r[2] = o.z, r[3] = 2.0f * R, r[4] = w.x, r[5] = w.y, r[6] = w.z, r[7] = 0;
-    }
-    GLuint bufs[2];
-    glGenBuffers(2, bufs);
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[0]);
-    glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(rayData.size() * 4), rayData.data(), GL_STATIC_DRAW);
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
-    glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(n * 4), nullptr, GL_STREAM_READ);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, bufs[0]);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, bufs[1]);
-    gpu->bind();
-    glUseProgram(rayProg);
-    for (int interp = 0; interp < 2; ++interp) {
-      glUniform1i(0, interp);
-      double best = 1e30;
-      for (int rep = 0; rep < 2; ++rep) {
-        glFinish();
-        const auto t0 = Clock::now();
-        // At most 2^20 rays per dispatch (GL guarantees 65535 work groups per dimension).
-        for (size_t first = 0; first < n; first += size_t(1) << 20) {
-          glUniform1ui(1, GLuint(first));
-          glDispatchCompute(GLuint((std::min(n - first, size_t(1) << 20) + 63) / 64), 1, 1);
-        }
-        glFinish();
-        best = std::min(best, seconds(t0, Clock::now()));
-      }
-      std::vector<float> gres(n);
-      glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-      glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
-      glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(n * 4), gres.data());
-      std::vector<float> cres(n);
-      QueryOptions qo;
-      qo.reconstruction = interp ? Reconstruction::kInterpolated : Reconstruction::kNearest;
-      const auto c0 = Clock::now();
-      // The batch calls, 4096 rays at a time (kNearest visibility: 0 or 1, as !occluded()).
-      parallel(threads, n, [&](size_t b, size_t e) {
-        for (size_t first = b; first < e; first += 4096) {
-          const size_t count = std::min<size_t>(4096, e - first);
-          cpu->visibility(std::span<const Ray>(rays.data() + first, count), std::span<float>(cres).subspan(first, count), qo);
-        }
-      });
-      const double cpuS = seconds(c0, Clock::now());
-      size_t differ = 0;
-      for (size_t i = 0; i < n; ++i) differ += std::fabs(gres[i] - cres[i]) > 1e-4f;
-      std::printf("| 2^%d | %s | %.3g | %.3g | %.2f |   (answers differing by > 1e-4: %zu)\n", logN,
-                  interp ? "interpolated visibility" : "nearest occluded", double(n) / best, double(n) / cpuS,
-                  cpuS / best, differ);
-      std::fflush(stdout);
-    }
-    glDeleteBuffers(2, bufs);
-  }
-
-  // ---- AO render ----
-  const gpubench::AoScene s = gpubench::makeAoScene(f, groundY, size);
-  GLuint bufs[3];
-  glGenBuffers(3, bufs);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[0]);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(s.gbuffer.size() * 4), s.gbuffer.data(), GL_STATIC_DRAW);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(s.directions.size() * 4), s.directions.data(), GL_STATIC_DRAW);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[2]);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(size_t(size) * size * 4), nullptr, GL_STREAM_READ);
-  for (int b = 0; b < 3; ++b) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, GLuint(5 + b), bufs[b]);
-  gpu->bind();
-  glUseProgram(aoProg);
-  std::printf("\nground AO %dx%d, %d rays/px (%.3g rays), tmax 2 R; GPU vs CPU image on the 8-bit scale\n", size, size,
-              spp, double(size) * size * spp);
-  std::printf("| query | GPU s | CPU s | GPU/CPU | max | RMS |\n|---|---|---|---|---|---|\n");
-  for (int interp = 0; interp < 2; ++interp) {
-    glUniform1i(0, size);
-    glUniform1i(1, spp);
-    glUniform1i(2, interp);
-    glUniform1f(3, s.eps);
-    glUniform1f(4, s.tmax);
-    // A warm-up dispatch (drivers such as llvmpipe compile the shader at its first use), then
-    // bands of 64 rows per dispatch (keeps single dispatches short on slow drivers).
-    glUniform1i(5, 0);
-    glDispatchCompute(1, 1, 1);
-    glFinish();
-    const auto t0 = Clock::now();
-    for (int row = 0; row < size; row += 64) {
-      glUniform1i(5, row);
-      glDispatchCompute(GLuint(size / 8), GLuint(std::min(64, size - row) / 8), 1);
-    }
-    glFinish();
-    const double gpuS = seconds(t0, Clock::now());
-    std::vector<float> g(size_t(size) * size);
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[2]);
-    glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(g.size() * 4), g.data());
-    const auto c0 = Clock::now();
-    const std::vector<float> cimg =
-        gpubench::cpuAo(*cpu, s, spp, interp ? Reconstruction::kInterpolated : Reconstruction::kNearest, threads);
-    const double cpuS = seconds(c0, Clock::now());
-    const gpubench::AoDiff d = gpubench::compareAo(cimg, g);
-    std::printf("| %s | %.2f | %.2f | %.2f | %.0f | %.4f |\n", interp ? "interpolated visibility" : "nearest occluded", gpuS,
-                cpuS, cpuS / gpuS, d.max, d.rms);
-    std::fflush(stdout);
-  }
-  glDeleteBuffers(3, bufs);
+  benchQueries(f, *gpu, *cpu, rayProg, o.threads);
+  benchAo(f, groundY, *gpu, *cpu, aoProg, o);
   glDeleteProgram(rayProg);
   glDeleteProgram(aoProg);
   if (glGetError() != GL_NO_ERROR) {

@@ -60,20 +60,21 @@
 #endif
 
 // ---- Resources -----------------------------------------------------------------------------------
-// Field and layout: the FDSC and LAYT fields (spec/format.md sections 5 and 6) plus three values the
-// loader derives exactly as the CPU does. Must match vff::gl::FieldBlock (112 bytes).
+// Field and layout: the FDSC and LAYT fields (spec/format.md sections 5 and 6) plus the values the
+// loader derives exactly as the CPU does. Must match vff::gl::FieldBlock (112 bytes; member order,
+// types and std140 offsets are checked by tests/gpu/test_glsl_layout.cpp).
 layout(std140, binding = VFF_FIELD_BINDING) uniform VffFieldBlock {
   vec3 sphereCenter;        // sphere.center
   float sphereRadius;       // sphere.radius
-  uint positionScheme;      // 1 octa-hemi2, 2 ea-octa-grid, 3 fibonacci
+  uint positionScheme;      // VFF_POSITION_*
   uint positionParam;       // n
   uint mapCount;
-  uint directionScheme;     // 1 concentric-equal-area, 2 hemi-octahedral
+  uint directionScheme;     // VFF_DIRECTION_*
   uint mapResolution;       // M
-  uint distanceEncoding;    // 1 unorm8-diameter, 2 unorm8-chord, 3 unorm16-diameter, 4 bit1
-  uint missCode;            // 255, 255, 65535, 0
-  uint normalEncoding;      // not read by this include
-  uint target;              // 1 2d-array, 2 3d
+  uint distanceEncoding;    // VFF_ENCODING_*
+  uint missCode;            // vff::missCode(distanceEncoding)
+  uint normalEncoding;      // VFF_NORMAL_NONE, else the normal plane's encoding
+  uint target;              // vff::LayoutTarget (not read: VFF_MAPS_3D selects the sampler)
   uint gutter;
   uint tileSize;
   uint tilesPerRow;
@@ -113,12 +114,14 @@ layout(binding = VFF_NORMALS_BINDING) uniform highp isampler2DArray vffNormals;
 // For unorm8-chord it continues with the decode scale of every texel of a map, 2R cos(alpha) / 254
 // with cos(alpha) of the texel centre, computed by the CPU exactly as the CPU query does: texel
 // t = j M + i is component t % 4 of vffPositions[mapCount + t / 4]. From vec4 index
-// vffField.neighbourOffset: the neighbour lists of kInterpolated, 8 sample indices per map (two
-// vec4, as floats; -1 pads), the lists the CPU query builds.
+// vffField.neighbourOffset: the neighbour lists of kInterpolated, VFF_NEIGHBOURS sample indices per
+// map (VFF_NEIGHBOURS / 4 vec4, as floats; -1 pads), the lists the CPU query builds.
 layout(std430, binding = VFF_POSITIONS_BINDING) readonly buffer VffPositionsBlock {
   vec4 vffPositions[];
 };
 
+// The values of vff/format.h's enums and of vff::kQueryNeighbours (tests/gpu/test_glsl_layout.cpp
+// checks every top-level constant of this file against the C++).
 const uint VFF_POSITION_OCTA_HEMI2 = 1u;
 const uint VFF_POSITION_EA_OCTA_GRID = 2u;
 const uint VFF_POSITION_FIBONACCI = 3u;
@@ -129,6 +132,8 @@ const uint VFF_ENCODING_UNORM8_CHORD = 2u;
 const uint VFF_ENCODING_UNORM16_DIAMETER = 3u;
 const uint VFF_ENCODING_BIT1 = 4u;
 const uint VFF_ENCODING_BC4_DIAMETER = 5u;
+const uint VFF_NORMAL_NONE = 0u;
+const uint VFF_NEIGHBOURS = 8u;  // neighbour list entries per map (vff::kQueryNeighbours)
 
 // ---- Arithmetic ----------------------------------------------------------------------------------
 // a / b, correctly rounded (one Newton correction of the driver's quotient, with a fused residual).
@@ -423,7 +428,7 @@ struct VffHit {
   bool inside;    // the origin was inside the bounding sphere (the reversed-ray test of 7.3)
   float t;        // along the ray, in multiples of its direction; +inf without a hit
   vec3 normal;    // object-space unit surface normal at the hit, when hasNormal
-  bool hasNormal; // the field has a normal plane (normalEncoding != 0) and the ray hit
+  bool hasNormal; // the field has a normal plane (normalEncoding != VFF_NORMAL_NONE) and the ray hit
   // The lookup that answered the ray (valid when looked): sample, texel, stored code and its
   // decoded distance from the sample's entry point. Useful for debugging and for the tests.
   // kInterpolated: the nearest sample only (texel, code and distance are 0).
@@ -489,7 +494,7 @@ VffHit vffQuery(vec3 origin, vec3 direction, float tmin, float tmax, float intra
 #ifdef VFF_NO_NORMALS
   bool normals = false;
 #else
-  bool normals = vffField.normalEncoding != 0u;
+  bool normals = vffField.normalEncoding != VFF_NORMAL_NONE;
 #endif
   // 2. The nearest sample, 3. the texel, 4. the decode.
   precise vec3 eu = (e - c) * vffField.invRadius;
@@ -528,13 +533,13 @@ VffHit vffQuery(vec3 origin, vec3 direction, float tmin, float tmax, float intra
   // kInterpolated: the kernel's samples (the nearest and its neighbours within the kernel), each
   // looked up along v from its own sample point with miss-aware bilinear weights; every hit point
   // is projected onto the ray. Hits and misses are summed separately (FieldQuery::Impl::query).
-  uint ks[9];
-  float kw[9];
+  uint ks[VFF_NEIGHBOURS + 1u];
+  float kw[VFF_NEIGHBOURS + 1u];
   uint kc = 1u;
   ks[0] = uint(k);
   kw[0] = max(vffKernel(eu, uint(k)), 1e-6);  // the nearest sample always contributes
-  uint nbase = vffField.neighbourOffset + 2u * uint(k);
-  for (uint q = 0u; q < 8u; ++q) {
+  uint nbase = vffField.neighbourOffset + (VFF_NEIGHBOURS / 4u) * uint(k);
+  for (uint q = 0u; q < VFF_NEIGHBOURS; ++q) {
     float f = vffPositions[nbase + q / 4u][q % 4u];
     if (f < 0.0) break;
     uint nk = uint(f);

@@ -1,21 +1,15 @@
-// The OpenGL 4.3 loader (vff/gl/loader.h).
+// The OpenGL 4.3 loader (vff/gl/loader.h): the GL calls of loadField and GpuField. What it uploads
+// is computed without GL in field_block.cpp.
 #include "vff/gl/loader.h"
 
 #include <GL/glcorearb.h>
 
-#include <algorithm>
-#include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "vff/positions.h"
-#include "vff/query.h"
-
 namespace vff::gl {
 namespace {
-
-constexpr float kPi = 3.14159265358979323846f;
 
 std::string glErrorName(GLenum e) {
   switch (e) {
@@ -97,55 +91,182 @@ Error limitError(const char* limit, uint32_t value, const std::string& need, con
   }
   return makeError(Code::kUnsupported, msg);
 }
+// The context: GL 4.3 for compute shaders, storage buffers and texelFetch on integer arrays.
+Status checkVersion() {
+  glGetError();  // a caller's stale error is not ours
+  const uint32_t major = getInt(GL_MAJOR_VERSION), minor = getInt(GL_MINOR_VERSION);
+  if (Status s = checkGl("querying the GL version"); !s)
+    return makeError(Code::kBadState, s.error().message + " (is a GL context current?)");
+  if (major < 4 || (major == 4 && minor < 3))
+    return makeError(Code::kUnsupported, "the GL context is version " + std::to_string(major) + "." +
+                                             std::to_string(minor) + ", vff_gl needs 4.3");
+  return {};
+}
 
-}  // namespace
+// The layout against the context's limits, tightened by the caller's. `width`: the distance
+// texture's width in texels.
+Status checkLimits(const FieldDesc& field, const LayoutDesc& layout, const LoadOptions& options, uint32_t width) {
+  const bool is3D = layout.target == LayoutTarget::kTexture3D;
+  const char* sizeName = is3D ? "GL_MAX_3D_TEXTURE_SIZE" : "GL_MAX_TEXTURE_SIZE";
+  const char* layerName = is3D ? "GL_MAX_3D_TEXTURE_SIZE" : "GL_MAX_ARRAY_TEXTURE_LAYERS";
+  uint32_t maxSize = getInt(is3D ? GL_MAX_3D_TEXTURE_SIZE : GL_MAX_TEXTURE_SIZE);
+  uint32_t maxLayers = getInt(is3D ? GL_MAX_3D_TEXTURE_SIZE : GL_MAX_ARRAY_TEXTURE_LAYERS);
+  if (options.maxTextureSize && options.maxTextureSize < maxSize) maxSize = options.maxTextureSize;
+  if (options.maxLayers && options.maxLayers < maxLayers) maxLayers = options.maxLayers;
+  if (width > maxSize)
+    return limitError(sizeName, maxSize, "slices " + std::to_string(width) + " texels wide", field, layout, maxSize,
+                      maxLayers);
+  if (layout.sliceHeight > maxSize)
+    return limitError(sizeName, maxSize, "slices " + std::to_string(layout.sliceHeight) + " texels high", field,
+                      layout, maxSize, maxLayers);
+  if (layout.sliceCount > maxLayers)
+    return limitError(layerName, maxLayers, std::to_string(layout.sliceCount) + " slices", field, layout, maxSize,
+                      maxLayers);
+  return {};
+}
 
-Result<FieldBlock> makeFieldBlock(const FieldDesc& field, const LayoutDesc& layout) {
-  if (Status s = checkFieldDesc(field); !s) return s.error();
-  if (Status s = checkLayout(layout, field); !s) return s.error();
-  FieldBlock b;
-  for (int i = 0; i < 3; ++i) b.sphereCenter[i] = field.sphere.center[i];
-  const float radius = field.sphere.radius;
-  b.sphereRadius = radius;
-  b.positionScheme = uint32_t(field.positionScheme);
-  b.positionParam = field.positionParam;
-  b.mapCount = field.mapCount;
-  b.directionScheme = uint32_t(field.directionScheme);
-  b.mapResolution = field.mapResolution;
-  b.distanceEncoding = uint32_t(field.distanceEncoding);
-  b.missCode = missCode(field.distanceEncoding);
-  b.normalEncoding = uint32_t(field.normalEncoding);
-  b.target = uint32_t(layout.target);
-  b.gutter = layout.gutter;
-  b.tileSize = layout.tileSize;
-  b.tilesPerRow = layout.tilesPerRow;
-  b.tilesPerColumn = layout.tilesPerColumn;
-  b.sliceWidth = layout.sliceWidth;
-  b.sliceHeight = layout.sliceHeight;
-  b.sliceCount = layout.sliceCount;
-  b.intraBias = defaultIntraBias(field);
-  // The same float expressions as the CPU query's decode (libvff/src/query.cpp), so that the
-  // shader's decoded distances are bit-identical.
+// The distance texture's format, checked against the file's slices.
+struct MapsFormat {
+  GLenum internalFormat = GL_R8UI, type = GL_UNSIGNED_BYTE;
+  uint32_t width = 0;        // texels (bit1: bytes) per slice row
+  uint64_t sliceBytes = 0;   // File::sliceBytes(Plane::kDistance)
+};
+
+Result<MapsFormat> mapsFormat(const File& file, uint32_t width) {
+  const FieldDesc& field = file.field();
+  const LayoutDesc& layout = file.layout();
+  MapsFormat f;
+  f.width = width;
   switch (field.distanceEncoding) {
     case DistanceEncoding::kUnorm8Diameter:
-    case DistanceEncoding::kBc4Diameter: b.distanceScale = 2.0f * radius / 254.0f; break;
-    case DistanceEncoding::kUnorm16Diameter: b.distanceScale = 2.0f * radius / 65534.0f; break;
-    default: b.distanceScale = 0.0f; break;
+    case DistanceEncoding::kUnorm8Chord:
+    case DistanceEncoding::kBit1: break;
+    case DistanceEncoding::kUnorm16Diameter: f.internalFormat = GL_R16UI; f.type = GL_UNSIGNED_SHORT; break;
+    case DistanceEncoding::kBc4Diameter: f.internalFormat = GL_COMPRESSED_RED_RGTC1; break;
+    default: return makeError(Code::kUnsupported, "vff_gl cannot upload this distance encoding");
   }
-  b.invRadius = 1.0f / radius;
-  b.twoRadius = 2.0f * radius;
-  // As FieldQuery::Impl::build.
-  const float spacing = std::sqrt(4.0f * kPi / float(field.mapCount));
-  const float r = kQueryKernelSpacings * spacing;
-  b.kernelRadius2 = r * r;
-  return b;
+  const bool bc4 = field.distanceEncoding == DistanceEncoding::kBc4Diameter;
+  if (bc4 && (layout.target == LayoutTarget::kTexture3D || layout.gutter != 0))  // the file's rules 7001 and 7002
+    return makeError(Code::kUnsupported, "bc4-diameter slices must be a 2D array without gutters");
+  f.sliceBytes = file.sliceBytes(Plane::kDistance);
+  const uint64_t texelBytes = f.type == GL_UNSIGNED_SHORT ? 2 : 1;
+  if (f.sliceBytes != (bc4 ? uint64_t(width) * layout.sliceHeight / 2 : uint64_t(width) * layout.sliceHeight * texelBytes))
+    return makeError(Code::kUnsupported, "unexpected slice size " + std::to_string(f.sliceBytes) + " bytes");
+  return f;
 }
 
-Result<std::vector<uint32_t>> neighbourLists(const FieldDesc& field) {
-  auto ps = PositionSet::fromField(field);
-  if (!ps) return ps.error();
-  return queryNeighbours(*ps);
+// A texture of one level, nearest filtering (integer textures allow nothing else), immutable storage.
+Status makeTexture(GLenum target, GLenum internalFormat, uint32_t width, const LayoutDesc& layout, GLuint* texture,
+                   const char* what) {
+  glGenTextures(1, texture);
+  glBindTexture(target, *texture);
+  glTexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(target, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTexParameteri(target, GL_TEXTURE_BASE_LEVEL, 0);
+  glTexParameteri(target, GL_TEXTURE_MAX_LEVEL, 0);
+  glTexStorage3D(target, 1, internalFormat, GLsizei(width), GLsizei(layout.sliceHeight), GLsizei(layout.sliceCount));
+  return checkGl(what);
 }
+
+// Tightly packed client memory for the uploads.
+void setUnpackDefaults() {
+  glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  glPixelStorei(GL_UNPACK_IMAGE_HEIGHT, 0);
+  glPixelStorei(GL_UNPACK_SKIP_PIXELS, 0);
+  glPixelStorei(GL_UNPACK_SKIP_ROWS, 0);
+  glPixelStorei(GL_UNPACK_SKIP_IMAGES, 0);
+}
+
+// The distance plane into the bound texture; adds the bytes uploaded to *bytes.
+Status uploadDistance(const File& file, GLenum target, const MapsFormat& f, uint64_t* bytes) {
+  const FieldDesc& field = file.field();
+  const LayoutDesc& layout = file.layout();
+  const GLsizei m = GLsizei(field.mapResolution);
+  if (field.distanceEncoding == DistanceEncoding::kBc4Diameter) {
+    // Each map's blocks are its compressed M x M image: upload them as stored. Unused tiles stay
+    // undefined; no lookup reads them.
+    for (uint32_t k = 0; k < field.mapCount; ++k) {
+      auto map = file.mapData(Plane::kDistance, k);
+      if (!map) return map.error();
+      const TilePlacement at = placeMap(layout, k);
+      glCompressedTexSubImage3D(target, 0, GLint(at.x), GLint(at.y), GLint(at.slice), m, m, 1,
+                                GL_COMPRESSED_RED_RGTC1, GLsizei(map->size()), map->data());
+    }
+    if (Status st = checkGl("glCompressedTexSubImage3D (maps)"); !st) return st.error();
+    *bytes += f.sliceBytes * layout.sliceCount;
+  } else if (layout.gutter == 0 && field.distanceEncoding != DistanceEncoding::kBit1) {
+    // Without gutters every map is one rectangle of its slice: upload it straight from the file's
+    // bytes (the mapped file itself for stored blocks), with no slice composed on the CPU. Tiles
+    // past the last map stay undefined; no lookup reads them.
+    for (uint32_t k = 0; k < field.mapCount; ++k) {
+      auto map = file.mapData(Plane::kDistance, k);
+      if (!map) return map.error();
+      const TilePlacement at = placeMap(layout, k);
+      glTexSubImage3D(target, 0, GLint(at.x), GLint(at.y), GLint(at.slice), m, m, 1, GL_RED_INTEGER, f.type,
+                      map->data());
+    }
+    if (Status st = checkGl("glTexSubImage3D (maps)"); !st) return st.error();
+    *bytes += f.sliceBytes * layout.sliceCount;
+  } else {
+    std::vector<uint8_t> slice(f.sliceBytes);
+    for (uint32_t s = 0; s < layout.sliceCount; ++s) {
+      if (Status st = file.readSlice(Plane::kDistance, s, slice); !st) return st.error();
+      glTexSubImage3D(target, 0, 0, 0, GLint(s), GLsizei(f.width), GLsizei(layout.sliceHeight), 1, GL_RED_INTEGER,
+                      f.type, slice.data());
+      if (Status st = checkGl("glTexSubImage3D"); !st) return st.error();
+      *bytes += f.sliceBytes;
+    }
+  }
+  return {};
+}
+
+// The normal plane: the same layout, two snorm16 per texel as GL_RG16I, into a new texture
+// *texture; adds the bytes uploaded to *bytes.
+Status uploadNormals(const File& file, GLenum target, GLuint* texture, uint64_t* bytes) {
+  const FieldDesc& field = file.field();
+  const LayoutDesc& layout = file.layout();
+  if (field.normalEncoding != NormalEncoding::kOctSnorm16)
+    return makeError(Code::kUnsupported, "vff_gl cannot upload this normal encoding");
+  const uint64_t normalBytes = file.sliceBytes(Plane::kNormal);
+  if (normalBytes != uint64_t(layout.sliceWidth) * layout.sliceHeight * 4)
+    return makeError(Code::kUnsupported, "unexpected normal slice size " + std::to_string(normalBytes) + " bytes");
+  if (Status s = makeTexture(target, GL_RG16I, layout.sliceWidth, layout, texture, "glTexStorage3D (normals)"); !s)
+    return s.error();
+  if (layout.gutter == 0) {
+    const GLsizei m = GLsizei(field.mapResolution);
+    for (uint32_t k = 0; k < field.mapCount; ++k) {  // straight from the file, as the distances
+      auto map = file.mapData(Plane::kNormal, k);
+      if (!map) return map.error();
+      const TilePlacement at = placeMap(layout, k);
+      glTexSubImage3D(target, 0, GLint(at.x), GLint(at.y), GLint(at.slice), m, m, 1, GL_RG_INTEGER, GL_SHORT,
+                      map->data());
+    }
+    if (Status st = checkGl("glTexSubImage3D (normal maps)"); !st) return st.error();
+    *bytes += normalBytes * layout.sliceCount;
+    return {};
+  }
+  std::vector<uint8_t> nslice(normalBytes);
+  for (uint32_t s = 0; s < layout.sliceCount; ++s) {
+    if (Status st = file.readSlice(Plane::kNormal, s, nslice); !st) return st.error();
+    glTexSubImage3D(target, 0, 0, 0, GLint(s), GLsizei(layout.sliceWidth), GLsizei(layout.sliceHeight), 1,
+                    GL_RG_INTEGER, GL_SHORT, nslice.data());
+    if (Status st = checkGl("glTexSubImage3D (normals)"); !st) return st.error();
+    *bytes += normalBytes;
+  }
+  return {};
+}
+
+// A new buffer object bound to `target`, holding `size` bytes from `data`.
+Status makeBuffer(GLenum target, const void* data, size_t size, GLuint* buffer, const char* what) {
+  glGenBuffers(1, buffer);
+  glBindBuffer(target, *buffer);
+  glBufferData(target, GLsizeiptr(size), data, GL_STATIC_DRAW);
+  return checkGl(what);
+}
+
+}  // namespace
 
 GpuField::GpuField(GpuField&& o) noexcept
     : block_(o.block_),
@@ -192,200 +313,44 @@ void GpuField::bind(const Bindings& b) const noexcept {
   glBindTexture(mapsTarget_ ? mapsTarget_ : GL_TEXTURE_2D_ARRAY, mapsTexture_);
 }
 
-const char* shaderDefines(const FieldDesc& field, const LayoutDesc& layout) noexcept {
-  if (field.distanceEncoding == DistanceEncoding::kBc4Diameter) return "#define VFF_MAPS_BC4\n";
-  return layout.target == LayoutTarget::kTexture3D ? "#define VFF_MAPS_3D\n" : "";
-}
-
 Result<GpuField> loadField(const File& file, const LoadOptions& options) {
   const FieldDesc& field = file.field();
   const LayoutDesc& layout = file.layout();
   auto block = makeFieldBlock(field, layout);
   if (!block) return block.error();
-
-  // The context: GL 4.3 for compute shaders, storage buffers and texelFetch on integer arrays.
-  glGetError();  // a caller's stale error is not ours
-  const uint32_t major = getInt(GL_MAJOR_VERSION), minor = getInt(GL_MINOR_VERSION);
-  if (Status s = checkGl("querying the GL version"); !s) return makeError(Code::kBadState, s.error().message + " (is a GL context current?)");
-  if (major < 4 || (major == 4 && minor < 3))
-    return makeError(Code::kUnsupported, "the GL context is version " + std::to_string(major) + "." +
-                                             std::to_string(minor) + ", vff_gl needs 4.3");
-
-  // The limits, tightened by the caller's.
-  const bool is3D = layout.target == LayoutTarget::kTexture3D;
-  const char* sizeName = is3D ? "GL_MAX_3D_TEXTURE_SIZE" : "GL_MAX_TEXTURE_SIZE";
-  const char* layerName = is3D ? "GL_MAX_3D_TEXTURE_SIZE" : "GL_MAX_ARRAY_TEXTURE_LAYERS";
-  uint32_t maxSize = getInt(is3D ? GL_MAX_3D_TEXTURE_SIZE : GL_MAX_TEXTURE_SIZE);
-  uint32_t maxLayers = getInt(is3D ? GL_MAX_3D_TEXTURE_SIZE : GL_MAX_ARRAY_TEXTURE_LAYERS);
-  if (options.maxTextureSize && options.maxTextureSize < maxSize) maxSize = options.maxTextureSize;
-  if (options.maxLayers && options.maxLayers < maxLayers) maxLayers = options.maxLayers;
+  if (Status s = checkVersion(); !s) return s.error();
   const bool bit1 = field.distanceEncoding == DistanceEncoding::kBit1;
   const uint32_t width = bit1 ? layout.sliceWidth / 8 : layout.sliceWidth;
-  if (width > maxSize)
-    return limitError(sizeName, maxSize, "slices " + std::to_string(width) + " texels wide", field, layout, maxSize,
-                      maxLayers);
-  if (layout.sliceHeight > maxSize)
-    return limitError(sizeName, maxSize, "slices " + std::to_string(layout.sliceHeight) + " texels high", field,
-                      layout, maxSize, maxLayers);
-  if (layout.sliceCount > maxLayers)
-    return limitError(layerName, maxLayers, std::to_string(layout.sliceCount) + " slices", field, layout, maxSize,
-                      maxLayers);
-
-  GLenum internalFormat = GL_R8UI, type = GL_UNSIGNED_BYTE;
-  switch (field.distanceEncoding) {
-    case DistanceEncoding::kUnorm8Diameter:
-    case DistanceEncoding::kUnorm8Chord:
-    case DistanceEncoding::kBit1: break;
-    case DistanceEncoding::kUnorm16Diameter: internalFormat = GL_R16UI; type = GL_UNSIGNED_SHORT; break;
-    case DistanceEncoding::kBc4Diameter: internalFormat = GL_COMPRESSED_RED_RGTC1; break;
-    default: return makeError(Code::kUnsupported, "vff_gl cannot upload this distance encoding");
-  }
-  const bool bc4 = field.distanceEncoding == DistanceEncoding::kBc4Diameter;
-  if (bc4 && (is3D || layout.gutter != 0))  // the file's rules 7001 and 7002
-    return makeError(Code::kUnsupported, "bc4-diameter slices must be a 2D array without gutters");
-  const uint64_t sliceBytes = file.sliceBytes(Plane::kDistance);
-  const uint64_t texelBytes = type == GL_UNSIGNED_SHORT ? 2 : 1;
-  if (sliceBytes != (bc4 ? uint64_t(width) * layout.sliceHeight / 2 : uint64_t(width) * layout.sliceHeight * texelBytes))
-    return makeError(Code::kUnsupported, "unexpected slice size " + std::to_string(sliceBytes) + " bytes");
+  if (Status s = checkLimits(field, layout, options, width); !s) return s.error();
+  auto format = mapsFormat(file, width);
+  if (!format) return format.error();
 
   SavedState saved;
   GpuField out;
   out.block_ = *block;
-  out.mapsTarget_ = is3D ? GL_TEXTURE_3D : GL_TEXTURE_2D_ARRAY;
-
-  // The slices.
-  glGenTextures(1, &out.mapsTexture_);
-  glBindTexture(out.mapsTarget_, out.mapsTexture_);
-  glTexParameteri(out.mapsTarget_, GL_TEXTURE_MIN_FILTER, GL_NEAREST);  // integer textures: nearest only
-  glTexParameteri(out.mapsTarget_, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-  glTexParameteri(out.mapsTarget_, GL_TEXTURE_BASE_LEVEL, 0);
-  glTexParameteri(out.mapsTarget_, GL_TEXTURE_MAX_LEVEL, 0);
-  glTexStorage3D(out.mapsTarget_, 1, internalFormat, GLsizei(width), GLsizei(layout.sliceHeight),
-                 GLsizei(layout.sliceCount));
-  if (Status s = checkGl("glTexStorage3D"); !s) return s.error();
-  glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
-  glPixelStorei(GL_UNPACK_IMAGE_HEIGHT, 0);
-  glPixelStorei(GL_UNPACK_SKIP_PIXELS, 0);
-  glPixelStorei(GL_UNPACK_SKIP_ROWS, 0);
-  glPixelStorei(GL_UNPACK_SKIP_IMAGES, 0);
-  if (bc4) {
-    // Each map's blocks are its compressed M x M image: upload them as stored. Unused tiles stay
-    // undefined; no lookup reads them.
-    const GLsizei m = GLsizei(field.mapResolution);
-    for (uint32_t k = 0; k < field.mapCount; ++k) {
-      auto map = file.mapData(Plane::kDistance, k);
-      if (!map) return map.error();
-      const TilePlacement at = placeMap(layout, k);
-      glCompressedTexSubImage3D(out.mapsTarget_, 0, GLint(at.x), GLint(at.y), GLint(at.slice), m, m, 1,
-                                GL_COMPRESSED_RED_RGTC1, GLsizei(map->size()), map->data());
-    }
-    if (Status st = checkGl("glCompressedTexSubImage3D (maps)"); !st) return st.error();
-    out.textureBytes_ += sliceBytes * layout.sliceCount;
-  } else if (layout.gutter == 0 && !bit1) {
-    // Without gutters every map is one rectangle of its slice: upload it straight from the file's
-    // bytes (the mapped file itself for stored blocks), with no slice composed on the CPU. Tiles
-    // past the last map stay undefined; no lookup reads them.
-    for (uint32_t k = 0; k < field.mapCount; ++k) {
-      auto map = file.mapData(Plane::kDistance, k);
-      if (!map) return map.error();
-      const TilePlacement at = placeMap(layout, k);
-      glTexSubImage3D(out.mapsTarget_, 0, GLint(at.x), GLint(at.y), GLint(at.slice), GLsizei(field.mapResolution),
-                      GLsizei(field.mapResolution), 1, GL_RED_INTEGER, type, map->data());
-    }
-    if (Status st = checkGl("glTexSubImage3D (maps)"); !st) return st.error();
-    out.textureBytes_ += sliceBytes * layout.sliceCount;
-  } else {
-    std::vector<uint8_t> slice(sliceBytes);
-    for (uint32_t s = 0; s < layout.sliceCount; ++s) {
-      if (Status st = file.readSlice(Plane::kDistance, s, slice); !st) return st.error();
-      glTexSubImage3D(out.mapsTarget_, 0, 0, 0, GLint(s), GLsizei(width), GLsizei(layout.sliceHeight), 1,
-                      GL_RED_INTEGER, type, slice.data());
-      if (Status st = checkGl("glTexSubImage3D"); !st) return st.error();
-      out.textureBytes_ += sliceBytes;
-    }
-  }
-
-  // The normal plane: the same layout, two snorm16 per texel as GL_RG16I.
+  out.mapsTarget_ = layout.target == LayoutTarget::kTexture3D ? GL_TEXTURE_3D : GL_TEXTURE_2D_ARRAY;
+  if (Status s = makeTexture(out.mapsTarget_, format->internalFormat, width, layout, &out.mapsTexture_,
+                             "glTexStorage3D");
+      !s)
+    return s.error();
+  setUnpackDefaults();
+  if (Status s = uploadDistance(file, out.mapsTarget_, *format, &out.textureBytes_); !s) return s.error();
   if (file.hasNormals()) {
-    if (field.normalEncoding != NormalEncoding::kOctSnorm16)
-      return makeError(Code::kUnsupported, "vff_gl cannot upload this normal encoding");
-    const uint64_t normalBytes = file.sliceBytes(Plane::kNormal);
-    if (normalBytes != uint64_t(layout.sliceWidth) * layout.sliceHeight * 4)
-      return makeError(Code::kUnsupported, "unexpected normal slice size " + std::to_string(normalBytes) + " bytes");
-    glGenTextures(1, &out.normalsTexture_);
-    glBindTexture(out.mapsTarget_, out.normalsTexture_);
-    glTexParameteri(out.mapsTarget_, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(out.mapsTarget_, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glTexParameteri(out.mapsTarget_, GL_TEXTURE_BASE_LEVEL, 0);
-    glTexParameteri(out.mapsTarget_, GL_TEXTURE_MAX_LEVEL, 0);
-    glTexStorage3D(out.mapsTarget_, 1, GL_RG16I, GLsizei(layout.sliceWidth), GLsizei(layout.sliceHeight),
-                   GLsizei(layout.sliceCount));
-    if (Status s = checkGl("glTexStorage3D (normals)"); !s) return s.error();
-    if (layout.gutter == 0) {
-      for (uint32_t k = 0; k < field.mapCount; ++k) {  // straight from the file, as the distances
-        auto map = file.mapData(Plane::kNormal, k);
-        if (!map) return map.error();
-        const TilePlacement at = placeMap(layout, k);
-        glTexSubImage3D(out.mapsTarget_, 0, GLint(at.x), GLint(at.y), GLint(at.slice), GLsizei(field.mapResolution),
-                        GLsizei(field.mapResolution), 1, GL_RG_INTEGER, GL_SHORT, map->data());
-      }
-      if (Status st = checkGl("glTexSubImage3D (normal maps)"); !st) return st.error();
-      out.textureBytes_ += normalBytes * layout.sliceCount;
-    } else {
-      std::vector<uint8_t> nslice(normalBytes);
-      for (uint32_t s = 0; s < layout.sliceCount; ++s) {
-        if (Status st = file.readSlice(Plane::kNormal, s, nslice); !st) return st.error();
-        glTexSubImage3D(out.mapsTarget_, 0, 0, 0, GLint(s), GLsizei(layout.sliceWidth), GLsizei(layout.sliceHeight),
-                        1, GL_RG_INTEGER, GL_SHORT, nslice.data());
-        if (Status st = checkGl("glTexSubImage3D (normals)"); !st) return st.error();
-        out.textureBytes_ += normalBytes;
-      }
-    }
+    if (Status s = uploadNormals(file, out.mapsTarget_, &out.normalsTexture_, &out.textureBytes_); !s)
+      return s.error();
   }
-
   // The field block (with where the neighbour lists start in the positions buffer).
-  const bool chordTable = field.distanceEncoding == DistanceEncoding::kUnorm8Chord;
-  const size_t mapTexels = size_t(field.mapResolution) * field.mapResolution;
-  out.block_.neighbourOffset = uint32_t(field.mapCount + (chordTable ? (mapTexels + 3) / 4 : 0));
-  glGenBuffers(1, &out.fieldBuffer_);
-  glBindBuffer(GL_UNIFORM_BUFFER, out.fieldBuffer_);
-  glBufferData(GL_UNIFORM_BUFFER, sizeof(FieldBlock), &out.block_, GL_STATIC_DRAW);
-  if (Status s = checkGl("uploading the field block"); !s) return s.error();
-
-  // The sample positions.
-  auto ps = PositionSet::fromField(field);
-  if (!ps) return ps.error();
-  const bool chord = field.distanceEncoding == DistanceEncoding::kUnorm8Chord;
-  std::vector<float> positions(size_t(out.block_.neighbourOffset) * 4 + size_t(field.mapCount) * kNeighbours, 0.0f);
-  if (chord) {
-    // The decode scale of every texel, as libvff/src/query.cpp computes it.
-    float* scale = positions.data() + size_t(field.mapCount) * 4;
-    const uint32_t m = field.mapResolution;
-    for (uint32_t j = 0; j < m; ++j)
-      for (uint32_t i = 0; i < m; ++i) {
-        const float cosAlpha = texelDirection(field.directionScheme, m, i, j).z;
-        scale[size_t(j) * m + i] = 2.0f * field.sphere.radius * cosAlpha / 254.0f;
-      }
-  }
-  for (uint32_t k = 0; k < field.mapCount; ++k) {
-    const Vec3 u = ps->position(k);
-    positions[4 * size_t(k)] = u.x;
-    positions[4 * size_t(k) + 1] = u.y;
-    positions[4 * size_t(k) + 2] = u.z;
-  }
-  if (field.mapCount > (1u << 24))
-    return makeError(Code::kUnsupported, "vff_gl stores sample indices as binary32: at most 2^24 maps");
-  auto nb = neighbourLists(field);
-  if (!nb) return nb.error();
-  float* lists = positions.data() + size_t(out.block_.neighbourOffset) * 4;
-  for (size_t i = 0; i < nb->size(); ++i) lists[i] = (*nb)[i] == UINT32_MAX ? -1.0f : float((*nb)[i]);
-  glGenBuffers(1, &out.positionsBuffer_);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, out.positionsBuffer_);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(positions.size() * sizeof(float)), positions.data(),
-               GL_STATIC_DRAW);
-  if (Status s = checkGl("uploading the sample positions"); !s) return s.error();
+  if (Status s = makeBuffer(GL_UNIFORM_BUFFER, &out.block_, sizeof(FieldBlock), &out.fieldBuffer_,
+                            "uploading the field block");
+      !s)
+    return s.error();
+  // The sample positions, the unorm8-chord decode steps and the neighbour lists.
+  auto positions = makePositionsBuffer(field);
+  if (!positions) return positions.error();
+  if (Status s = makeBuffer(GL_SHADER_STORAGE_BUFFER, positions->data(), positions->size() * sizeof(float),
+                            &out.positionsBuffer_, "uploading the sample positions");
+      !s)
+    return s.error();
   return out;
 }
 

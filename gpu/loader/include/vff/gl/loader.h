@@ -17,9 +17,10 @@
 // * a uniform buffer holding a FieldBlock (std140, the shader's VffFieldBlock);
 // * a shader storage buffer with the binary32 unit vector of every positional sample
 //   (vff::PositionSet::position), one vec4 each; for unorm8-chord followed by the decode scale
-//   2R cos(alpha) / 254 of every texel of a map (M * M floats, padded to a multiple of 4); then,
-//   from vec4 FieldBlock::neighbourOffset, the neighbour lists (neighbourLists below) as floats,
-//   two vec4 per map, -1 for padding (indices below 2^24 are exact in binary32);
+//   2R cos(alpha) / 254 (vff::quantizationStep) of every texel of a map (M * M floats, padded to a
+//   multiple of 4); then, from vec4 FieldBlock::neighbourOffset, the neighbour lists
+//   (neighbourLists below) as floats, two vec4 per map, -1 for padding (indices below 2^24 are
+//   exact in binary32);
 // * when the field has a normal plane (oct-snorm16): its packed slices, same layout and target as
 //   the distance slices, internal format GL_RG16I (the raw snorm16 pairs; the shader converts them
 //   exactly as vff::decodeNormal does, not through GL's snorm conversion).
@@ -69,7 +70,8 @@ struct FieldBlock {
   uint32_t sliceHeight = 0;
   uint32_t sliceCount = 0;
   float intraBias = 0;      // vff::defaultIntraBias(field), a fraction of R
-  float distanceScale = 0;  // 2R / 254 (unorm8-diameter), 2R / 65534 (unorm16-diameter), else 0
+  float distanceScale = 0;  // vff::quantizationStep: 2R / 254 (unorm8-, bc4-diameter), 2R / 65534
+                            // (unorm16-diameter); 0 for unorm8-chord (per texel) and bit1
   float invRadius = 0;      // 1 / R
   float twoRadius = 0;      // 2 R
   // Reconstruction::kInterpolated (libvff/src/query.cpp, FieldQuery::Impl::build): where the
@@ -89,9 +91,15 @@ static_assert(sizeof(FieldBlock) == 112, "FieldBlock must match the std140 block
 inline constexpr uint32_t kNeighbours = kQueryNeighbours;
 Result<std::vector<uint32_t>> neighbourLists(const FieldDesc& field);
 
-// Fills the block from a field and its layout (no GL calls). Errors: checkFieldDesc's and
-// checkLayout's.
+// Fills the block from a field and its layout (no GL calls), as loadField uploads it. Errors:
+// checkFieldDesc's and checkLayout's.
 Result<FieldBlock> makeFieldBlock(const FieldDesc& field, const LayoutDesc& layout);
+
+// The floats of the positions buffer (VffPositionsBlock, see the top of this file) as loadField
+// uploads them (no GL calls): a vec4 per sample, for unorm8-chord the decode step
+// vff::quantizationStep of every texel, from vec4 makeFieldBlock(...).neighbourOffset the
+// neighbour lists. Errors: PositionSet::fromField's; kUnsupported beyond 2^24 maps.
+Result<std::vector<float>> makePositionsBuffer(const FieldDesc& field);
 
 // Limits a caller can tighten below the context's (0: the context's value).
 struct LoadOptions {

@@ -1,0 +1,357 @@
+// The GLSL include (gpu/glsl/vff_query.glsl) against the C++ it must agree with, without any GL
+// context (as NanoVDB checks PNanoVDB.h against NanoVDB.h), so it runs where GL and EGL are missing:
+// * every top-level `const` of the include: the enum values of vff/format.h and
+//   vff::kQueryNeighbours, or one of the few math constants listed here; a constant the test
+//   cannot parse or does not know fails, naming it;
+// * the default bindings (#define VFF_*_BINDING) against vff::gl::Bindings;
+// * the uniform block VffFieldBlock (member names, types, order, std140 offsets and size) against
+//   vff::gl::FieldBlock, and the storage block VffPositionsBlock (one vec4 array, std430);
+// * what the loader fills in (makeFieldBlock, makePositionsBuffer) against libvff's definitions:
+//   one code step is vff::quantizationStep, positions are PositionSet::position, the neighbour
+//   lists are vff::queryNeighbours.
+// The parser reads the include's own declaration style, one declaration per line, and nothing else.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "vff/encoding.h"
+#include "vff/gl/loader.h"
+#include "vff/vff.h"
+
+namespace vff {
+namespace {
+
+std::string readGlsl() {
+  std::ifstream in(std::string(VFF_GLSL_DIR) + "/vff_query.glsl");
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// The include's lines, with `//` comments and trailing blanks removed.
+std::vector<std::string> glslLines() {
+  std::vector<std::string> lines;
+  std::istringstream in(readGlsl());
+  for (std::string line; std::getline(in, line);) {
+    if (const size_t c = line.find("//"); c != std::string::npos) line.erase(c);
+    while (!line.empty() && (line.back() == ' ' || line.back() == '\r')) line.pop_back();
+    lines.push_back(line);
+  }
+  return lines;
+}
+
+bool sameBits(float a, float b) { return std::memcmp(&a, &b, sizeof(float)) == 0; }
+
+// ---- Constants -----------------------------------------------------------------------------------
+
+// A top-level `const` of the include (a declaration that begins in column 0; it may span lines).
+struct GlslConstant {
+  std::string name, type, value;  // value: the initialiser's text
+  bool parsed = false;
+  std::string text;               // the declaration as written
+};
+
+std::vector<GlslConstant> glslConstants() {
+  static const std::regex decl(R"(^const (uint|int|float) ([A-Za-z_][A-Za-z0-9_]*)(\[[0-9]+\])? = ([^;]+);$)");
+  std::vector<GlslConstant> out;
+  const std::vector<std::string> lines = glslLines();
+  for (size_t i = 0; i < lines.size(); ++i) {
+    if (lines[i].rfind("const ", 0) != 0) continue;
+    GlslConstant c;
+    c.text = lines[i];
+    while (c.text.find(';') == std::string::npos && i + 1 < lines.size()) c.text += " " + lines[++i];
+    std::smatch m;
+    if (std::regex_match(c.text, m, decl)) {
+      c.parsed = true;
+      c.type = m[1].str() + m[3].str();
+      c.name = m[2];
+      c.value = m[4];
+    }
+    out.push_back(c);
+  }
+  return out;
+}
+
+// The format values the include spells, by their GLSL names.
+const std::map<std::string, uint32_t>& expectedUintConstants() {
+  static const std::map<std::string, uint32_t> k = {
+      {"VFF_POSITION_OCTA_HEMI2", uint32_t(PositionScheme::kOctaHemi2)},
+      {"VFF_POSITION_EA_OCTA_GRID", uint32_t(PositionScheme::kEqualAreaOctaGrid)},
+      {"VFF_POSITION_FIBONACCI", uint32_t(PositionScheme::kSphericalFibonacci)},
+      {"VFF_DIRECTION_CONCENTRIC_EQUAL_AREA", uint32_t(DirectionScheme::kConcentricEqualArea)},
+      {"VFF_DIRECTION_HEMI_OCTAHEDRAL", uint32_t(DirectionScheme::kHemiOctahedral)},
+      {"VFF_ENCODING_UNORM8_DIAMETER", uint32_t(DistanceEncoding::kUnorm8Diameter)},
+      {"VFF_ENCODING_UNORM8_CHORD", uint32_t(DistanceEncoding::kUnorm8Chord)},
+      {"VFF_ENCODING_UNORM16_DIAMETER", uint32_t(DistanceEncoding::kUnorm16Diameter)},
+      {"VFF_ENCODING_BIT1", uint32_t(DistanceEncoding::kBit1)},
+      {"VFF_ENCODING_BC4_DIAMETER", uint32_t(DistanceEncoding::kBc4Diameter)},
+      {"VFF_NORMAL_NONE", uint32_t(NormalEncoding::kNone)},
+      {"VFF_NEIGHBOURS", kQueryNeighbours},
+  };
+  return k;
+}
+
+// Constants of the include's own arithmetic, with no C++ counterpart to check against.
+const std::map<std::string, std::string>& localConstants() {
+  static const std::map<std::string, std::string> k = {
+      {"kVffPi", "float"},          // pi, for the concentric map's angles
+      {"kVffQuarterPi", "float"},   // pi / 4
+      {"VFF_FIB", "uint[22]"},      // Fibonacci numbers, for the nearest Fibonacci sample
+  };
+  return k;
+}
+
+TEST(GlslConstants, EveryConstantIsParsedAndKnown) {
+  const std::vector<GlslConstant> all = glslConstants();
+  ASSERT_FALSE(all.empty()) << "no top-level const in " << VFF_GLSL_DIR << "/vff_query.glsl";
+  for (const GlslConstant& c : all) {
+    if (!c.parsed) {
+      ADD_FAILURE() << "cannot parse the GLSL constant declaration: " << c.text;
+      continue;
+    }
+    const bool format = expectedUintConstants().count(c.name) != 0;
+    const auto local = localConstants().find(c.name);
+    EXPECT_TRUE(format || local != localConstants().end())
+        << "the GLSL constant " << c.name << " is checked against nothing: add it to this test";
+    if (local != localConstants().end()) {
+      EXPECT_EQ(c.type, local->second) << "the GLSL constant " << c.name;
+    }
+  }
+}
+
+TEST(GlslConstants, FormatValuesMatchTheCppHeaders) {
+  std::map<std::string, GlslConstant> byName;
+  for (const GlslConstant& c : glslConstants()) byName[c.name] = c;
+  static const std::regex uintLiteral(R"(^([0-9]+)u$)");
+  for (const auto& [name, value] : expectedUintConstants()) {
+    const auto it = byName.find(name);
+    if (it == byName.end()) {
+      ADD_FAILURE() << "the GLSL constant " << name << " is missing";
+      continue;
+    }
+    std::smatch m;
+    if (it->second.type != "uint" || !std::regex_match(it->second.value, m, uintLiteral)) {
+      ADD_FAILURE() << "the GLSL constant " << name << " is not a uint literal: " << it->second.text;
+      continue;
+    }
+    EXPECT_EQ(std::stoul(m[1]), value) << "the GLSL constant " << name << " differs from the C++ value";
+  }
+  EXPECT_EQ(gl::kNeighbours, kQueryNeighbours);
+  EXPECT_EQ(kQueryNeighbours % 4, 0u) << "the neighbour lists are read as whole vec4";
+}
+
+TEST(GlslConstants, DefaultBindingsMatchLoaderBindings) {
+  static const std::regex define(R"(^#define (VFF_[A-Z]+_BINDING) ([0-9]+)$)");
+  std::map<std::string, uint32_t> found;
+  for (const std::string& line : glslLines()) {
+    std::smatch m;
+    if (std::regex_match(line, m, define)) found[m[1]] = uint32_t(std::stoul(m[2]));
+  }
+  const gl::Bindings b;
+  const std::map<std::string, uint32_t> expected = {{"VFF_FIELD_BINDING", b.field},
+                                                    {"VFF_MAPS_BINDING", b.maps},
+                                                    {"VFF_POSITIONS_BINDING", b.positions},
+                                                    {"VFF_NORMALS_BINDING", b.normals}};
+  for (const auto& [name, value] : expected) {
+    const auto it = found.find(name);
+    if (it == found.end()) {
+      ADD_FAILURE() << "the GLSL default " << name << " is missing";
+      continue;
+    }
+    EXPECT_EQ(it->second, value) << "the GLSL default " << name << " differs from vff::gl::Bindings";
+  }
+  EXPECT_EQ(found.size(), expected.size()) << "a GLSL binding default is checked against nothing";
+}
+
+// ---- Blocks --------------------------------------------------------------------------------------
+
+struct Member {
+  std::string type, name;
+  size_t offset = 0, size = 0;
+};
+
+// The members of the block that begins with the line `header`, up to the line `footer`.
+std::vector<Member> glslBlock(const std::string& header, const std::string& footer) {
+  static const std::regex member(R"(^  (float|int|uint|vec[234]|ivec[234]|uvec[234]) ([A-Za-z_][A-Za-z0-9_]*)(\[\])?;$)");
+  std::vector<Member> out;
+  const std::vector<std::string> lines = glslLines();
+  size_t i = 0;
+  while (i < lines.size() && lines[i] != header) ++i;
+  if (i == lines.size()) {
+    ADD_FAILURE() << "the GLSL block is missing: " << header;
+    return out;
+  }
+  for (++i; i < lines.size() && lines[i] != footer; ++i) {
+    if (lines[i].empty()) continue;
+    std::smatch m;
+    if (!std::regex_match(lines[i], m, member)) {
+      ADD_FAILURE() << "cannot parse the GLSL block member: " << lines[i];
+      continue;
+    }
+    out.push_back({m[1].str() + m[3].str(), m[2], 0, 0});
+  }
+  if (i == lines.size()) ADD_FAILURE() << "the GLSL block does not end with " << footer;
+  return out;
+}
+
+// std140 offsets of scalar and vector members: base alignment 4 (scalars), 8 (two components),
+// 16 (three and four), size 4 per component.
+void layoutStd140(std::vector<Member>& members) {
+  size_t at = 0;
+  for (Member& m : members) {
+    const char last = m.type.back();
+    const size_t n = (last >= '2' && last <= '4') ? size_t(last - '0') : 1;
+    const size_t align = n == 1 ? 4 : n == 2 ? 8 : 16;
+    m.offset = (at + align - 1) / align * align;
+    m.size = 4 * n;
+    at = m.offset + m.size;
+  }
+}
+
+template <class T>
+constexpr const char* glslTypeOf() {
+  if constexpr (std::is_same_v<T, float>) return "float";
+  else if constexpr (std::is_same_v<T, uint32_t>) return "uint";
+  else if constexpr (std::is_same_v<T, int32_t>) return "int";
+  else if constexpr (std::is_same_v<T, float[3]>) return "vec3";
+  else if constexpr (std::is_same_v<T, float[4]>) return "vec4";
+  else static_assert(sizeof(T) == 0, "a FieldBlock member of a type this test does not map to GLSL");
+}
+
+#define VFF_FIELD_MEMBER(m) \
+  Member { glslTypeOf<decltype(gl::FieldBlock::m)>(), #m, offsetof(gl::FieldBlock, m), sizeof(gl::FieldBlock::m) }
+
+// vff::gl::FieldBlock member by member (a member missing here fails the tiling check below).
+std::vector<Member> cppFieldBlock() {
+  static_assert(std::is_standard_layout_v<gl::FieldBlock>);
+  return {VFF_FIELD_MEMBER(sphereCenter),   VFF_FIELD_MEMBER(sphereRadius),     VFF_FIELD_MEMBER(positionScheme),
+          VFF_FIELD_MEMBER(positionParam),  VFF_FIELD_MEMBER(mapCount),         VFF_FIELD_MEMBER(directionScheme),
+          VFF_FIELD_MEMBER(mapResolution),  VFF_FIELD_MEMBER(distanceEncoding), VFF_FIELD_MEMBER(missCode),
+          VFF_FIELD_MEMBER(normalEncoding), VFF_FIELD_MEMBER(target),           VFF_FIELD_MEMBER(gutter),
+          VFF_FIELD_MEMBER(tileSize),       VFF_FIELD_MEMBER(tilesPerRow),      VFF_FIELD_MEMBER(tilesPerColumn),
+          VFF_FIELD_MEMBER(sliceWidth),     VFF_FIELD_MEMBER(sliceHeight),      VFF_FIELD_MEMBER(sliceCount),
+          VFF_FIELD_MEMBER(intraBias),      VFF_FIELD_MEMBER(distanceScale),    VFF_FIELD_MEMBER(invRadius),
+          VFF_FIELD_MEMBER(twoRadius),      VFF_FIELD_MEMBER(neighbourOffset),  VFF_FIELD_MEMBER(kernelRadius2),
+          VFF_FIELD_MEMBER(reserved0),      VFF_FIELD_MEMBER(reserved1)};
+}
+
+TEST(GlslLayout, FieldBlockMatchesTheLoaderStruct) {
+  std::vector<Member> glsl = glslBlock("layout(std140, binding = VFF_FIELD_BINDING) uniform VffFieldBlock {",
+                                       "} vffField;");
+  layoutStd140(glsl);
+  const std::vector<Member> cpp = cppFieldBlock();
+  // The listed C++ members cover FieldBlock without gaps, so none is left out of the comparison.
+  size_t end = 0;
+  for (const Member& m : cpp) {
+    EXPECT_EQ(m.offset, end) << "vff::gl::FieldBlock::" << m.name << " does not follow the member before it";
+    end = m.offset + m.size;
+  }
+  EXPECT_EQ(end, sizeof(gl::FieldBlock)) << "vff::gl::FieldBlock has members this test does not list";
+  for (size_t i = 0; i < std::max(glsl.size(), cpp.size()); ++i) {
+    if (i >= glsl.size()) {
+      ADD_FAILURE() << "VffFieldBlock lacks vff::gl::FieldBlock::" << cpp[i].name;
+      continue;
+    }
+    if (i >= cpp.size()) {
+      ADD_FAILURE() << "VffFieldBlock." << glsl[i].name << " has no vff::gl::FieldBlock member";
+      continue;
+    }
+    const Member &g = glsl[i], &c = cpp[i];
+    EXPECT_EQ(g.name, c.name) << "member " << i << " of VffFieldBlock";
+    EXPECT_EQ(g.type, c.type) << "VffFieldBlock." << g.name;
+    EXPECT_EQ(g.offset, c.offset) << "the std140 offset of VffFieldBlock." << g.name;
+    EXPECT_EQ(g.size, c.size) << "the size of VffFieldBlock." << g.name;
+  }
+  // A std140 block's size is rounded up to a vec4.
+  const size_t glslEnd = glsl.empty() ? 0 : glsl.back().offset + glsl.back().size;
+  EXPECT_EQ((glslEnd + 15) / 16 * 16, sizeof(gl::FieldBlock)) << "the std140 size of VffFieldBlock";
+}
+
+TEST(GlslLayout, PositionsBlockIsOneVec4Array) {
+  // makePositionsBuffer's floats are read four at a time: std430 vec4 array, stride 16.
+  const std::vector<Member> glsl = glslBlock(
+      "layout(std430, binding = VFF_POSITIONS_BINDING) readonly buffer VffPositionsBlock {", "};");
+  ASSERT_EQ(glsl.size(), 1u);
+  EXPECT_EQ(glsl[0].type, "vec4[]");
+  EXPECT_EQ(glsl[0].name, "vffPositions");
+}
+
+// ---- What the loader fills in, against libvff ------------------------------------------------------
+
+FieldDesc makeField(PositionScheme p, uint32_t n, DirectionScheme d, DistanceEncoding e, uint32_t m, float radius) {
+  return {.sphere = {{0.25f, -1.5f, 3.0f}, radius}, .positionScheme = p, .positionParam = n,
+          .mapCount = positionCount(p, n).value(), .directionScheme = d, .mapResolution = m, .distanceEncoding = e};
+}
+
+TEST(GlslLayout, DistanceScaleIsQuantizationStep) {
+  for (float radius : {1.0f, 1.28641f, 0.1f, 37.5f, 3.0e-3f})
+    for (DistanceEncoding e : {DistanceEncoding::kUnorm8Diameter, DistanceEncoding::kUnorm8Chord,
+                               DistanceEncoding::kUnorm16Diameter, DistanceEncoding::kBit1,
+                               DistanceEncoding::kBc4Diameter}) {
+      const FieldDesc f =
+          makeField(PositionScheme::kOctaHemi2, 4, DirectionScheme::kConcentricEqualArea, e, 32, radius);
+      auto layout = computeLayout(f, {});
+      ASSERT_TRUE(layout.ok()) << layout.error().toString();
+      auto b = gl::makeFieldBlock(f, *layout);
+      ASSERT_TRUE(b.ok()) << b.error().toString();
+      // unorm8-chord's step is per texel (the table in the positions buffer); bit1 has none.
+      const float expected =
+          e == DistanceEncoding::kUnorm8Chord ? 0.0f : quantizationStep(e, radius, 1.0f);
+      EXPECT_TRUE(sameBits(b->distanceScale, expected))
+          << distanceEncodingName(e) << " R " << radius << ": " << b->distanceScale << " vs " << expected;
+      EXPECT_EQ(b->missCode, missCode(e));
+      EXPECT_EQ(b->distanceEncoding, uint32_t(e));
+    }
+}
+
+TEST(GlslLayout, PositionsBufferHoldsLibvffValues) {
+  for (DirectionScheme d : {DirectionScheme::kConcentricEqualArea, DirectionScheme::kHemiOctahedral})
+    for (DistanceEncoding e : {DistanceEncoding::kUnorm8Chord, DistanceEncoding::kUnorm8Diameter}) {
+      const FieldDesc f = makeField(PositionScheme::kSphericalFibonacci, 100, d, e, 37, 1.28641f);
+      auto layout = computeLayout(f, {});
+      ASSERT_TRUE(layout.ok()) << layout.error().toString();
+      auto b = gl::makeFieldBlock(f, *layout);
+      auto buf = gl::makePositionsBuffer(f);
+      ASSERT_TRUE(b.ok() && buf.ok());
+      auto ps = PositionSet::fromField(f);
+      ASSERT_TRUE(ps.ok());
+      const std::vector<uint32_t> nb = queryNeighbours(*ps);
+      ASSERT_EQ(buf->size(), size_t(b->neighbourOffset) * 4 + nb.size());
+      for (uint32_t k = 0; k < f.mapCount; ++k) {
+        const Vec3 u = ps->position(k);
+        const float* p = &(*buf)[4 * size_t(k)];
+        EXPECT_TRUE(sameBits(p[0], u.x) && sameBits(p[1], u.y) && sameBits(p[2], u.z) && p[3] == 0.0f)
+            << "position " << k;
+      }
+      const uint32_t m = f.mapResolution;
+      if (e == DistanceEncoding::kUnorm8Chord) {
+        EXPECT_EQ(b->neighbourOffset, f.mapCount + (m * m + 3) / 4);
+        for (uint32_t j = 0; j < m; ++j)
+          for (uint32_t i = 0; i < m; ++i) {
+            const float cosAlpha = texelDirection(d, m, i, j).z;
+            const float step = quantizationStep(e, f.sphere.radius, cosAlpha);
+            const float got = (*buf)[size_t(f.mapCount) * 4 + size_t(j) * m + i];
+            EXPECT_TRUE(sameBits(got, step)) << "chord step of texel " << i << "," << j;
+          }
+      } else {
+        EXPECT_EQ(b->neighbourOffset, f.mapCount);
+      }
+      for (size_t i = 0; i < nb.size(); ++i) {
+        const float expected = nb[i] == UINT32_MAX ? -1.0f : float(nb[i]);
+        EXPECT_EQ((*buf)[size_t(b->neighbourOffset) * 4 + i], expected) << "neighbour list entry " << i;
+      }
+    }
+}
+
+}  // namespace
+}  // namespace vff
