@@ -80,7 +80,7 @@ struct ExrBand {
   uint64_t y0 = 0;
   const std::vector<float>* y = nullptr;     // distance
   const std::vector<float>* miss = nullptr;  // 1 miss, 0 hit
-  const std::vector<float>* rgb = nullptr;   // the normal's three channels (with normals)
+  const std::vector<float>* rgb = nullptr;   // the normal's three channels; null without normals
   bool halfNormals = false;                  // the normal parts are HALF
 };
 
@@ -89,20 +89,17 @@ struct ExrBand {
 void importMap(FieldData& d, uint32_t k, const ExrBand& band, const std::vector<float>& cosines,
                ExrReadReport* report) {
   const FieldDesc& f = d.field;
-  const LayoutDesc& l = d.layout;
   const uint32_t m = f.mapResolution;
-  const bool normals = f.normalEncoding != NormalEncoding::kNone;
-  const uint64_t dBytes = distanceMapBytes(f.distanceEncoding, m);
-  const uint64_t nBytes = normalMapBytes(f.normalEncoding, m);
-  const uint64_t y0 = band.y0;
   const std::vector<float>& y = *band.y;
   const std::vector<float>& miss = *band.miss;
   const std::vector<float>* rgb = band.rgb;
-  const TilePlacement p = placeMap(l, k);
+  const uint64_t dBytes = distanceMapBytes(f.distanceEncoding, m);
+  const uint64_t nBytes = normalMapBytes(f.normalEncoding, m);
+  const TilePlacement p = placeMap(d.layout, k);
   const std::span<uint8_t> dmap(d.distance.data() + k * dBytes, dBytes);
   for (uint32_t j = 0; j < m; ++j) {
     for (uint32_t i = 0; i < m; ++i) {
-      const uint64_t at = (uint64_t{p.y + j} - y0) * l.sliceWidth + (p.x + i);
+      const uint64_t at = (uint64_t{p.y + j} - band.y0) * d.layout.sliceWidth + (p.x + i);
       const float cosAlpha = cosines[uint64_t{j} * m + i];
       const bool hit = !(miss[at] >= 0.5f);
       const uint32_t code = encodeDistance(f.distanceEncoding, hit, y[at], f.sphere.radius, cosAlpha);
@@ -119,7 +116,7 @@ void importMap(FieldData& d, uint32_t k, const ExrBand& band, const std::vector<
         if ((code > 0 && same(code - 1)) || (code < maxHitCode(f.distanceEncoding) && same(code + 1)))
           ++report->ambiguousTexels;
       }
-      if (normals && hit) {
+      if (rgb != nullptr && hit) {
         uint8_t* out = d.normals.data() + k * nBytes + 4 * (uint64_t{j} * m + i);
         const Vec3 n{rgb[0][at], rgb[1][at], rgb[2][at]};
         if (!encodeNormalExact(n, band.halfNormals, out)) ++report->inexactNormals;
@@ -358,7 +355,7 @@ Result<FieldData> readExr(const std::string& path, ExrReadReport* report) {
         if (bandFirst >= bandEnd) continue;
         d.distance.resize(bandEnd * dBytes, 0);
         if (normals) d.normals.resize(bandEnd * nBytes, 0);
-        const ExrBand b{y0, &y, &miss, rgb, nType == Imf::HALF};
+        const ExrBand b{y0, &y, &miss, normals ? rgb : nullptr, nType == Imf::HALF};
         for (uint32_t k = static_cast<uint32_t>(bandFirst); k < bandEnd; ++k) importMap(d, k, b, cosines, report);
       }
     }

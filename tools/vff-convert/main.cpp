@@ -164,45 +164,16 @@ int toVdb(const Options& o, const FieldData& d, const char* inputKind) {
   return vff::cli::kExitSuccess;
 }
 
-// An EXR written by --to exr, with a warning for each kind of value that was not exact.
-vff::Result<FieldData> readExrInput(const Options& o) {
-  vff::convert::ExrReadReport report;
-  auto r = vff::convert::readExr(o.input, &report);
-  if (!r) return r;
-  if (report.inexactTexels)
-    std::fprintf(stderr,
-                 "%s: warning: %s: %llu hit texels do not hold an exactly decoded distance; they were "
-                 "quantised to the nearest code\n",
-                 kProg, o.input.c_str(), static_cast<unsigned long long>(report.inexactTexels));
-  if (report.ambiguousTexels)
-    std::fprintf(stderr,
-                 "%s: warning: %s: %llu hit texels are ambiguous: HALF holds the same value for "
-                 "neighbouring codes, so the codes may differ from the original (export with FLOAT)\n",
-                 kProg, o.input.c_str(), static_cast<unsigned long long>(report.ambiguousTexels));
-  if (report.inexactNormals)
-    std::fprintf(stderr, "%s: warning: %s: %llu normals are not exact oct-snorm16 values; they were quantised\n",
-                 kProg, o.input.c_str(), static_cast<unsigned long long>(report.inexactNormals));
-  return r;
-}
-
-// A .vdb written by --to vdb, with a warning for each kind of value that was not exact.
-vff::Result<FieldData> readVdbInput(const Options& o) {
-  vff::convert::VdbReadReport report;
-  auto r = vff::convert::readVdb(o.input, &report);
-  if (!r) return r;
-  if (report.inexactTexels)
-    std::fprintf(stderr,
-                 "%s: warning: %s: %llu active voxels do not hold an exactly decoded distance; they were "
-                 "quantised to the nearest code\n",
-                 kProg, o.input.c_str(), static_cast<unsigned long long>(report.inexactTexels));
-  if (report.inexactNormals)
-    std::fprintf(stderr, "%s: warning: %s: %llu normals are not exact oct-snorm16 values; they were quantised\n",
-                 kProg, o.input.c_str(), static_cast<unsigned long long>(report.inexactNormals));
-  return r;
+// "vff-convert: warning: INPUT: COUNT WHAT" when count is not 0.
+void warnCount(const Options& o, uint64_t count, const char* what) {
+  if (count)
+    std::fprintf(stderr, "%s: warning: %s: %llu %s\n", kProg, o.input.c_str(), static_cast<unsigned long long>(count),
+                 what);
 }
 
 // Reads the input, of the kind its magic number says, into *d and its kind into *kind ("vff",
-// "exr", "vdb"). Returns the exit code of a failure (an input of the output's kind is a usage error).
+// "exr", "vdb"), with a warning for each kind of value an EXR or VDB import did not find exact.
+// Returns the exit code of a failure (an input of the output's kind is a usage error).
 std::optional<int> readInput(const Options& o, FieldData* d, const char** kind) {
   const bool exr = vff::convert::looksLikeExr(o.input);
   const bool vdb = !exr && vff::convert::looksLikeVdb(o.input);
@@ -212,8 +183,21 @@ std::optional<int> readInput(const Options& o, FieldData* d, const char** kind) 
                                     ": convert it --to vff");
     return vff::cli::kExitUsage;
   }
-  auto r = exr ? readExrInput(o) : vdb ? readVdbInput(o) : loadVff(o.input);
+  vff::convert::ExrReadReport exrReport;
+  vff::convert::VdbReadReport vdbReport;
+  auto r = exr   ? vff::convert::readExr(o.input, &exrReport)
+           : vdb ? vff::convert::readVdb(o.input, &vdbReport)
+                 : loadVff(o.input);
   if (!r) return vff::cli::reportError(kProg, o.input, r.error());
+  warnCount(o, exrReport.inexactTexels,
+            "hit texels do not hold an exactly decoded distance; they were quantised to the nearest code");
+  warnCount(o, exrReport.ambiguousTexels,
+            "hit texels are ambiguous: HALF holds the same value for neighbouring codes, so the codes may "
+            "differ from the original (export with FLOAT)");
+  warnCount(o, vdbReport.inexactTexels,
+            "active voxels do not hold an exactly decoded distance; they were quantised to the nearest code");
+  warnCount(o, exrReport.inexactNormals + vdbReport.inexactNormals,
+            "normals are not exact oct-snorm16 values; they were quantised");
   *d = std::move(r).value();
   return std::nullopt;
 }
