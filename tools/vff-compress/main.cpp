@@ -11,7 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <map>
+#include <optional>
 
 #include "cli.h"
 #include "compress.h"
@@ -68,21 +68,8 @@ nlohmann::json bc4Json(const vff::compress::Bc4Report& b) {
           {"rmsErrorCodes", b.hits ? std::sqrt(b.sumSquared / double(b.hits)) : 0.0}};
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  Options o;
-  CLI::App app{
-      "Compresses a visibility field (.vff) losslessly, decompresses it, or benchmarks the codecs.\n"
-      "Compression: every block is one zstd frame (random access per block survives); distance blocks\n"
-      "of unorm8-* fields also try the hits-med filter (format 1.1: a hit mask and median-predicted\n"
-      "hit codes) and keep it where it is smaller. --decompress writes stored blocks (format 1.0), the\n"
-      "form a GPU loader uploads without decoding. Layout, metadata and maps are kept exactly; the\n"
-      "output is written through a temporary file and a rename.\n"
-      "  vff-compress in.vff out.vff\n"
-      "  vff-compress --decompress in.vff out.vff\n"
-      "  vff-compress --benchmark a.vff [b.vff ...]\n" +
-      vff::cli::exitCodeHelp()};
+// Adds every option of `o` to `app`.
+void addOptions(CLI::App& app, Options& o) {
   vff::cli::addCommonOptions(app, kProg, o.common);
   app.add_option("files", o.files, "input and output .vff (with --benchmark: the fields to measure)")->required();
   app.add_flag("-d,--decompress", o.decompress, "write stored (uncompressed, unfiltered) blocks");
@@ -107,6 +94,135 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--tmp", o.tmpDir, "benchmark: folder for the EXR files (default: the system's temporary folder)");
   app.add_flag("-q,--quiet", o.quiet, "print nothing on success");
+}
+
+// The field the output will hold, and how the input's maps become its maps.
+struct Plan {
+  vff::FieldDesc field;   // the input's, or with --bc4 the bc4-diameter one
+  bool reencode = false;  // --bc4 re-encodes the distance plane
+  bool eightBit = false;  // the output's distances are 8-bit codes (the hits-med filter applies)
+};
+
+// Checks that `in` can be rewritten as asked (known roCompatFeatures, --bc4 and --filter hits-med
+// on a field they apply to) and warns about the sections that are not copied. Returns the exit
+// code of a failure.
+std::optional<int> planRewrite(const Options& o, const std::string& input, const vff::File& in, Plan* plan) {
+  if (uint64_t unknown = in.info().roCompatFeatures & ~vff::kKnownRoCompatFeatures; unknown != 0) {
+    vff::cli::printError(kProg, input + ": roCompatFeatures " + vff::cli::hex(unknown) +
+                                    " has bits this tool does not know; such a file must not be rewritten");
+    return vff::cli::kExitUnsupported;
+  }
+  for (const vff::SectionInfo& s : in.info().sections)
+    if (!s.known && !o.quiet)
+      std::fprintf(stderr, "%s: warning: %s: unknown section '%s' is not copied\n", kProg, input.c_str(),
+                   vff::sectionTagName(s.tag).c_str());
+
+  vff::FieldDesc& field = plan->field;
+  field = in.field();
+  plan->reencode = o.bc4 && field.distanceEncoding != vff::DistanceEncoding::kBc4Diameter;
+  if (plan->reencode && field.distanceEncoding != vff::DistanceEncoding::kUnorm8Diameter) {
+    vff::cli::printError(kProg, input + ": --bc4 re-encodes unorm8-diameter codes; this field is " +
+                                    vff::distanceEncodingName(field.distanceEncoding) +
+                                    " (vff-convert --encoding bc4-diameter converts from any encoding with distances)");
+    return vff::cli::kExitUnsupported;
+  }
+  if (plan->reencode && field.mapResolution % 4 != 0) {
+    vff::cli::printError(kProg, input + ": --bc4 needs maps whose size is a multiple of 4 (4x4 blocks); this "
+                                        "field's are " + std::to_string(field.mapResolution) +
+                                        " (vff-convert --map-size makes smaller maps)");
+    return vff::cli::kExitUnsupported;
+  }
+  if (plan->reencode) field.distanceEncoding = vff::DistanceEncoding::kBc4Diameter;
+  plan->eightBit = field.distanceEncoding == vff::DistanceEncoding::kUnorm8Diameter ||
+                   field.distanceEncoding == vff::DistanceEncoding::kUnorm8Chord;
+  if (o.filter == "hits-med" && !plan->eightBit) {
+    vff::cli::printError(kProg, input + ": the hits-med filter needs an 8-bit distance encoding (unorm8-diameter or "
+                                        "unorm8-chord); this field is " +
+                                        vff::distanceEncodingName(field.distanceEncoding) + " (use --filter auto)");
+    return vff::cli::kExitUnsupported;
+  }
+  return std::nullopt;
+}
+
+// The writer's options: the input's layout limits and metadata, the codec and filter asked for;
+// with --bc4, the layout bc4-diameter needs and a provenance entry in the metadata.
+vff::Result<vff::WriteOptions> writeOptions(const Options& o, const std::string& input, const vff::File& in,
+                                            const Plan& plan) {
+  vff::WriteOptions w;
+  w.codec = o.decompress ? vff::Codec::kStored : vff::Codec::kZstd;
+  w.zstdLevel = o.level;
+  w.filter = !o.decompress && plan.eightBit && o.filter != "none" ? vff::Filter::kHitsMed : vff::Filter::kNone;
+  w.mapsPerBlock = o.mapsPerBlock;
+  w.layout.target = in.layout().target;
+  w.layout.maxTextureSize = in.layout().maxTextureSize;
+  w.layout.maxLayers = in.layout().maxLayers;
+  w.layout.gutter = in.layout().gutter;
+  w.metadataJson = std::string(in.metadata());
+  if (plan.reencode) {
+    // bc4-diameter slices are a 2D array without gutters (spec rules 7001, 7002).
+    w.layout.target = vff::LayoutTarget::kTexture2DArray;
+    w.layout.gutter = 0;
+    auto hash = vff::convert::fileXxh3(input);
+    if (!hash) return std::move(hash).error();
+    const size_t slash = input.find_last_of('/');
+    vff::convert::ResampleOptions r;
+    r.encoding = vff::DistanceEncoding::kBc4Diameter;
+    auto meta = vff::convert::appendProvenance(w.metadataJson, in.field(), plan.field, r,
+                                               slash == std::string::npos ? input : input.substr(slash + 1), *hash,
+                                               kProg);
+    if (!meta) return std::move(meta).error();
+    w.metadataJson = std::move(*meta);
+  }
+  return w;
+}
+
+// The --format json report, or the text one (not with --quiet), on stdout.
+void printReport(const Options& o, const std::string& input, const std::string& output, const vff::File& in,
+                 const vff::WriteOptions& w, const vff::compress::Report& report) {
+  if (o.common.format == vff::cli::OutputFormat::kJson) {
+    nlohmann::json j = {{"input", input},
+                        {"output", output},
+                        {"inputBytes", in.bytes().size()},
+                        {"outputBytes", report.fileBytes},
+                        {"codec", vff::codecName(w.codec)},
+                        {"filter", vff::filterName(w.filter)},
+                        {"seconds", report.seconds},
+                        {"distance", planeJson(report.planes[0])}};
+    if (report.planes[1].present) j["normal"] = planeJson(report.planes[1]);
+    if (report.bc4.done) j["bc4"] = bc4Json(report.bc4);
+    std::printf("%s\n", j.dump(2).c_str());
+  } else if (!o.quiet) {
+    std::printf("%s: %s -> %s (%s, filter %s, %.2f s)\n", output.c_str(), vff::cli::formatBytes(in.bytes().size()).c_str(),
+                vff::cli::formatBytes(report.fileBytes).c_str(), vff::codecName(w.codec),
+                w.filter == vff::Filter::kNone ? "none" : "hits-med where smaller", report.seconds);
+    printPlane("distance", report.planes[0], o.blocks);
+    if (report.planes[1].present) printPlane("normal", report.planes[1], o.blocks);
+    if (report.bc4.done) {
+      const auto& b = report.bc4;
+      std::printf("  bc4      unorm8-diameter -> bc4-diameter: %llu of %llu hits changed, max error %u codes, RMS "
+                  "%.3f codes (a code is 2R/254); every hit and miss kept\n",
+                  static_cast<unsigned long long>(b.changed), static_cast<unsigned long long>(b.hits), b.maxError,
+                  b.hits ? std::sqrt(b.sumSquared / double(b.hits)) : 0.0);
+    }
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  CLI::App app{
+      "Compresses a visibility field (.vff) losslessly, decompresses it, or benchmarks the codecs.\n"
+      "Compression: every block is one zstd frame (random access per block survives); distance blocks\n"
+      "of unorm8-* fields also try the hits-med filter (format 1.1: a hit mask and median-predicted\n"
+      "hit codes) and keep it where it is smaller. --decompress writes stored blocks (format 1.0), the\n"
+      "form a GPU loader uploads without decoding. Layout, metadata and maps are kept exactly; the\n"
+      "output is written through a temporary file and a rename.\n"
+      "  vff-compress in.vff out.vff\n"
+      "  vff-compress --decompress in.vff out.vff\n"
+      "  vff-compress --benchmark a.vff [b.vff ...]\n" +
+      vff::cli::exitCodeHelp()};
+  addOptions(app, o);
   if (auto rc = vff::cli::parse(app, kProg, argc, argv)) return *rc;
 
   if (o.benchmark) {
@@ -130,93 +246,13 @@ int main(int argc, char** argv) {
 
   auto in = vff::File::open(input);
   if (!in) return vff::cli::reportError(kProg, input, in.error());
-  if (uint64_t unknown = in->info().roCompatFeatures & ~vff::kKnownRoCompatFeatures; unknown != 0) {
-    vff::cli::printError(kProg, input + ": roCompatFeatures " + vff::cli::hex(unknown) +
-                                    " has bits this tool does not know; such a file must not be rewritten");
-    return vff::cli::kExitUnsupported;
-  }
-  for (const vff::SectionInfo& s : in->info().sections)
-    if (!s.known && !o.quiet)
-      std::fprintf(stderr, "%s: warning: %s: unknown section '%s' is not copied\n", kProg, input.c_str(),
-                   vff::sectionTagName(s.tag).c_str());
-
-  vff::FieldDesc field = in->field();
-  const bool reencode = o.bc4 && field.distanceEncoding != vff::DistanceEncoding::kBc4Diameter;
-  if (reencode && field.distanceEncoding != vff::DistanceEncoding::kUnorm8Diameter) {
-    vff::cli::printError(kProg, input + ": --bc4 re-encodes unorm8-diameter codes; this field is " +
-                                    vff::distanceEncodingName(field.distanceEncoding) +
-                                    " (vff-convert --encoding bc4-diameter converts from any encoding with distances)");
-    return vff::cli::kExitUnsupported;
-  }
-  if (reencode && field.mapResolution % 4 != 0) {
-    vff::cli::printError(kProg, input + ": --bc4 needs maps whose size is a multiple of 4 (4x4 blocks); this "
-                                        "field's are " + std::to_string(field.mapResolution) +
-                                        " (vff-convert --map-size makes smaller maps)");
-    return vff::cli::kExitUnsupported;
-  }
-  if (reencode) field.distanceEncoding = vff::DistanceEncoding::kBc4Diameter;
-  const bool eightBit = field.distanceEncoding == vff::DistanceEncoding::kUnorm8Diameter ||
-                        field.distanceEncoding == vff::DistanceEncoding::kUnorm8Chord;
-  if (o.filter == "hits-med" && !eightBit) {
-    vff::cli::printError(kProg, input + ": the hits-med filter needs an 8-bit distance encoding (unorm8-diameter or "
-                                        "unorm8-chord); this field is " +
-                                        vff::distanceEncodingName(field.distanceEncoding) + " (use --filter auto)");
-    return vff::cli::kExitUnsupported;
-  }
-  vff::WriteOptions w;
-  w.codec = o.decompress ? vff::Codec::kStored : vff::Codec::kZstd;
-  w.zstdLevel = o.level;
-  w.filter = !o.decompress && eightBit && o.filter != "none" ? vff::Filter::kHitsMed : vff::Filter::kNone;
-  w.mapsPerBlock = o.mapsPerBlock;
-  w.layout.target = in->layout().target;
-  w.layout.maxTextureSize = in->layout().maxTextureSize;
-  w.layout.maxLayers = in->layout().maxLayers;
-  w.layout.gutter = in->layout().gutter;
-  w.metadataJson = std::string(in->metadata());
-  if (reencode) {
-    // bc4-diameter slices are a 2D array without gutters (spec rules 7001, 7002).
-    w.layout.target = vff::LayoutTarget::kTexture2DArray;
-    w.layout.gutter = 0;
-    auto hash = vff::convert::fileXxh3(input);
-    if (!hash) return vff::cli::reportError(kProg, input, hash.error());
-    const size_t slash = input.find_last_of('/');
-    vff::convert::ResampleOptions r;
-    r.encoding = vff::DistanceEncoding::kBc4Diameter;
-    auto meta = vff::convert::appendProvenance(w.metadataJson, in->field(), field, r,
-                                               slash == std::string::npos ? input : input.substr(slash + 1), *hash,
-                                               kProg);
-    if (!meta) return vff::cli::reportError(kProg, input, meta.error());
-    w.metadataJson = std::move(*meta);
-  }
-
+  Plan plan;
+  if (auto rc = planRewrite(o, input, *in, &plan)) return *rc;
+  auto w = writeOptions(o, input, *in, plan);
+  if (!w) return vff::cli::reportError(kProg, input, w.error());
   vff::compress::Report report;
-  if (vff::Status st = vff::compress::rewrite(*in, output, field, w, reencode, &report); !st)
+  if (vff::Status st = vff::compress::rewrite(*in, output, plan.field, *w, plan.reencode, &report); !st)
     return vff::cli::reportError(kProg, st.error().code == vff::Code::kIoWrite ? output : input, st.error());
-  if (o.common.format == vff::cli::OutputFormat::kJson) {
-    nlohmann::json j = {{"input", input},
-                        {"output", output},
-                        {"inputBytes", in->bytes().size()},
-                        {"outputBytes", report.fileBytes},
-                        {"codec", vff::codecName(w.codec)},
-                        {"filter", vff::filterName(w.filter)},
-                        {"seconds", report.seconds},
-                        {"distance", planeJson(report.planes[0])}};
-    if (report.planes[1].present) j["normal"] = planeJson(report.planes[1]);
-    if (report.bc4.done) j["bc4"] = bc4Json(report.bc4);
-    std::printf("%s\n", j.dump(2).c_str());
-  } else if (!o.quiet) {
-    std::printf("%s: %s -> %s (%s, filter %s, %.2f s)\n", output.c_str(), vff::cli::formatBytes(in->bytes().size()).c_str(),
-                vff::cli::formatBytes(report.fileBytes).c_str(), vff::codecName(w.codec),
-                w.filter == vff::Filter::kNone ? "none" : "hits-med where smaller", report.seconds);
-    printPlane("distance", report.planes[0], o.blocks);
-    if (report.planes[1].present) printPlane("normal", report.planes[1], o.blocks);
-    if (report.bc4.done) {
-      const auto& b = report.bc4;
-      std::printf("  bc4      unorm8-diameter -> bc4-diameter: %llu of %llu hits changed, max error %u codes, RMS "
-                  "%.3f codes (a code is 2R/254); every hit and miss kept\n",
-                  static_cast<unsigned long long>(b.changed), static_cast<unsigned long long>(b.hits), b.maxError,
-                  b.hits ? std::sqrt(b.sumSquared / double(b.hits)) : 0.0);
-    }
-  }
+  printReport(o, input, output, *in, *w, report);
   return vff::cli::kExitSuccess;
 }

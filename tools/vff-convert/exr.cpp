@@ -75,6 +75,56 @@ class TempFile {
   int errno_ = 0;
 };
 
+// The pixels of one band of a slice as read: rows y0.. of the slice, sliceWidth floats a row.
+struct ExrBand {
+  uint64_t y0 = 0;
+  const std::vector<float>* y = nullptr;     // distance
+  const std::vector<float>* miss = nullptr;  // 1 miss, 0 hit
+  const std::vector<float>* rgb = nullptr;   // the normal's three channels; null without normals
+  bool halfNormals = false;                  // the normal parts are HALF
+};
+
+// Encodes map k, whose tile lies in `band`, into d's planes (already sized for it), counting in
+// `report` the values that were not exact.
+void importMap(FieldData& d, uint32_t k, const ExrBand& band, const std::vector<float>& cosines,
+               ExrReadReport* report) {
+  const FieldDesc& f = d.field;
+  const uint32_t m = f.mapResolution;
+  const std::vector<float>& y = *band.y;
+  const std::vector<float>& miss = *band.miss;
+  const std::vector<float>* rgb = band.rgb;
+  const uint64_t dBytes = distanceMapBytes(f.distanceEncoding, m);
+  const uint64_t nBytes = normalMapBytes(f.normalEncoding, m);
+  const TilePlacement p = placeMap(d.layout, k);
+  const std::span<uint8_t> dmap(d.distance.data() + k * dBytes, dBytes);
+  for (uint32_t j = 0; j < m; ++j) {
+    for (uint32_t i = 0; i < m; ++i) {
+      const uint64_t at = (uint64_t{p.y + j} - band.y0) * d.layout.sliceWidth + (p.x + i);
+      const float cosAlpha = cosines[uint64_t{j} * m + i];
+      const bool hit = !(miss[at] >= 0.5f);
+      const uint32_t code = encodeDistance(f.distanceEncoding, hit, y[at], f.sphere.radius, cosAlpha);
+      storeCode(f.distanceEncoding, dmap, m, i, j, code);
+      const Texel back = decodeDistance(f.distanceEncoding, code, f.sphere.radius, cosAlpha);
+      if (hit && roundToType(back.distance, report->half) != y[at]) {
+        ++report->inexactTexels;
+      } else if (hit && report->half && f.distanceEncoding != DistanceEncoding::kBit1) {
+        // A neighbouring code that HALF stores as the same value makes the texel ambiguous.
+        const auto same = [&](uint32_t c) {
+          return roundToType(decodeDistance(f.distanceEncoding, c, f.sphere.radius, cosAlpha).distance, true) ==
+                 y[at];
+        };
+        if ((code > 0 && same(code - 1)) || (code < maxHitCode(f.distanceEncoding) && same(code + 1)))
+          ++report->ambiguousTexels;
+      }
+      if (rgb != nullptr && hit) {
+        uint8_t* out = d.normals.data() + k * nBytes + 4 * (uint64_t{j} * m + i);
+        const Vec3 n{rgb[0][at], rgb[1][at], rgb[2][at]};
+        if (!encodeNormalExact(n, band.halfNormals, out)) ++report->inexactNormals;
+      }
+    }
+  }
+}
+
 }  // namespace
 
 bool looksLikeExr(const std::string& path) {
@@ -305,36 +355,8 @@ Result<FieldData> readExr(const std::string& path, ExrReadReport* report) {
         if (bandFirst >= bandEnd) continue;
         d.distance.resize(bandEnd * dBytes, 0);
         if (normals) d.normals.resize(bandEnd * nBytes, 0);
-        for (uint32_t k = static_cast<uint32_t>(bandFirst); k < bandEnd; ++k) {
-          const TilePlacement p = placeMap(l, k);
-          const std::span<uint8_t> dmap(d.distance.data() + k * dBytes, dBytes);
-          for (uint32_t j = 0; j < m; ++j) {
-            for (uint32_t i = 0; i < m; ++i) {
-              const uint64_t at = (uint64_t{p.y + j} - y0) * l.sliceWidth + (p.x + i);
-              const float cosAlpha = cosines[uint64_t{j} * m + i];
-              const bool hit = !(miss[at] >= 0.5f);
-              const uint32_t code = encodeDistance(f.distanceEncoding, hit, y[at], f.sphere.radius, cosAlpha);
-              storeCode(f.distanceEncoding, dmap, m, i, j, code);
-              const Texel back = decodeDistance(f.distanceEncoding, code, f.sphere.radius, cosAlpha);
-              if (hit && roundToType(back.distance, report->half) != y[at]) {
-                ++report->inexactTexels;
-              } else if (hit && report->half && f.distanceEncoding != DistanceEncoding::kBit1) {
-                // A neighbouring code that HALF stores as the same value makes the texel ambiguous.
-                const auto same = [&](uint32_t c) {
-                  return roundToType(decodeDistance(f.distanceEncoding, c, f.sphere.radius, cosAlpha).distance, true) ==
-                         y[at];
-                };
-                if ((code > 0 && same(code - 1)) || (code < maxHitCode(f.distanceEncoding) && same(code + 1)))
-                  ++report->ambiguousTexels;
-              }
-              if (normals && hit) {
-                uint8_t* out = d.normals.data() + k * nBytes + 4 * (uint64_t{j} * m + i);
-                const Vec3 n{rgb[0][at], rgb[1][at], rgb[2][at]};
-                if (!encodeNormalExact(n, nType == Imf::HALF, out)) ++report->inexactNormals;
-              }
-            }
-          }
-        }
+        const ExrBand b{y0, &y, &miss, normals ? rgb : nullptr, nType == Imf::HALF};
+        for (uint32_t k = static_cast<uint32_t>(bandFirst); k < bandEnd; ++k) importMap(d, k, b, cosines, report);
       }
     }
     if (d.distance.size() != uint64_t{f.mapCount} * dBytes)  // the layout places every map (checked by its parser)

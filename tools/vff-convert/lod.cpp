@@ -137,6 +137,90 @@ Value combine(const std::vector<Value>& plane, uint32_t m, uint32_t f, uint32_t 
   return out;
 }
 
+// The converted field `nf` of `src` before its maps are computed: its layout, metadata, codec and
+// G, and its planes allocated (zero).
+Result<FieldData> newField(const FieldData& src, const FieldDesc& nf, const ResampleReport& r) {
+  FieldData out;
+  out.field = nf;
+  out.layout = src.layout;
+  if (nf.distanceEncoding == DistanceEncoding::kBit1) out.layout.gutter = 0;  // bit1 tiles have no gutters
+  if (nf.distanceEncoding == DistanceEncoding::kBc4Diameter) {  // nor bc4 tiles, which only 2D arrays hold
+    out.layout.gutter = 0;
+    out.layout.target = LayoutTarget::kTexture2DArray;
+  }
+  out.metadata = src.metadata;
+  out.codec = src.codec;
+  // The source's G fits the source's maps; new maps get the writer's automatic G.
+  out.mapsPerBlock = (r.positionsChanged || r.mapSizeChanged || r.encodingChanged) ? 0 : src.mapsPerBlock;
+  try {
+    out.distance.assign(size_t(nf.mapCount) * distanceMapBytes(nf.distanceEncoding, nf.mapResolution), 0);
+    if (!src.normals.empty())
+      out.normals.assign(size_t(nf.mapCount) * normalMapBytes(nf.normalEncoding, nf.mapResolution), 0);
+  } catch (const std::bad_alloc&) {
+    return makeError(Code::kOutOfMemory, "cannot allocate the new field's maps");
+  }
+  return out;
+}
+
+// The error of a map fitted to BC4 blocks (`map`, bc4-diameter) against the distances before
+// encoding (`exact`, -1 for a miss), accounted in `stats`.
+void accountBc4Errors(const FieldDesc& nf, std::span<const uint8_t> map, const std::vector<float>& exact,
+                      EncodeStats* stats) {
+  const uint32_t nm = nf.mapResolution;
+  const float radius = nf.sphere.radius;
+  const float step = quantizationStep(nf.distanceEncoding, radius, 1.0f);
+  for (uint32_t j = 0; j < nm; ++j)
+    for (uint32_t i = 0; i < nm; ++i) {
+      const float want = exact[size_t(j) * nm + i];
+      if (want < 0) continue;  // a miss, and the blocks keep it one
+      ++stats->hits;
+      const Texel x = decodeDistance(nf.distanceEncoding, loadCode(nf.distanceEncoding, map, nm, i, j), radius, 1.0f);
+      const float scale = 2.0f * radius;
+      if (want > scale) {  // beyond the sphere's diameter: the largest code
+        ++stats->clamped;
+        stats->maxClampRadii = std::max(stats->maxClampRadii, std::fabs(double(x.distance) - want) / double(radius));
+        continue;
+      }
+      accountError(stats, std::fabs(double(x.distance) - double(want)), step, radius);
+    }
+}
+
+// The hit texels of the source's distance plane, into r->sourceHits.
+void countSourceHits(const FieldData& src, ResampleReport* r) {
+  const FieldDesc& sf = src.field;
+  const uint32_t m = sf.mapResolution;
+  const uint64_t sBytes = distanceMapBytes(sf.distanceEncoding, m);
+  for (uint32_t k = 0; k < sf.mapCount; ++k)
+    for (uint32_t j = 0; j < m; ++j)
+      for (uint32_t i = 0; i < m; ++i)
+        r->sourceHits += loadCode(sf.distanceEncoding, {src.distance.data() + size_t(k) * sBytes, sBytes}, m, i, j) !=
+                         missCode(sf.distanceEncoding);
+}
+
+// For a pure re-encoding (no position or map-size change, not to bit1): how many new codes do not
+// give the source code back when decoded and encoded again (r->notReversible).
+void checkReversible(const FieldData& src, const FieldData& out, const std::vector<Vec3>& srcDirs,
+                     ResampleReport* r) {
+  const FieldDesc& sf = src.field;
+  const FieldDesc& nf = out.field;
+  const uint32_t m = sf.mapResolution;
+  const float radius = sf.sphere.radius;
+  const uint64_t sBytes = distanceMapBytes(sf.distanceEncoding, m);
+  const uint64_t nBytes = distanceMapBytes(nf.distanceEncoding, nf.mapResolution);
+  if (r->encodingChanged && !r->positionsChanged && !r->mapSizeChanged && nf.distanceEncoding != DistanceEncoding::kBit1) {
+    r->reverseChecked = true;
+    for (uint32_t k = 0; k < sf.mapCount; ++k)
+      for (uint32_t j = 0; j < m; ++j)
+        for (uint32_t i = 0; i < m; ++i) {
+          const size_t t = size_t(j) * m + i;
+          const uint32_t c = loadCode(sf.distanceEncoding, {src.distance.data() + size_t(k) * sBytes, sBytes}, m, i, j);
+          const uint32_t n = loadCode(nf.distanceEncoding, {out.distance.data() + size_t(k) * nBytes, nBytes}, m, i, j);
+          const Texel x = decodeDistance(nf.distanceEncoding, n, radius, srcDirs[t].z);
+          r->notReversible += encodeDistance(sf.distanceEncoding, x.hit, x.distance, radius, srcDirs[t].z) != c;
+        }
+  }
+}
+
 }  // namespace
 
 Result<FieldDesc> planResample(const FieldDesc& source, const ResampleOptions& o) {
@@ -205,30 +289,14 @@ Result<FieldData> resampleField(const FieldData& src, const ResampleOptions& o, 
 
   const uint32_t m = sf.mapResolution, nm = nf.mapResolution, f = r.factor;
   const float radius = sf.sphere.radius;
-  const uint64_t sBytes = distanceMapBytes(sf.distanceEncoding, m);
   const uint64_t nBytes = distanceMapBytes(nf.distanceEncoding, nm);
   const uint64_t nNormBytes = normalMapBytes(nf.normalEncoding, nm);
   const bool normals = !src.normals.empty();
 
-  FieldData out;
-  out.field = nf;
-  out.layout = src.layout;
-  if (nf.distanceEncoding == DistanceEncoding::kBit1) out.layout.gutter = 0;  // bit1 tiles have no gutters
-  if (nf.distanceEncoding == DistanceEncoding::kBc4Diameter) {  // nor bc4 tiles, which only 2D arrays hold
-    out.layout.gutter = 0;
-    out.layout.target = LayoutTarget::kTexture2DArray;
-  }
+  auto made = newField(src, nf, r);
+  if (!made) return std::move(made).error();
+  FieldData& out = *made;
   const bool bc4 = nf.distanceEncoding == DistanceEncoding::kBc4Diameter;
-  out.metadata = src.metadata;
-  out.codec = src.codec;
-  // The source's G fits the source's maps; new maps get the writer's automatic G.
-  out.mapsPerBlock = (r.positionsChanged || r.mapSizeChanged || r.encodingChanged) ? 0 : src.mapsPerBlock;
-  try {
-    out.distance.assign(size_t(nf.mapCount) * nBytes, 0);
-    if (normals) out.normals.assign(size_t(nf.mapCount) * nNormBytes, 0);
-  } catch (const std::bad_alloc&) {
-    return makeError(Code::kOutOfMemory, "cannot allocate the new field's maps");
-  }
 
   std::vector<Vec3> srcDirs(size_t(m) * m), newDirs(size_t(nm) * nm);
   for (uint32_t j = 0; j < m; ++j)
@@ -319,21 +387,7 @@ Result<FieldData> resampleField(const FieldData& src, const ResampleOptions& o, 
       }
     if (!bc4) return;
     encodeBc4Map(codes, nm, {map, nBytes});
-    const float step = quantizationStep(nf.distanceEncoding, radius, 1.0f);
-    for (uint32_t j = 0; j < nm; ++j)
-      for (uint32_t i = 0; i < nm; ++i) {
-        const float want = exact[size_t(j) * nm + i];
-        if (want < 0) continue;  // a miss, and the blocks keep it one
-        ++stats.hits;
-        const Texel x = decodeDistance(nf.distanceEncoding, loadCode(nf.distanceEncoding, {map, nBytes}, nm, i, j), radius, 1.0f);
-        const float scale = 2.0f * radius;
-        if (want > scale) {  // beyond the sphere's diameter: the largest code
-          ++stats.clamped;
-          stats.maxClampRadii = std::max(stats.maxClampRadii, std::fabs(double(x.distance) - want) / double(radius));
-          continue;
-        }
-        accountError(&stats, std::fabs(double(x.distance) - double(want)), step, radius);
-      }
+    accountBc4Errors(nf, {map, nBytes}, exact, &stats);
   };
 
   unsigned threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
@@ -361,23 +415,8 @@ Result<FieldData> resampleField(const FieldData& src, const ResampleOptions& o, 
   r.rmsErrorSteps = all.hits > all.clamped ? std::sqrt(all.sumSquaredSteps / double(all.hits - all.clamped)) : 0.0;
   r.clamped = all.clamped;
   r.maxClampRadii = all.maxClampRadii;
-  for (uint32_t k = 0; k < sf.mapCount; ++k)
-    for (uint32_t j = 0; j < m; ++j)
-      for (uint32_t i = 0; i < m; ++i)
-        r.sourceHits += loadCode(sf.distanceEncoding, {src.distance.data() + size_t(k) * sBytes, sBytes}, m, i, j) !=
-                        missCode(sf.distanceEncoding);
-  if (r.encodingChanged && !r.positionsChanged && !r.mapSizeChanged && nf.distanceEncoding != DistanceEncoding::kBit1) {
-    r.reverseChecked = true;
-    for (uint32_t k = 0; k < sf.mapCount; ++k)
-      for (uint32_t j = 0; j < m; ++j)
-        for (uint32_t i = 0; i < m; ++i) {
-          const size_t t = size_t(j) * m + i;
-          const uint32_t c = loadCode(sf.distanceEncoding, {src.distance.data() + size_t(k) * sBytes, sBytes}, m, i, j);
-          const uint32_t n = loadCode(nf.distanceEncoding, {out.distance.data() + size_t(k) * nBytes, nBytes}, m, i, j);
-          const Texel x = decodeDistance(nf.distanceEncoding, n, radius, srcDirs[t].z);
-          r.notReversible += encodeDistance(sf.distanceEncoding, x.hit, x.distance, radius, srcDirs[t].z) != c;
-        }
-  }
+  countSourceHits(src, &r);
+  checkReversible(src, out, srcDirs, &r);
   if (report) *report = r;
   return out;
 }

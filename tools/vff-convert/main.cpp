@@ -6,18 +6,19 @@
 //   vff-convert a.vff --to vff b.vff --encoding unorm8-diameter --map-size 32 --count 16   re-encode, LOD
 //   vff-convert field.vff --to vdb field.vdb            packed slices as OpenVDB grids (vdb.h), and back
 //
-// The input's kind is found by its magic number, the output's by --to (or its extension).
+// The input's kind is found by its magic number, the output's by --to (or its extension). The
+// command line is convert_options.cpp; here: read the input, change the maps, write the output.
 #include <OpenEXR/ImfThreading.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
-#include <map>
 #include <optional>
 #include <thread>
 
 #include "cli.h"
 #include "convert.h"
+#include "convert_options.h"
 #include "resample.h"
 #include "vdb.h"
 #include "vff/vff.h"
@@ -25,49 +26,8 @@
 namespace {
 
 using vff::convert::FieldData;
-
-const char* kProg = "vff-convert";
-
-struct Options {
-  std::string input, output, to;
-  bool half = false;
-  bool quiet = false;
-  std::optional<std::string> target;
-  std::optional<uint32_t> maxTextureSize, maxLayers, gutter, mapsPerBlock;
-  std::optional<std::string> codec;
-  int zstdLevel = 19;
-  unsigned threads = 0;
-  // Conversions that change the maps (resample.h).
-  std::optional<std::string> encoding, positions, downsample, resample;
-  std::optional<uint32_t> mapSize, count;
-};
-
-const std::map<std::string, vff::Codec> kCodecs = {{"stored", vff::Codec::kStored}, {"zstd", vff::Codec::kZstd}};
-const std::map<std::string, vff::LayoutTarget> kTargets = {{"2d-array", vff::LayoutTarget::kTexture2DArray},
-                                                           {"3d", vff::LayoutTarget::kTexture3D}};
-
-const std::map<std::string, vff::DistanceEncoding> kEncodings = {
-    {"unorm8-diameter", vff::DistanceEncoding::kUnorm8Diameter},
-    {"unorm8-chord", vff::DistanceEncoding::kUnorm8Chord},
-    {"unorm16-diameter", vff::DistanceEncoding::kUnorm16Diameter},
-    {"bit1", vff::DistanceEncoding::kBit1},
-    {"bc4-diameter", vff::DistanceEncoding::kBc4Diameter}};
-const std::map<std::string, vff::PositionScheme> kPositions = {
-    {"octa-hemi2", vff::PositionScheme::kOctaHemi2},
-    {"ea-octa-grid", vff::PositionScheme::kEqualAreaOctaGrid},
-    {"fibonacci", vff::PositionScheme::kSphericalFibonacci}};
-const std::map<std::string, vff::convert::DownsampleRule> kRules = {
-    {"min", vff::convert::DownsampleRule::kMin},
-    {"majority", vff::convert::DownsampleRule::kMajority},
-    {"centre", vff::convert::DownsampleRule::kCentre},
-    {"tent", vff::convert::DownsampleRule::kTent}};
-const std::map<std::string, vff::convert::PositionResample> kResamples = {
-    {"nearest", vff::convert::PositionResample::kNearest},
-    {"interpolated", vff::convert::PositionResample::kInterpolated}};
-
-bool endsWith(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
+using vff::convert::kProg;
+using vff::convert::Options;
 
 // Reads a whole .vff into memory, with what is needed to write it again as it was.
 vff::Result<FieldData> loadVff(const std::string& path) {
@@ -106,14 +66,11 @@ vff::Result<FieldData> loadVff(const std::string& path) {
 // Writes a .vff: the source's layout limits, codec and G unless the command line overrides them.
 int saveVff(const Options& o, const FieldData& d) {
   vff::WriteOptions w;
-  w.codec = o.codec ? kCodecs.at(*o.codec) : d.codec;
-  w.zstdLevel = o.zstdLevel;
+  w.codec = o.codec.codec.ifGiven().value_or(d.codec);
+  w.zstdLevel = o.codec.zstdLevel;
   // The source's G is kept only with the source's codec: a new codec re-picks it unless given.
-  w.mapsPerBlock = o.mapsPerBlock ? *o.mapsPerBlock : (w.codec == d.codec ? d.mapsPerBlock : 0);
-  w.layout.target = o.target ? kTargets.at(*o.target) : d.layout.target;
-  w.layout.maxTextureSize = o.maxTextureSize.value_or(d.layout.maxTextureSize);
-  w.layout.maxLayers = o.maxLayers.value_or(d.layout.maxLayers);
-  w.layout.gutter = o.gutter.value_or(d.layout.gutter);
+  w.mapsPerBlock = o.codec.mapsPerBlockGiven() ? o.codec.mapsPerBlock : (w.codec == d.codec ? d.mapsPerBlock : 0);
+  w.layout = o.layout.limits({d.layout.target, d.layout.maxTextureSize, d.layout.maxLayers, d.layout.gutter});
   w.metadataJson = d.metadata;
   // A field that does not fit the requested limits is a command-line problem: exit 1, naming the limit.
   auto layout = vff::computeLayout(d.field, w.layout);
@@ -140,12 +97,12 @@ int saveVff(const Options& o, const FieldData& d) {
 // appended to META. Returns an exit code; *d becomes the converted field.
 int resampleMaps(const Options& o, FieldData* d) {
   vff::convert::ResampleOptions r;
-  if (o.encoding) r.encoding = kEncodings.at(*o.encoding);
-  if (o.positions) r.positionScheme = kPositions.at(*o.positions);
+  r.encoding = o.encoding.ifGiven();
+  r.positionScheme = o.positions.ifGiven();
   r.positionParam = o.count.value_or(0);
   r.mapResolution = o.mapSize.value_or(0);
-  if (o.downsample) r.downsample = kRules.at(*o.downsample);
-  if (o.resample) r.resample = kResamples.at(*o.resample);
+  if (o.downsample.given()) r.downsample = o.downsample.value();
+  if (o.resample.given()) r.resample = o.resample.value();
   r.threads = o.threads;
   vff::convert::ResampleReport report;
   auto out = vff::convert::resampleField(*d, r, &report);
@@ -207,6 +164,44 @@ int toVdb(const Options& o, const FieldData& d, const char* inputKind) {
   return vff::cli::kExitSuccess;
 }
 
+// "vff-convert: warning: INPUT: COUNT WHAT" when count is not 0.
+void warnCount(const Options& o, uint64_t count, const char* what) {
+  if (count)
+    std::fprintf(stderr, "%s: warning: %s: %llu %s\n", kProg, o.input.c_str(), static_cast<unsigned long long>(count),
+                 what);
+}
+
+// Reads the input, of the kind its magic number says, into *d and its kind into *kind ("vff",
+// "exr", "vdb"), with a warning for each kind of value an EXR or VDB import did not find exact.
+// Returns the exit code of a failure (an input of the output's kind is a usage error).
+std::optional<int> readInput(const Options& o, FieldData* d, const char** kind) {
+  const bool exr = vff::convert::looksLikeExr(o.input);
+  const bool vdb = !exr && vff::convert::looksLikeVdb(o.input);
+  *kind = exr ? "exr" : vdb ? "vdb" : "vff";
+  if ((exr || vdb) && o.to == *kind) {
+    vff::cli::usageError(kProg, o.input + (exr ? " is already an EXR file" : " is already an OpenVDB file") +
+                                    ": convert it --to vff");
+    return vff::cli::kExitUsage;
+  }
+  vff::convert::ExrReadReport exrReport;
+  vff::convert::VdbReadReport vdbReport;
+  auto r = exr   ? vff::convert::readExr(o.input, &exrReport)
+           : vdb ? vff::convert::readVdb(o.input, &vdbReport)
+                 : loadVff(o.input);
+  if (!r) return vff::cli::reportError(kProg, o.input, r.error());
+  warnCount(o, exrReport.inexactTexels,
+            "hit texels do not hold an exactly decoded distance; they were quantised to the nearest code");
+  warnCount(o, exrReport.ambiguousTexels,
+            "hit texels are ambiguous: HALF holds the same value for neighbouring codes, so the codes may "
+            "differ from the original (export with FLOAT)");
+  warnCount(o, vdbReport.inexactTexels,
+            "active voxels do not hold an exactly decoded distance; they were quantised to the nearest code");
+  warnCount(o, exrReport.inexactNormals + vdbReport.inexactNormals,
+            "normals are not exact oct-snorm16 values; they were quantised");
+  *d = std::move(r).value();
+  return std::nullopt;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -224,85 +219,10 @@ int main(int argc, char** argv) {
       "Outputs are written through a temporary file and a rename: a failure leaves no partial file.\n" +
       vff::cli::exitCodeHelp()};
   vff::cli::addVersionFlag(app, kProg);
-  app.add_option("input", o.input, "input .vff, .exr or .vdb (kind found by its magic number)")->required();
-  app.add_option("output", o.output, "output file")->required();
-  app.add_option("--to", o.to, "output kind (default: from the output's extension)")
-      ->check(CLI::IsMember({"exr", "vff", "vdb"}));
-  app.add_flag("--half", o.half, "EXR: HALF channels instead of FLOAT (lossy for unorm16-diameter and normals)");
-  app.add_option("--target", o.target, "vff: GPU texture target of the packed layout (default: the input's)")
-      ->check(CLI::IsMember({"2d-array", "3d"}));
-  app.add_option("--max-texture-size", o.maxTextureSize, "vff: largest slice width/height (default: the input's)")
-      ->check(CLI::PositiveNumber);
-  app.add_option("--max-layers", o.maxLayers, "vff: most array layers or 3D depth (default: the input's)")
-      ->check(CLI::PositiveNumber);
-  app.add_option("--gutter", o.gutter, "vff: texels of edge replication around each tile (default: the input's)")
-      ->check(CLI::Range(0u, 64u));
-  app.add_option("--codec", o.codec, "vff: block codec (default: the input's)")
-      ->check(CLI::IsMember({"stored", "zstd"}));
-  app.add_option("--zstd-level", o.zstdLevel, "vff: zstd level")->check(CLI::Range(1, 22))->capture_default_str();
-  app.add_option("--maps-per-block", o.mapsPerBlock,
-                 "vff: maps per block (0: about 256 KiB per block; default: the input's)");
-  app.add_option("-j,--threads", o.threads,
-                 "threads for EXR compression and for re-encoding / LOD (0: all cores); the output does not "
-                 "depend on it")
-      ->capture_default_str();
-  app.add_option("--encoding", o.encoding,
-                 "vff: re-encode the distances (prints the largest and RMS error in steps of the new encoding; "
-                 "bc4-diameter: lossy GPU block compression, half the size of unorm8; "
-                 "from bit1: exit 5)")
-      ->check(CLI::IsMember({"unorm8-diameter", "unorm8-chord", "unorm16-diameter", "bit1", "bc4-diameter"}));
-  app.add_option("--map-size", o.mapSize, "vff: smaller maps M' (must divide the source's M; bit1: a multiple of 8)")
-      ->check(CLI::PositiveNumber);
-  app.add_option("--downsample", o.downsample,
-                 "vff, with --map-size: how source texels combine into a new texel: tent (within one new texel "
-                 "of its centre, tent-weighted; default), majority (those under it: hit if half hit, mean distance), "
-                 "centre (the middle one or 2x2), min (hit if any hits, smallest distance)")
-      ->check(CLI::IsMember({"min", "majority", "centre", "tent"}));
-  app.add_option("--positions", o.positions, "vff: resample to another positional-sample scheme")
-      ->check(CLI::IsMember({"octa-hemi2", "ea-octa-grid", "fibonacci"}));
-  app.add_option("--count", o.count,
-                 "vff: the new scheme parameter n, as vff-bake's --count (octa-hemi2 n: 2(2n^2+2n+1) maps)")
-      ->check(CLI::PositiveNumber);
-  app.add_option("--resample", o.resample,
-                 "vff, with --positions/--count: nearest (nearest source sample, reprojected; default) or "
-                 "interpolated (FieldQuery's blend of the neighbouring samples)")
-      ->check(CLI::IsMember({"nearest", "interpolated"}));
-  app.add_flag("-q,--quiet", o.quiet, "print nothing on success");
+  addOptions(app, o);
   if (auto rc = vff::cli::parse(app, kProg, argc, argv)) return *rc;
-
-  if (o.to.empty()) {
-    if (endsWith(o.output, ".exr"))
-      o.to = "exr";
-    else if (endsWith(o.output, ".vff"))
-      o.to = "vff";
-    else if (endsWith(o.output, ".vdb"))
-      o.to = "vdb";
-    else {
-      vff::cli::usageError(kProg, "cannot tell the output kind from \"" + o.output + "\": give --to exr|vff|vdb");
-      return vff::cli::kExitUsage;
-    }
-  }
-  const bool layoutOptions = o.target || o.maxTextureSize || o.maxLayers || o.gutter || o.codec || o.mapsPerBlock ||
-                             app.count("--zstd-level") > 0;
-  if (o.to != "vff" && layoutOptions) {
-    vff::cli::usageError(kProg,
-                         "--target, --max-texture-size, --max-layers, --gutter, --codec, --zstd-level and "
-                         "--maps-per-block apply to --to vff only");
-    return vff::cli::kExitUsage;
-  }
-  const bool resampling = o.encoding || o.mapSize || o.downsample || o.positions || o.count || o.resample;
-  if (o.to != "vff" && resampling) {
-    vff::cli::usageError(kProg, "--encoding, --map-size, --downsample, --positions, --count and --resample apply to "
-                                "--to vff only");
-    return vff::cli::kExitUsage;
-  }
-  if ((o.downsample && !o.mapSize) || (o.resample && !o.positions && !o.count)) {
-    vff::cli::usageError(kProg, o.downsample && !o.mapSize ? "--downsample applies with --map-size only"
-                                                           : "--resample applies with --positions or --count only");
-    return vff::cli::kExitUsage;
-  }
-  if (o.to != "exr" && o.half) {
-    vff::cli::usageError(kProg, "--half applies to --to exr only");
+  if (auto problem = checkOptions(&o)) {
+    vff::cli::usageError(kProg, *problem);
     return vff::cli::kExitUsage;
   }
 
@@ -312,53 +232,8 @@ int main(int argc, char** argv) {
 
   FieldData d;
   const char* inputKind = "vff";
-  if (vff::convert::looksLikeExr(o.input)) {
-    inputKind = "exr";
-    if (o.to == "exr") {
-      vff::cli::usageError(kProg, o.input + " is already an EXR file: convert it --to vff");
-      return vff::cli::kExitUsage;
-    }
-    vff::convert::ExrReadReport report;
-    auto r = vff::convert::readExr(o.input, &report);
-    if (!r) return vff::cli::reportError(kProg, o.input, r.error());
-    if (report.inexactTexels)
-      std::fprintf(stderr,
-                   "%s: warning: %s: %llu hit texels do not hold an exactly decoded distance; they were "
-                   "quantised to the nearest code\n",
-                   kProg, o.input.c_str(), static_cast<unsigned long long>(report.inexactTexels));
-    if (report.ambiguousTexels)
-      std::fprintf(stderr,
-                   "%s: warning: %s: %llu hit texels are ambiguous: HALF holds the same value for "
-                   "neighbouring codes, so the codes may differ from the original (export with FLOAT)\n",
-                   kProg, o.input.c_str(), static_cast<unsigned long long>(report.ambiguousTexels));
-    if (report.inexactNormals)
-      std::fprintf(stderr, "%s: warning: %s: %llu normals are not exact oct-snorm16 values; they were quantised\n",
-                   kProg, o.input.c_str(), static_cast<unsigned long long>(report.inexactNormals));
-    d = std::move(r).value();
-  } else if (vff::convert::looksLikeVdb(o.input)) {
-    if (o.to == "vdb") {
-      vff::cli::usageError(kProg, o.input + " is already an OpenVDB file: convert it --to vff");
-      return vff::cli::kExitUsage;
-    }
-    vff::convert::VdbReadReport report;
-    auto r = vff::convert::readVdb(o.input, &report);
-    if (!r) return vff::cli::reportError(kProg, o.input, r.error());
-    if (report.inexactTexels)
-      std::fprintf(stderr,
-                   "%s: warning: %s: %llu active voxels do not hold an exactly decoded distance; they were "
-                   "quantised to the nearest code\n",
-                   kProg, o.input.c_str(), static_cast<unsigned long long>(report.inexactTexels));
-    if (report.inexactNormals)
-      std::fprintf(stderr, "%s: warning: %s: %llu normals are not exact oct-snorm16 values; they were quantised\n",
-                   kProg, o.input.c_str(), static_cast<unsigned long long>(report.inexactNormals));
-    d = std::move(r).value();
-    inputKind = "vdb";
-  } else {
-    auto r = loadVff(o.input);
-    if (!r) return vff::cli::reportError(kProg, o.input, r.error());
-    d = std::move(r).value();
-  }
-  if (resampling)
+  if (auto rc = readInput(o, &d, &inputKind)) return *rc;
+  if (o.resampling())
     if (int rc = resampleMaps(o, &d); rc != vff::cli::kExitSuccess) return rc;
   if (o.to == "vdb") return toVdb(o, d, inputKind);
   return o.to == "exr" ? toExr(o, d) : saveVff(o, d);

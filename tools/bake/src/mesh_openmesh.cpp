@@ -17,30 +17,32 @@
 namespace vff::bake::detail {
 namespace {
 
-// OpenMesh's PLY reader loops forever, or for as many steps as a garbled count says, on a header
-// that never reaches `end_header`, holds an unknown or malformed line, or a body whose list counts
-// or element counts do not match the file (found by tests/fuzz, fuzz_mesh). The file is checked
-// first: the header's grammar (within 64 KiB), then the body against it, row by row for ASCII and
-// byte by byte for binary, with list lengths of at most 65536.
-Status checkPly(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return makeError(Code::kIoOpen, path + ": cannot open");
-  struct Property {
-    bool list = false;
-    int countSize = 0, itemSize = 0;  // bytes; countSize only for lists
-    bool countSigned = false;
-  };
-  struct Element {
-    uint64_t count = 0;
-    std::vector<Property> properties;
-  };
+struct PlyProperty {
+  bool list = false;
+  int countSize = 0, itemSize = 0;  // bytes; countSize only for lists
+  bool countSigned = false;
+};
+struct PlyElement {
+  uint64_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+struct PlyHeader {
+  std::string format;  // "ascii", "binary_little_endian" or "binary_big_endian"
+  std::vector<PlyElement> elements;
+};
+
+constexpr uint64_t kMaxPlyList = 65536;
+
+// Reads the header's lines from `in` (left at the body's first byte) into *header, checking its
+// grammar within 64 KiB.
+Status parsePlyHeader(std::istream& in, const std::string& path, PlyHeader* header) {
   static const std::map<std::string, std::pair<int, bool>> kTypes = {
       {"char", {1, true}},    {"uchar", {1, false}},  {"int8", {1, true}},    {"uint8", {1, false}},
       {"short", {2, true}},   {"ushort", {2, false}}, {"int16", {2, true}},   {"uint16", {2, false}},
       {"int", {4, true}},     {"uint", {4, false}},   {"int32", {4, true}},   {"uint32", {4, false}},
       {"float", {4, true}},   {"float32", {4, true}}, {"double", {8, true}},  {"float64", {8, true}}};
-  std::vector<Element> elements;
-  std::string format;
+  std::vector<PlyElement>& elements = header->elements;
+  std::string& format = header->format;
   std::string line;
   uint64_t read = 0;
   int64_t n = 0;
@@ -87,7 +89,7 @@ Status checkPly(const std::string& path) {
                   rest[1] == "float32" || rest[1] == "double" || rest[1] == "float64")
                : (rest.size() != 2 || !kTypes.count(rest[0])))
         return bad("PLY property line is not 'property TYPE NAME' or 'property list INTEGER-TYPE TYPE NAME'");
-      Property pr;
+      PlyProperty pr;
       pr.list = list;
       if (list) {
         pr.countSize = kTypes.at(rest[1]).first;
@@ -103,40 +105,46 @@ Status checkPly(const std::string& path) {
   }
   if (!ended) return makeError(Code::kMeshParse, path + ": PLY header has no end_header line");
   if (format.empty()) return makeError(Code::kMeshParse, path + ": PLY header has no format line");
-  constexpr uint64_t kMaxList = 65536;
-  if (format == "ascii") {
-    std::string word;
-    auto number = [&](bool integer, uint64_t* value) {
-      if (!(in >> word)) return false;
-      std::istringstream ws(word);
-      if (integer) {
-        long long v = 0;
-        if (!(ws >> v) || ws.peek() != EOF || v < 0) return false;
-        *value = uint64_t(v);
-        return true;
-      }
-      double d = 0;
-      return bool(ws >> d) && ws.peek() == EOF;
-    };
-    for (size_t e = 0; e < elements.size(); ++e)
-      for (uint64_t row = 0; row < elements[e].count && !elements[e].properties.empty(); ++row)
-        for (const Property& pr : elements[e].properties) {
-          uint64_t items = 1;
-          if (pr.list && (!number(true, &items) || items > kMaxList))
-            return makeError(Code::kMeshParse, path + ": element " + std::to_string(e) + " row " + std::to_string(row) +
-                                                   ": a list length is not an integer from 0 to 65536");
-          for (uint64_t i = 0; i < items; ++i) {
-            uint64_t ignored = 0;
-            if (!number(false, &ignored))
-              return makeError(Code::kMeshParse, path + ": element " + std::to_string(e) + " row " +
-                                                     std::to_string(row) + ": missing or malformed value");
-          }
+  return {};
+}
+
+// An ASCII body, row by row: every value a number, every list length an integer up to 65536.
+Status checkPlyAsciiBody(std::istream& in, const std::string& path, const std::vector<PlyElement>& elements) {
+  std::string word;
+  auto number = [&](bool integer, uint64_t* value) {
+    if (!(in >> word)) return false;
+    std::istringstream ws(word);
+    if (integer) {
+      long long v = 0;
+      if (!(ws >> v) || ws.peek() != EOF || v < 0) return false;
+      *value = uint64_t(v);
+      return true;
+    }
+    double d = 0;
+    return bool(ws >> d) && ws.peek() == EOF;
+  };
+  for (size_t e = 0; e < elements.size(); ++e)
+    for (uint64_t row = 0; row < elements[e].count && !elements[e].properties.empty(); ++row)
+      for (const PlyProperty& pr : elements[e].properties) {
+        uint64_t items = 1;
+        if (pr.list && (!number(true, &items) || items > kMaxPlyList))
+          return makeError(Code::kMeshParse, path + ": element " + std::to_string(e) + " row " + std::to_string(row) +
+                                                 ": a list length is not an integer from 0 to 65536");
+        for (uint64_t i = 0; i < items; ++i) {
+          uint64_t ignored = 0;
+          if (!number(false, &ignored))
+            return makeError(Code::kMeshParse, path + ": element " + std::to_string(e) + " row " +
+                                                   std::to_string(row) + ": missing or malformed value");
         }
-    return {};
-  }
-  // Binary: walk the rows through the file, reading only the list lengths. Elements without lists
-  // have a fixed row size and are stepped over whole.
-  const bool little = format == "binary_little_endian";
+      }
+  return {};
+}
+
+// A binary body: walk the rows through the file, reading only the list lengths. Elements without
+// lists have a fixed row size and are stepped over whole.
+Status checkPlyBinaryBody(std::istream& in, const std::string& path, const PlyHeader& header) {
+  const std::vector<PlyElement>& elements = header.elements;
+  const bool little = header.format == "binary_little_endian";
   const uint64_t bodyStart = uint64_t(in.tellg());
   in.seekg(0, std::ios::end);
   const uint64_t size = uint64_t(in.tellg());
@@ -146,10 +154,10 @@ Status checkPly(const std::string& path) {
                                            ": the file ends inside the body");
   };
   for (size_t e = 0; e < elements.size(); ++e) {
-    const Element& el = elements[e];
+    const PlyElement& el = elements[e];
     bool hasList = false;
     uint64_t rowBytes = 0;
-    for (const Property& pr : el.properties) {
+    for (const PlyProperty& pr : el.properties) {
       hasList = hasList || pr.list;
       rowBytes += uint64_t(pr.itemSize);
     }
@@ -159,7 +167,7 @@ Status checkPly(const std::string& path) {
       continue;
     }
     for (uint64_t row = 0; row < el.count; ++row)
-      for (const Property& pr : el.properties) {
+      for (const PlyProperty& pr : el.properties) {
         uint64_t items = 1;
         if (pr.list) {
           if (pos + uint64_t(pr.countSize) > size) return ends(e, row);
@@ -169,7 +177,7 @@ Status checkPly(const std::string& path) {
           uint64_t v = 0;
           for (int k = 0; k < pr.countSize; ++k) v |= uint64_t(bytes[little ? k : pr.countSize - 1 - k]) << (8 * k);
           const bool negative = pr.countSigned && (v >> (8 * pr.countSize - 1)) != 0;
-          if (negative || v > kMaxList)
+          if (negative || v > kMaxPlyList)
             return makeError(Code::kMeshParse, path + ": element " + std::to_string(e) + " row " + std::to_string(row) +
                                                    ": a list length is not from 0 to 65536");
           items = v;
@@ -180,6 +188,20 @@ Status checkPly(const std::string& path) {
       }
   }
   return {};
+}
+
+// OpenMesh's PLY reader loops forever, or for as many steps as a garbled count says, on a header
+// that never reaches `end_header`, holds an unknown or malformed line, or a body whose list counts
+// or element counts do not match the file (found by tests/fuzz, fuzz_mesh). The file is checked
+// first: the header's grammar (within 64 KiB), then the body against it, row by row for ASCII and
+// byte by byte for binary, with list lengths of at most 65536.
+Status checkPly(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return makeError(Code::kIoOpen, path + ": cannot open");
+  PlyHeader header;
+  if (Status st = parsePlyHeader(in, path, &header); !st) return st;
+  if (header.format == "ascii") return checkPlyAsciiBody(in, path, header.elements);
+  return checkPlyBinaryBody(in, path, header);
 }
 
 // OpenMesh's OBJ reader writes through invalid handles when a face refers to a vertex or normal

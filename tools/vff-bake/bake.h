@@ -1,0 +1,100 @@
+// bake.h - what vff-bake's parts share: the command line (options.cpp), the checks and output every
+// bake makes (common.cpp), and the two bakes, from a mesh (mesh_bake.cpp) and from an OpenVDB level
+// set (levelset_bake.cpp).
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdint>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "enum_option.h"
+#include "options_codec.h"
+#include "options_layout.h"
+#include "vff/bake/baker.h"
+#include "vff/vff.h"
+
+namespace vff::bake_tool {
+
+inline constexpr const char* kProg = "vff-bake";
+
+// ---- The command line (options.cpp) -------------------------------------------------------------
+struct Options {
+  std::string mesh;
+  std::string output;
+  std::string grid;  // .vdb input: the level set grid to bake (empty: the first)
+  cli::EnumOption<PositionScheme> positions{"--positions", cli::kPositionSchemes, PositionScheme::kOctaHemi2};
+  uint32_t count = 0;  // 0: the scheme's default
+  uint32_t mapSize = 64;
+  cli::EnumOption<DirectionScheme> directions{"--directions", cli::kDirectionSchemes,
+                                              DirectionScheme::kConcentricEqualArea};
+  cli::EnumOption<DistanceEncoding> encoding{"--encoding", cli::kDistanceEncodings,
+                                             DistanceEncoding::kUnorm8Diameter};
+  bool normals = false;
+  unsigned threads = 0;
+  std::vector<float> center;
+  float radius = 0;
+  cli::OptionsCodec codec;
+  cli::OptionsLayout layout;
+  bool json = false;
+  bool quiet = false;
+  bool benchmark = false;
+  int repeat = 3;
+};
+
+// Adds every option of `o` to `app`.
+void addOptions(CLI::App& app, Options& o);
+// The usage error of a parsed command line that CLI11 cannot see (an option that needs another, or
+// does not apply to the input's kind); nothing when there is none.
+std::optional<std::string> checkOptions(const Options& o);
+// The baker's options and the writer's, from the command line.
+bake::BakeOptions bakeOptions(const Options& o);
+WriteOptions writeOptions(const Options& o);
+// The input is an OpenVDB file (by its extension).
+bool isVdbPath(const std::string& p);
+
+// ---- What both bakes share (common.cpp) ---------------------------------------------------------
+// A progress line on stderr, redrawn at most 10 times a second, only when enabled (on a terminal).
+class Progress {
+ public:
+  Progress(bool enabled, uint64_t raysPerMap) : enabled_(enabled), raysPerMap_(raysPerMap) {}
+  void update(uint64_t done, uint64_t total);
+
+ private:
+  bool enabled_;
+  uint64_t raysPerMap_;
+  std::mutex mu_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now(), last_{};
+};
+
+// Seconds since `t0`.
+double secondsSince(std::chrono::steady_clock::time_point t0);
+// The last component of a path.
+std::string baseName(const std::string& p);
+// The process's peak resident memory.
+double peakRssMiB();
+
+// Checks a planned field before any output exists: the baker's description of it (`field`), its
+// layout under `limits`, its payload under the baker's 16 GiB limit. Each failure is a usage error,
+// printed here; returns the exit code then, else nothing, with the payload bytes in *payload.
+std::optional<int> checkPlan(const Result<FieldDesc>& field, const LayoutLimits& limits, uint64_t* payload);
+
+// Writes the baked maps (the normals too with o.normals) through `writer` and finishes the file;
+// *seconds: the time it took, *fileBytes: the file's size. Returns the exit code of a failure.
+std::optional<int> writeBaked(const Options& o, Writer& writer, const bake::BakedField& baked, double* seconds,
+                              uint64_t* fileBytes);
+
+// The --json keys every bake reports (the callers add their input's and timing keys).
+nlohmann::json bakeSummary(const bake::BakeOptions& bo, const FieldDesc& field, const bake::BakeStats& s,
+                           uint64_t payload, double bakeSeconds);
+
+// ---- The bakes; each returns the tool's exit code -----------------------------------------------
+int bakeFromMesh(const Options& o, bake::BakeOptions bo, WriteOptions wo);      // mesh_bake.cpp
+int bakeFromLevelSet(const Options& o, bake::BakeOptions bo, WriteOptions wo);  // levelset_bake.cpp
+
+}  // namespace vff::bake_tool

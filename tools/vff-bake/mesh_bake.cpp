@@ -1,0 +1,147 @@
+// mesh_bake.cpp - vff-bake from a triangle mesh with Embree, and --benchmark: Embree's raw
+// throughput on exactly the bake's rays against the whole bake.
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <optional>
+#include <thread>
+
+#include "bake.h"
+#include "cli.h"
+#include "vff/bake/mesh.h"
+
+namespace vff::bake_tool {
+
+namespace {
+
+std::string meshMetadata(const Options& o, const bake::BakeOptions& bo, const bake::Mesh& mesh,
+                         const bake::MeshInfo& info) {
+  const nlohmann::json meta = {
+      {"vff.generator", "vff-bake"},
+      {"vff.generatorVersion", kLibraryVersion},
+      {"vff.source", {{"name", baseName(o.mesh)}, {"format", info.format}, {"xxh3", cli::hexDigits64(bake::meshHash(mesh))},
+                      {"vertices", mesh.vertexCount()}, {"triangles", mesh.triangleCount()}}},
+      {"vff.bake", {{"rayOrigin", "texel centre"}, {"sphere", bo.sphere ? "user" : "minimal-enclosing"},
+                    {"twoSided", true}, {"normals", o.normals ? (mesh.normals.empty() ? "geometric" : "interpolated") : "none"}}}};
+  return meta.dump();
+}
+
+// What a mesh bake measured, for the report.
+struct Measures {
+  double load = 0, build = 0, raw = 0, bake = 0, write = 0;  // seconds (raw, bake: best of --repeat)
+  uint64_t fileBytes = 0;
+  uint64_t payload = 0;
+};
+
+// The --benchmark table on stdout.
+void printBenchmark(const Options& o, const bake::Mesh& mesh, const FieldDesc& field, double rays, const Measures& m,
+                    double payloadMiB, double meshMiB, double bvhMiB) {
+  std::printf("mesh            %s: %zu triangles\n", o.mesh.c_str(), mesh.triangleCount());
+  std::printf("rays            %u maps x %ux%u = %.0f rays, %u threads\n", field.mapCount, field.mapResolution,
+              field.mapResolution, rays, o.threads ? o.threads : std::thread::hardware_concurrency());
+  std::printf("embree raw      %8.3f s  %7.2f Mrays/s   (rtcIntersect16, same rays, nothing stored)\n", m.raw,
+              rays / m.raw / 1e6);
+  std::printf("bake            %8.3f s  %7.2f Mrays/s   (trace + encode%s)\n", m.bake, rays / m.bake / 1e6,
+              o.normals ? " + normals" : "");
+  std::printf("ratio           %8.3f    (bake throughput / raw throughput; target >= 0.9)\n", m.raw / m.bake);
+  std::printf("peak memory     %8.1f MiB (budget: payload %.1f + mesh %.1f + BVH %.1f + 64 = %.1f MiB)\n",
+              peakRssMiB(), payloadMiB, meshMiB, bvhMiB, payloadMiB + meshMiB + bvhMiB + 64.0);
+}
+
+// The --json summary or the --benchmark table on stdout, or the one-line report on stderr (not
+// with --quiet).
+void reportMeshBake(const Options& o, const bake::BakeOptions& bo, const bake::Mesh& mesh, const bake::Scene& scene,
+                    const FieldDesc& field, const bake::BakeStats& s, const Measures& m, bool wrote) {
+  const double rays = double(s.rays);
+  const double meshMiB =
+      double(mesh.positions.size() * 4 + mesh.normals.size() * 4 + mesh.indices.size() * 4) / 1048576.0;
+  const double bvhMiB = double(scene.embreeBytes()) / 1048576.0;
+  const double payloadMiB = double(m.payload) / 1048576.0;
+  nlohmann::json summary = bakeSummary(bo, field, s, m.payload, m.bake);
+  summary.update({{"mesh", o.mesh},
+                  {"vertices", mesh.vertexCount()},
+                  {"triangles", mesh.triangleCount()},
+                  {"droppedDegenerate", mesh.droppedDegenerate},
+                  {"seconds", {{"load", m.load}, {"build", m.build}, {"bake", m.bake}, {"write", m.write}}},
+                  {"meshMiB", meshMiB},
+                  {"bvhMiB", bvhMiB}});
+  if (wrote) {
+    summary["output"] = o.output;
+    summary["fileBytes"] = m.fileBytes;
+  }
+  if (o.benchmark) {
+    summary["benchmark"] = {{"embreeRaysPerSecond", rays / m.raw},
+                            {"bakeRaysPerSecond", rays / m.bake},
+                            {"ratio", m.raw / m.bake},
+                            {"memoryBudgetMiB", payloadMiB + meshMiB + bvhMiB + 64.0}};
+  }
+  if (o.json) {
+    std::printf("%s\n", summary.dump(2).c_str());
+  } else if (o.benchmark) {
+    printBenchmark(o, mesh, field, rays, m, payloadMiB, meshMiB, bvhMiB);
+  } else if (!o.quiet) {
+    std::fprintf(stderr, "%s: %s: %u maps of %ux%u (%.0f rays, %.1f%% hits) in %.2f s (%.1f Mrays/s), %.3f MiB payload -> %s\n",
+                 kProg, o.mesh.c_str(), field.mapCount, field.mapResolution, field.mapResolution, rays,
+                 100.0 * double(s.hits) / rays, m.bake, rays / m.bake / 1e6, payloadMiB, o.output.c_str());
+  }
+}
+
+// Traces and bakes (--repeat times each with --benchmark, keeping the best times in *m); the
+// field of the last bake, or the exit code of a failure.
+std::optional<int> traceAndBake(const Options& o, bake::BakeOptions bo, const bake::Scene& scene, Measures* m,
+                                std::optional<bake::BakedField>* baked) {
+  if (o.benchmark) {
+    for (int r = 0; r < o.repeat; ++r) {
+      auto st = bake::traceOnly(scene, bo);
+      if (!st) return cli::reportError(kProg, o.mesh, st.error());
+      m->raw = r == 0 ? st->seconds : std::min(m->raw, st->seconds);
+    }
+  }
+  Progress progress(!o.quiet && !o.json && !o.benchmark && isatty(2), uint64_t(o.mapSize) * o.mapSize);
+  bo.progress = [&](uint64_t d, uint64_t t) { progress.update(d, t); };
+  for (int r = 0; r < (o.benchmark ? o.repeat : 1); ++r) {
+    auto b = bake::bakeField(scene, bo);
+    if (!b) return cli::reportError(kProg, o.mesh, b.error());
+    m->bake = r == 0 ? b->stats.seconds : std::min(m->bake, b->stats.seconds);
+    baked->emplace(std::move(*b));
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+int bakeFromMesh(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
+  // Load and check the mesh, then the parameters, before any output exists.
+  Measures m;
+  bake::MeshInfo info;
+  auto t0 = std::chrono::steady_clock::now();
+  auto mesh = bake::loadMesh(o.mesh, &info);
+  if (!mesh) return cli::reportError(kProg, o.mesh, mesh.error());
+  m.load = secondsSince(t0);
+  auto field = bake::describeBake(*mesh, bo);
+  if (auto rc = checkPlan(field, wo.layout, &m.payload)) return *rc;
+
+  // The writer creates its temporary file now, so an unwritable destination fails before baking.
+  std::optional<Writer> writer;
+  wo.metadataJson = meshMetadata(o, bo, *mesh, info);
+  if (!o.output.empty()) {
+    auto w = Writer::create(o.output, *field, wo);
+    if (!w) return cli::reportError(kProg, o.output, w.error());
+    writer.emplace(std::move(*w));
+  }
+
+  t0 = std::chrono::steady_clock::now();
+  auto scene = bake::Scene::create(*mesh, o.threads);
+  if (!scene) return cli::reportError(kProg, o.mesh, scene.error());
+  m.build = secondsSince(t0);
+
+  std::optional<bake::BakedField> baked;
+  if (auto rc = traceAndBake(o, bo, *scene, &m, &baked)) return *rc;
+  if (writer)
+    if (auto rc = writeBaked(o, *writer, *baked, &m.write, &m.fileBytes)) return *rc;
+  reportMeshBake(o, bo, *mesh, *scene, *field, baked->stats, m, writer.has_value());
+  return cli::kExitSuccess;
+}
+
+}  // namespace vff::bake_tool

@@ -1,0 +1,92 @@
+// options.cpp - vff-bake's command line: the options, the checks CLI11 cannot make, and the baker's
+// and writer's options they give.
+#include <algorithm>
+#include <cctype>
+
+#include "bake.h"
+#include "cli.h"
+
+namespace vff::bake_tool {
+
+namespace {
+
+uint32_t defaultCount(PositionScheme s) {
+  switch (s) {
+    case PositionScheme::kEqualAreaOctaGrid: return 65;  // 4225 maps
+    case PositionScheme::kSphericalFibonacci: return 4226;
+    default: return 32;  // 4226 maps
+  }
+}
+
+}  // namespace
+
+void addOptions(CLI::App& app, Options& o) {
+  cli::addVersionFlag(app, kProg);
+  app.add_option("mesh", o.mesh, "input mesh, or OpenVDB level set (.vdb)")->required();
+  app.add_option("-o,--output", o.output, "output .vff file (written atomically)");
+  app.add_option("--grid", o.grid, ".vdb input: name of the level set grid to bake (default: the first level set by name)");
+  o.positions.add(app, "positional-sample scheme")->capture_default_str();
+  app.add_option("-n,--count", o.count,
+                 "scheme parameter: octa-hemi2 n (maps = 2(2n^2+2n+1), default 32 = 4226 maps), "
+                 "ea-octa-grid n (n^2 maps, default 65), fibonacci N (default 4226)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("-m,--map-size", o.mapSize, "map resolution M (M x M rays per sample)")->capture_default_str()
+      ->check(CLI::Range(1u, 4096u));
+  o.directions.add(app, "hemisphere-to-square map")->capture_default_str();
+  o.encoding.add(app, "distance encoding")->capture_default_str();
+  app.add_flag("--normals", o.normals, "also store the surface normal at each hit (4 bytes per ray)");
+  app.add_option("-j,--threads", o.threads, "baking threads (0: all cores); the output does not depend on it")
+      ->capture_default_str();
+  app.add_option("--center", o.center, "bounding-sphere centre x y z (default: minimal enclosing sphere)")
+      ->expected(3);
+  app.add_option("--radius", o.radius, "bounding-sphere radius (with --center)");
+  o.codec.add(app, cli::Defaults::kTool);
+  o.layout.add(app, cli::Defaults::kTool);
+  app.add_flag("--json", o.json, "print a machine-readable summary on stdout");
+  app.add_flag("-q,--quiet", o.quiet, "no progress output");
+  app.add_flag("--benchmark", o.benchmark,
+               "measure Embree's raw throughput on exactly the bake's rays against the whole bake, and print both");
+  app.add_option("--repeat", o.repeat, "benchmark repetitions (best is reported)")->check(CLI::Range(1, 100));
+}
+
+std::optional<std::string> checkOptions(const Options& o) {
+  if (o.output.empty() && !o.benchmark) return "an output file is required (-o FILE), unless --benchmark is given";
+  if ((!o.center.empty()) != (o.radius > 0)) return "--center and --radius go together (radius > 0)";
+  if (isVdbPath(o.mesh)) {
+    if (o.benchmark) return "--benchmark measures Embree on a mesh; it does not apply to a .vdb level set";
+  } else if (!o.grid.empty()) {
+    return "--grid applies to a .vdb level set input only";
+  }
+  return std::nullopt;
+}
+
+bake::BakeOptions bakeOptions(const Options& o) {
+  bake::BakeOptions bo;
+  bo.positionScheme = o.positions.value();
+  bo.positionParam = o.count ? o.count : defaultCount(bo.positionScheme);
+  bo.directionScheme = o.directions.value();
+  bo.mapResolution = o.mapSize;
+  bo.encoding = o.encoding.value();
+  bo.normals = o.normals;
+  bo.threads = o.threads;
+  if (!o.center.empty()) bo.sphere = Sphere{{o.center[0], o.center[1], o.center[2]}, o.radius};
+  return bo;
+}
+
+WriteOptions writeOptions(const Options& o) {
+  WriteOptions wo;
+  wo.codec = o.codec.codec.value();
+  wo.zstdLevel = o.codec.zstdLevel;
+  wo.mapsPerBlock = o.codec.mapsPerBlock;
+  wo.layout = o.layout.limits(LayoutLimits{});
+  return wo;
+}
+
+bool isVdbPath(const std::string& p) {
+  if (p.size() < 4) return false;
+  std::string ext = p.substr(p.size() - 4);
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext == ".vdb";
+}
+
+}  // namespace vff::bake_tool
