@@ -198,7 +198,7 @@ def query_header(with_cpu):
     return ["| " + " | ".join(cols) + " |", "|" + "---|" * (2 if with_cpu else 1) + "---:|" * (len(cols) - (2 if with_cpu else 1))]
 
 
-def accuracy_table(steps):
+def accuracy_table(steps, only=None):
     lines = ["| experiment | field | memory MiB | RMS nearest | RMS interpolated | time s: exact / nearest |",
              "|---|---|---:|---:|---:|---:|"]
     for name in STEPS:
@@ -211,6 +211,8 @@ def accuracy_table(steps):
             if r["config"] not in configs:
                 configs.append(r["config"])
         for c in configs:
+            if only and c != only:
+                continue
             by = {r["reconstruction"]: r for r in rows if r["config"] == c}
             near, interp = by.get("nearest"), by.get("interpolated")
             first = near or interp
@@ -240,9 +242,10 @@ def gpu_table(g):
     return lines
 
 
-def sections(machine, steps, heading, queries=None):
+def sections(machine, steps, heading, queries=None, only=None):
     """The summary's tables, one per topic; `queries` (a list of (machine, query)) replaces the
-    query table of this run by one row per ray set of each CPU on record."""
+    query table of this run by one row per ray set of each CPU on record; `only` keeps the
+    accuracy rows of that field configuration."""
     out = []
     if "bake" in steps:
         out += [f"{heading} Bake speed", "", *bake_table(machine, steps["bake"]), ""]
@@ -257,7 +260,7 @@ def sections(machine, steps, heading, queries=None):
         out += [f"{heading} Query speed ({q['threads']} threads, {q['kernel']} kernel)", "",
                 *query_header(False), *query_rows(machine, q, False), ""]
     if any(k.startswith("accuracy-") for k in steps):
-        out += [f"{heading} Accuracy against exact Embree casts (8-bit scale)", "", *accuracy_table(steps), ""]
+        out += [f"{heading} Accuracy against exact Embree casts (8-bit scale)", "", *accuracy_table(steps, only), ""]
     if "compression" in steps:
         c = steps["compression"]
         out += [f"{heading} Compression of the distance payload ({c['payload']})", "", *compression_table(c), ""]
@@ -349,7 +352,7 @@ def readme_block(results_dir):
              f"From [{rel}]({rel}) ({machine['cpu']}, {machine['cores']} cores, commit {machine['commit']}, "
              f"{machine['mesh']}, field {machine['field']}), but the query table, which has a row per CPU on "
              "record. Figures differ between CPUs: `bash benchmarks/run.sh` measures yours.", ""]
-    return "\n".join(lines + sections(machine, steps, "####", list(latest.values())) + [END])
+    return "\n".join(lines + sections(machine, steps, "####", list(latest.values()), machine["field"]) + [END])
 
 
 def readme(args):
