@@ -265,7 +265,9 @@ def sections(machine, steps, heading, queries=None, only=None):
         c = steps["compression"]
         out += [f"{heading} Compression of the distance payload ({c['payload']})", "", *compression_table(c), ""]
     if "gpu" in steps:
-        out += [f"{heading} GPU ({steps['gpu']['gpu']})", "", *gpu_table(steps["gpu"]), ""]
+        renderer = steps["gpu"]["gpu"]
+        soft = ": Mesa's software rasteriser, on the CPU" if "llvmpipe" in renderer else ""
+        out += [f"{heading} GPU query ({renderer}{soft})", "", *gpu_table(steps["gpu"]), ""]
     return out
 
 
@@ -349,9 +351,9 @@ def readme_block(results_dir):
     latest = {m["cpu"]: (m, s["query"]) for _, m, s in runs if "query" in s}
     rel = os.path.relpath(path, ROOT)
     lines = [BEGIN, "",
-             f"From [{rel}]({rel}) ({machine['cpu']}, {machine['cores']} cores, commit {machine['commit']}, "
-             f"{machine['mesh']}, field {machine['field']}), but the query table, which has a row per CPU on "
-             "record. Figures differ between CPUs: `bash benchmarks/run.sh` measures yours.", ""]
+             f"From [{rel}]({rel}): {machine['cpu']}, {machine['cores']} cores, commit {machine['commit']}, "
+             f"{machine['mesh']}, field {machine['field']}; the query table has a row for each CPU on record. "
+             "Figures differ between CPUs: `bash benchmarks/run.sh` measures yours.", ""]
     return "\n".join(lines + sections(machine, steps, "####", list(latest.values()), machine["field"]) + [END])
 
 
