@@ -27,7 +27,7 @@ test_quick_run_writes_a_results_file() {
       || fail "no query row with a share of the floor for the $set rays"
   done
   # The GPU bench ran (a table naming the renderer) or the file says why not.
-  grep -q -E "^### GPU \(|^Not run: " "$WORK/r.md" || fail "the results file says nothing of the GPU bench"
+  grep -q -E "^### GPU query \(|^Not run: " "$WORK/r.md" || fail "the results file says nothing of the GPU bench"
   # No machine path: the commands are shown relative to the build folder.
   ! grep -q -F "$VFF_BUILD_DIR" "$WORK/r.md" || fail "the results file names the build folder"
   ! grep -q -F "$WORK" "$WORK/r.md" || fail "the results file names the scratch folder"
@@ -54,6 +54,19 @@ test_run_refuses_a_missing_mesh() {
   expect_rc 2
   expect_err "nothere.obj: cannot read the mesh"
   [[ ! -e $WORK/r.md ]] || fail "a results file was written"
+}
+
+# Every figure in README.md comes from a committed results file: its tables are exactly what
+# report.py makes of benchmarks/results/.
+test_readme_tables_match_the_results_files() {
+  run "$PYTHON" "$report" readme --check "$VFF_SOURCE_DIR/README.md"
+  expect_rc 0
+  cp "$VFF_SOURCE_DIR/README.md" "$WORK/README.md"
+  sed -i '/^<!-- benchmarks:begin/,/^<!-- benchmarks:end/ s/| \([0-9]\+\)\.\([0-9]\+\)x |/| 9\1.\2x |/' "$WORK/README.md"
+  cmp -s "$VFF_SOURCE_DIR/README.md" "$WORK/README.md" && fail "the edit of a ratio changed nothing"
+  run "$PYTHON" "$report" readme --check "$WORK/README.md"
+  expect_rc 1
+  expect_err "its benchmark tables differ from benchmarks/results/"
 }
 
 run_test "$1"
