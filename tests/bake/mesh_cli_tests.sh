@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# mesh_cli_tests.sh - vff-bake on mesh inputs: PLY triangle strips, user spheres that do not enclose
+# the mesh, the report of dropped triangles, interrupted bakes.
+#
+# Every function named test_* is one ctest case (tests/bake/CMakeLists.txt finds them in this file):
+# `bash mesh_cli_tests.sh test_NAME` runs one. Environment:
+#   VFF_BAKE     the vff-bake executable
+#   VFF_INSPECT  the vff-inspect executable
+#   MESHGEN      the vff-procedural-mesh executable
+#   WORK         a scratch folder of this test (emptied first)
+set -euo pipefail
+: "${VFF_BAKE:?}" "${VFF_INSPECT:?}" "${MESHGEN:?}" "${WORK:?}"
+
+here="$(dirname "${BASH_SOURCE[0]}")"
+source "$here/../common/cli_harness.sh"
+bake() { run "$VFF_BAKE" "$@"; }
+knot() { "$MESHGEN" torus-knot "$WORK/knot.obj" || fail "mesh generator"; }
+
+# ---- PLY triangle strips -------------------------------------------------------------------------
+# The same mesh as a face list and as one `tristrips` list (ply_strips.py), ASCII and binary: the
+# same field, byte for byte (the metadata names the file, "m.ply" in each folder, and hashes the
+# mesh as read).
+test_ply_tristrips_bake_like_the_face_list() {
+  knot
+  python3 "$here/ply_strips.py" "$WORK/knot.obj" "$WORK" >/dev/null || fail "ply_strips.py"
+  for d in faces-ascii strips-ascii faces-binary strips-binary; do
+    bake "$WORK/$d/m.ply" -o "$WORK/$d/m.vff" -n 3 -m 16 -q
+    expect_rc 0
+  done
+  for d in strips-ascii faces-binary strips-binary; do
+    cmp "$WORK/faces-ascii/m.vff" "$WORK/$d/m.vff" || fail "$d bakes another field than faces-ascii"
+  done
+  run "$VFF_INSPECT" "$WORK/strips-binary/m.vff" --format json
+  expect_out '"triangles": 8192'
+}
+
+# A strip list whose length claims more than the file holds: invalid input naming the file and row.
+test_ply_tristrips_longer_than_the_file_is_refused() {
+  {
+    printf 'ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n'
+    printf 'property float z\nelement tristrips 1\nproperty list int int vertex_indices\nend_header\n'
+    head -c 36 /dev/zero
+    printf '\x00\x00\x00\x70\x00\x00\x00\x00\x01\x00\x00\x00\x02\x00\x00\x00'
+  } >"$WORK/long.ply"
+  bake "$WORK/long.ply" -o "$WORK/x.vff"
+  expect_rc 3
+  expect_err "long.ply: element 1 row 0: the file ends inside the body"
+  [[ ! -e $WORK/x.vff ]] || fail "output left behind"
+  printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement tristrips 1\nproperty list int int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n4000000000 0 1 2\n' >"$WORK/long_ascii.ply"
+  bake "$WORK/long_ascii.ply" -o "$WORK/x.vff"
+  expect_rc 3
+  expect_err "long_ascii.ply: element 1 row 0: missing or malformed value"
+  [[ ! -e $WORK/x.vff ]] || fail "output left behind"
+}
+
+run_test "$1"
