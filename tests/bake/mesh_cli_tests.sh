@@ -53,4 +53,42 @@ test_ply_tristrips_longer_than_the_file_is_refused() {
   [[ ! -e $WORK/x.vff ]] || fail "output left behind"
 }
 
+# ---- A user sphere that does not enclose the mesh --------------------------------------------------
+# The torus knot's farthest vertex is 1.05 from the origin.
+test_user_sphere_cutting_the_mesh_is_a_usage_error() {
+  knot
+  bake "$WORK/knot.obj" -o "$WORK/x.vff" -n 1 -m 8 --center 0 0 0 --radius 0.5
+  expect_rc 1
+  expect_err_re "the sphere of radius 0.5 does not enclose .*knot.obj: its farthest vertex is 1.04[0-9]* from the centre"
+  expect_err "--allow-clipped-sphere"
+  [[ ! -e $WORK/x.vff ]] || fail "output left behind"
+  bake "$WORK/knot.obj" -o "$WORK/x.vff" --allow-clipped-sphere
+  expect_rc 1
+  expect_err "--allow-clipped-sphere needs --center and --radius"
+}
+
+test_allow_clipped_sphere_bakes_warns_and_records_it() {
+  knot
+  bake "$WORK/knot.obj" -o "$WORK/x.vff" -n 1 -m 8 --center 0 0 0 --radius 0.5 --allow-clipped-sphere -q
+  expect_rc 0
+  expect_err "vff-bake: warning: the sphere of radius 0.5 does not enclose"
+  valid "$WORK/x.vff"
+  run "$VFF_INSPECT" "$WORK/x.vff" --format json
+  expect_out '"sphereEnclosesMesh": false'
+}
+
+# An enclosing sphere, the user's or the default one: no warning, no key (the files of before).
+test_enclosing_sphere_is_unchanged() {
+  knot
+  for sphere in "" "--center 0 0 0 --radius 1.1"; do
+    # shellcheck disable=SC2086
+    bake "$WORK/knot.obj" -o "$WORK/x.vff" -n 1 -m 8 -q $sphere
+    expect_rc 0
+    expect_no_err
+    run "$VFF_INSPECT" "$WORK/x.vff" --format json
+    expect_rc 0
+    ! grep -q sphereEnclosesMesh "$WORK/out" || fail "sphereEnclosesMesh written for an enclosing sphere ($sphere)"
+  done
+}
+
 run_test "$1"

@@ -39,6 +39,7 @@ struct Options {
   unsigned threads = 0;
   std::vector<float> center;
   float radius = 0;
+  bool allowClippedSphere = false;  // a --center/--radius sphere may cut the mesh
   cli::OptionsCodec codec;
   cli::OptionsLayout layout;
   bool json = false;
