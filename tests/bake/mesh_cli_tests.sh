@@ -91,4 +91,26 @@ test_enclosing_sphere_is_unchanged() {
   done
 }
 
+# ---- Dropped degenerate triangles ------------------------------------------------------------------
+# Two of the four triangles have zero area: one line on stderr with the count, not with -q, none
+# for a mesh without.
+test_dropped_degenerate_triangles_are_reported() {
+  printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 2 0 0\nv 0 2 0\nv 0 3 0\nf 1 2 3\nf 1 2 5\nf 1 3 4\nf 3 6 7\n' >"$WORK/d.obj"
+  bake "$WORK/d.obj" -o "$WORK/d.vff" -n 1 -m 8
+  expect_rc 0
+  expect_err "vff-bake: $WORK/d.obj: dropped 2 degenerate (zero-area) triangles"
+  [[ $(grep -c "zero-area" "$WORK/err") -eq 1 ]] || { show; fail "not one line"; }
+  bake "$WORK/d.obj" -o "$WORK/d.vff" -n 1 -m 8 --json
+  expect_rc 0
+  expect_err "dropped 2 degenerate"
+  expect_out '"droppedDegenerate": 2'
+  bake "$WORK/d.obj" -o "$WORK/d.vff" -n 1 -m 8 -q
+  expect_rc 0
+  expect_no_err
+  knot
+  bake "$WORK/knot.obj" -o "$WORK/k.vff" -n 1 -m 8
+  expect_rc 0
+  ! grep -q zero-area "$WORK/err" || { show; fail "reported zero dropped triangles"; }
+}
+
 run_test "$1"

@@ -159,6 +159,9 @@ int bakeFromMesh(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
   auto mesh = bake::loadMesh(o.mesh, &info);
   if (!mesh) return cli::reportError(kProg, o.mesh, mesh.error());
   m.load = secondsSince(t0);
+  if (mesh->droppedDegenerate && !o.quiet)
+    std::fprintf(stderr, "%s: %s: dropped %llu degenerate (zero-area) triangle%s\n", kProg, o.mesh.c_str(),
+                 static_cast<unsigned long long>(mesh->droppedDegenerate), mesh->droppedDegenerate == 1 ? "" : "s");
   auto field = bake::describeBake(*mesh, bo);
   if (auto rc = checkPlan(field, wo.layout, &m.payload)) return *rc;
   bool clipped = false;
