@@ -113,4 +113,52 @@ test_dropped_degenerate_triangles_are_reported() {
   ! grep -q zero-area "$WORK/err" || { show; fail "reported zero dropped triangles"; }
 }
 
+# ---- Interrupted bakes -----------------------------------------------------------------------------
+# SIGINT, SIGTERM or SIGHUP in the middle of a bake (a few seconds on one thread): the process ends
+# killed by the signal, its temporary is gone, the old output is intact. (SIGKILL cannot be caught:
+# tests/crash.)
+test_interrupted_bake_removes_its_temporary() {
+  knot
+  local sig num pid rc tmp
+  for sig in INT TERM HUP; do
+    echo old >"$WORK/out.vff"
+    set -m  # job control: the background bake does not start with SIGINT ignored
+    "$VFF_BAKE" "$WORK/knot.obj" -o "$WORK/out.vff" -m 96 -j 1 -q &
+    pid=$!
+    set +m
+    tmp=""
+    for _ in $(seq 400); do
+      tmp=$(compgen -G "$WORK/.out.vff.tmp-$pid-*" || true)
+      [[ -n $tmp ]] && break
+      sleep 0.025
+    done
+    [[ -n $tmp ]] || fail "SIG$sig: no temporary appeared"
+    kill -s "$sig" "$pid"
+    rc=0
+    wait "$pid" || rc=$?
+    num=$(kill -l "$sig")
+    [[ $rc -eq $((128 + num)) ]] || fail "SIG$sig: exit status $rc, expected $((128 + num)) (killed by the signal)"
+    ! compgen -G "$WORK/.out.vff*.tmp-*" >/dev/null || { ls -la "$WORK"; fail "SIG$sig: a temporary remains"; }
+    [[ $(cat "$WORK/out.vff") == old ]] || fail "SIG$sig: the old output changed"
+  done
+}
+
+# Temporaries of the output's name left by dead processes go; a live process's, and another
+# output's, stay.
+test_stale_temporaries_of_dead_processes_are_removed() {
+  knot
+  local dead
+  sh -c 'exit 0' &
+  dead=$!
+  wait "$dead"
+  touch "$WORK/.out.vff.tmp-$dead-0" "$WORK/.out.vff.tmp-$dead-7" "$WORK/.out.vff.tmp-$$-0" \
+    "$WORK/.other.vff.tmp-$dead-0"
+  bake "$WORK/knot.obj" -o "$WORK/out.vff" -n 1 -m 8 -q
+  expect_rc 0
+  [[ ! -e $WORK/.out.vff.tmp-$dead-0 && ! -e $WORK/.out.vff.tmp-$dead-7 ]] || fail "a dead process's temporary remains"
+  [[ -e $WORK/.out.vff.tmp-$$-0 ]] || fail "a live process's temporary was removed"
+  [[ -e $WORK/.other.vff.tmp-$dead-0 ]] || fail "another output's temporary was removed"
+  valid "$WORK/out.vff"
+}
+
 run_test "$1"

@@ -171,9 +171,11 @@ int bakeFromMesh(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
   std::optional<Writer> writer;
   wo.metadataJson = meshMetadata(o, bo, *mesh, info, clipped);
   if (!o.output.empty()) {
+    removeStaleTemporaries(o.output);
     auto w = Writer::create(o.output, *field, wo);
     if (!w) return cli::reportError(kProg, o.output, w.error());
     writer.emplace(std::move(*w));
+    removeTemporaryOnSignal(o.output);
   }
 
   t0 = std::chrono::steady_clock::now();
