@@ -39,12 +39,10 @@ void addOptions(CLI::App& app, Options& o) {
       ->capture_default_str();
   app.add_option("--center", o.center, "bounding-sphere centre x y z (default: minimal enclosing sphere)")
       ->expected(3);
-  app.add_option("--radius", o.radius,
-                 "bounding-sphere radius (with --center); a mesh vertex outside it is a usage error (checked for meshes; "
-                 "a level set's active voxels include the band outside its surface)");
-  app.add_flag("--allow-clipped-sphere", o.allowClippedSphere,
-               "bake with a --center/--radius sphere that does not enclose the mesh (distances past it are "
-               "clamped; a warning, and \"sphereEnclosesMesh\": false in the metadata)");
+  app.add_option("--radius", o.radius, "bounding-sphere radius (with --center); it must enclose a mesh's vertices");
+  // Level sets are not checked: their active voxels include the band outside the surface.
+  app.add_flag("--allow-clipped-sphere", o.allowClippedSphere, "bake with a --center/--radius sphere that cuts the mesh "
+               "(distances past it are clamped; a warning, \"sphereEnclosesMesh\": false in the metadata)");
   o.codec.add(app, cli::Defaults::kTool);
   o.layout.add(app, cli::Defaults::kTool);
   app.add_flag("--json", o.json, "print a machine-readable summary on stdout");
