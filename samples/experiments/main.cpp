@@ -26,8 +26,10 @@ int main(int argc, char** argv) {
   const std::map<std::string, int (*)(const Options&)> experiments = {
       {"ao", runAo}, {"intra-ao", runIntraAo}, {"shadows", runShadows}, {"reflections", runReflections},
       {"bench", runBench}};
-  app.add_option("experiment,--experiment", o.experiment, "ao | intra-ao | shadows | reflections | bench")
-      ->required()
+  // One option under two names: CLI11 would mark each REQUIRED, as if both were; the check after
+  // parsing asks for one of them.
+  app.add_option("experiment,--experiment", o.experiment,
+                 "ao | intra-ao | shadows | reflections | bench (required: as the positional or --experiment)")
       ->check(CLI::IsMember({"ao", "intra-ao", "shadows", "reflections", "bench"}));
   app.add_option("--mesh", o.mesh, "object mesh (.obj .ply .off .stl .gltf .glb)")->capture_default_str();
   app.add_option("-o,--out", o.out, "output folder for images and tables")->capture_default_str();
@@ -54,6 +56,11 @@ int main(int argc, char** argv) {
   app.add_option("--repeat", o.repeat, "bench: repetitions (best is reported)")->capture_default_str()
       ->check(CLI::Range(1, 100));
   if (auto rc = vff::cli::parse(app, kProg, argc, argv)) return *rc;
+  if (o.experiment.empty()) {
+    vff::cli::usageError(kProg, "an experiment is required: ao, intra-ao, shadows, reflections or bench (the "
+                                "positional EXPERIMENT or --experiment)");
+    return vff::cli::kExitUsage;
+  }
   if (o.experiment == "bench" && !o.fields.empty()) {
     vff::cli::usageError(kProg, "--field applies to the image experiments, not to bench");
     return vff::cli::kExitUsage;

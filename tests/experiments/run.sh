@@ -69,6 +69,19 @@ case "$case" in
     "$exp" nosuch >/dev/null 2>&1; rc=$?
     [ "$rc" -eq 1 ] || fail "unknown experiment exited $rc, expected 1"
     ;;
+  help_requires_one_experiment)
+    # The positional and --experiment are one option: help must not mark both required.
+    "$exp" --help >help.txt 2>&1 || fail "--help failed"
+    ! grep -q REQUIRED help.txt || { cat help.txt; fail "--help marks an option REQUIRED"; }
+    grep -q "required: as the positional or --experiment" help.txt || { cat help.txt; fail "--help does not say one is required"; }
+    "$exp" >stdout.txt 2>stderr.txt; rc=$?
+    [ "$rc" -eq 1 ] || fail "no experiment exited $rc, expected 1"
+    grep -q "an experiment is required" stderr.txt || { cat stderr.txt; fail "no experiment: unclear message"; }
+    "$exp" --experiment nosuch >/dev/null 2>&1; rc=$?
+    [ "$rc" -eq 1 ] || fail "--experiment nosuch exited $rc, expected 1"
+    "$exp" --experiment bench --field x.vff >/dev/null 2>stderr.txt; rc=$?
+    [ "$rc" -eq 1 ] && grep -q "not to bench" stderr.txt || fail "--experiment bench is not read as the experiment"
+    ;;
   *) fail "unknown case $case" ;;
 esac
 echo "PASS: $case"

@@ -39,6 +39,7 @@ struct Options {
   unsigned threads = 0;
   std::vector<float> center;
   float radius = 0;
+  bool allowClippedSphere = false;  // a --center/--radius sphere may cut the mesh
   cli::OptionsCodec codec;
   cli::OptionsLayout layout;
   bool json = false;
@@ -92,6 +93,15 @@ std::optional<int> writeBaked(const Options& o, Writer& writer, const bake::Bake
 // The --json keys every bake reports (the callers add their input's and timing keys).
 nlohmann::json bakeSummary(const bake::BakeOptions& bo, const FieldDesc& field, const bake::BakeStats& s,
                            uint64_t payload, double bakeSeconds);
+
+// ---- The temporary file (interrupt.cpp) ---------------------------------------------------------
+// Removes the temporaries of `output` (.NAME.tmp-PID-N beside it) left by processes that no longer
+// exist; those of live processes stay.
+void removeStaleTemporaries(const std::string& output);
+// Once the Writer of `output` exists: on SIGINT, SIGTERM or SIGHUP, its temporary is removed and the
+// process ends killed by the signal (the old file at `output`, if any, stays as it was). A signal
+// ignored when this is called stays ignored.
+void removeTemporaryOnSignal(const std::string& output);
 
 // ---- The bakes; each returns the tool's exit code -----------------------------------------------
 int bakeFromMesh(const Options& o, bake::BakeOptions bo, WriteOptions wo);      // mesh_bake.cpp

@@ -75,8 +75,10 @@ int bakeFromLevelSet(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
   if (auto rc = checkPlan(field, wo.layout, &payload)) return *rc;
   wo.metadataJson = levelSetMetadata(o, bo, info);
   // The writer creates its temporary file now, so an unwritable destination fails before baking.
+  removeStaleTemporaries(o.output);
   auto writer = Writer::create(o.output, *field, wo);
   if (!writer) return cli::reportError(kProg, o.output, writer.error());
+  removeTemporaryOnSignal(o.output);
 
   Progress progress(!o.quiet && !o.json && isatty(2), uint64_t(o.mapSize) * o.mapSize);
   bo.progress = [&](uint64_t d, uint64_t total) { progress.update(d, total); };

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 #include <thread>
@@ -15,16 +16,55 @@ namespace vff::bake_tool {
 
 namespace {
 
+// A user sphere that cuts the mesh is recorded (`clipped`); other files keep their bytes.
 std::string meshMetadata(const Options& o, const bake::BakeOptions& bo, const bake::Mesh& mesh,
-                         const bake::MeshInfo& info) {
-  const nlohmann::json meta = {
+                         const bake::MeshInfo& info, bool clipped) {
+  nlohmann::json meta = {
       {"vff.generator", "vff-bake"},
       {"vff.generatorVersion", kLibraryVersion},
       {"vff.source", {{"name", baseName(o.mesh)}, {"format", info.format}, {"xxh3", cli::hexDigits64(bake::meshHash(mesh))},
                       {"vertices", mesh.vertexCount()}, {"triangles", mesh.triangleCount()}}},
       {"vff.bake", {{"rayOrigin", "texel centre"}, {"sphere", bo.sphere ? "user" : "minimal-enclosing"},
                     {"twoSided", true}, {"normals", o.normals ? (mesh.normals.empty() ? "geometric" : "interpolated") : "none"}}}};
+  if (clipped) meta["vff.bake"]["sphereEnclosesMesh"] = false;
   return meta.dump();
+}
+
+// The distance of the mesh's farthest vertex from the sphere's centre.
+double farthestVertex(const bake::Mesh& mesh, const Sphere& s) {
+  double far2 = 0;
+  for (size_t i = 0; i < mesh.positions.size(); i += 3) {
+    const double dx = double(mesh.positions[i]) - s.center[0], dy = double(mesh.positions[i + 1]) - s.center[1],
+                 dz = double(mesh.positions[i + 2]) - s.center[2];
+    far2 = std::max(far2, dx * dx + dy * dy + dz * dz);
+  }
+  return std::sqrt(far2);
+}
+
+// A --center/--radius sphere must enclose every vertex (distances past it would be clamped into
+// the last code): a usage error, unless --allow-clipped-sphere says it is meant, then a warning.
+// *clipped: the sphere cuts the mesh. Returns the exit code of a refusal.
+std::optional<int> checkUserSphere(const Options& o, const bake::BakeOptions& bo, const bake::Mesh& mesh,
+                                   bool* clipped) {
+  *clipped = false;
+  if (!bo.sphere) return std::nullopt;
+  const double far = farthestVertex(mesh, *bo.sphere);
+  if (far <= double(bo.sphere->radius)) return std::nullopt;
+  auto number = [](double v) {
+    char s[32];
+    std::snprintf(s, sizeof s, "%.9g", v);
+    return std::string(s);
+  };
+  const std::string what = "the sphere of radius " + number(bo.sphere->radius) + " does not enclose " + o.mesh +
+                           ": its farthest vertex is " + number(far) + " from the centre";
+  if (!o.allowClippedSphere) {
+    cli::usageError(kProg, what + " (a larger --radius, or --allow-clipped-sphere if this is meant)");
+    return cli::kExitUsage;
+  }
+  std::fprintf(stderr, "%s: warning: %s; distances past the sphere are clamped (--allow-clipped-sphere)\n", kProg,
+               what.c_str());
+  *clipped = true;
+  return std::nullopt;
 }
 
 // What a mesh bake measured, for the report.
@@ -119,16 +159,23 @@ int bakeFromMesh(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
   auto mesh = bake::loadMesh(o.mesh, &info);
   if (!mesh) return cli::reportError(kProg, o.mesh, mesh.error());
   m.load = secondsSince(t0);
+  if (mesh->droppedDegenerate && !o.quiet)
+    std::fprintf(stderr, "%s: %s: dropped %llu degenerate (zero-area) triangle%s\n", kProg, o.mesh.c_str(),
+                 static_cast<unsigned long long>(mesh->droppedDegenerate), mesh->droppedDegenerate == 1 ? "" : "s");
   auto field = bake::describeBake(*mesh, bo);
   if (auto rc = checkPlan(field, wo.layout, &m.payload)) return *rc;
+  bool clipped = false;
+  if (auto rc = checkUserSphere(o, bo, *mesh, &clipped)) return *rc;
 
   // The writer creates its temporary file now, so an unwritable destination fails before baking.
   std::optional<Writer> writer;
-  wo.metadataJson = meshMetadata(o, bo, *mesh, info);
+  wo.metadataJson = meshMetadata(o, bo, *mesh, info, clipped);
   if (!o.output.empty()) {
+    removeStaleTemporaries(o.output);
     auto w = Writer::create(o.output, *field, wo);
     if (!w) return cli::reportError(kProg, o.output, w.error());
     writer.emplace(std::move(*w));
+    removeTemporaryOnSignal(o.output);
   }
 
   t0 = std::chrono::steady_clock::now();

@@ -39,7 +39,10 @@ void addOptions(CLI::App& app, Options& o) {
       ->capture_default_str();
   app.add_option("--center", o.center, "bounding-sphere centre x y z (default: minimal enclosing sphere)")
       ->expected(3);
-  app.add_option("--radius", o.radius, "bounding-sphere radius (with --center)");
+  app.add_option("--radius", o.radius, "bounding-sphere radius (with --center); it must enclose a mesh's vertices");
+  // Level sets are not checked: their active voxels include the band outside the surface.
+  app.add_flag("--allow-clipped-sphere", o.allowClippedSphere, "bake with a --center/--radius sphere that cuts the mesh "
+               "(distances past it are clamped; a warning, \"sphereEnclosesMesh\": false in the metadata)");
   o.codec.add(app, cli::Defaults::kTool);
   o.layout.add(app, cli::Defaults::kTool);
   app.add_flag("--json", o.json, "print a machine-readable summary on stdout");
@@ -52,6 +55,7 @@ void addOptions(CLI::App& app, Options& o) {
 std::optional<std::string> checkOptions(const Options& o) {
   if (o.output.empty() && !o.benchmark) return "an output file is required (-o FILE), unless --benchmark is given";
   if ((!o.center.empty()) != (o.radius > 0)) return "--center and --radius go together (radius > 0)";
+  if (o.allowClippedSphere && o.center.empty()) return "--allow-clipped-sphere needs --center and --radius";
   if (isVdbPath(o.mesh)) {
     if (o.benchmark) return "--benchmark measures Embree on a mesh; it does not apply to a .vdb level set";
   } else if (!o.grid.empty()) {

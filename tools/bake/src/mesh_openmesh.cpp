@@ -1,5 +1,6 @@
 // OBJ, PLY, OFF and STL through OpenMesh.
 #include <OpenMesh/Core/IO/MeshIO.hh>
+#include <OpenMesh/Core/IO/importer/ImporterT.hh>
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <OpenMesh/Core/System/omstream.hh>
 
@@ -16,193 +17,6 @@
 
 namespace vff::bake::detail {
 namespace {
-
-struct PlyProperty {
-  bool list = false;
-  int countSize = 0, itemSize = 0;  // bytes; countSize only for lists
-  bool countSigned = false;
-};
-struct PlyElement {
-  uint64_t count = 0;
-  std::vector<PlyProperty> properties;
-};
-struct PlyHeader {
-  std::string format;  // "ascii", "binary_little_endian" or "binary_big_endian"
-  std::vector<PlyElement> elements;
-};
-
-constexpr uint64_t kMaxPlyList = 65536;
-
-// Reads the header's lines from `in` (left at the body's first byte) into *header, checking its
-// grammar within 64 KiB.
-Status parsePlyHeader(std::istream& in, const std::string& path, PlyHeader* header) {
-  static const std::map<std::string, std::pair<int, bool>> kTypes = {
-      {"char", {1, true}},    {"uchar", {1, false}},  {"int8", {1, true}},    {"uint8", {1, false}},
-      {"short", {2, true}},   {"ushort", {2, false}}, {"int16", {2, true}},   {"uint16", {2, false}},
-      {"int", {4, true}},     {"uint", {4, false}},   {"int32", {4, true}},   {"uint32", {4, false}},
-      {"float", {4, true}},   {"float32", {4, true}}, {"double", {8, true}},  {"float64", {8, true}}};
-  std::vector<PlyElement>& elements = header->elements;
-  std::string& format = header->format;
-  std::string line;
-  uint64_t read = 0;
-  int64_t n = 0;
-  auto bad = [&](const std::string& why) {
-    return makeError(Code::kMeshParse, path + ": line " + std::to_string(n) + ": " + why);
-  };
-  bool ended = false;
-  while (!ended && std::getline(in, line)) {
-    ++n;
-    read += line.size() + 1;
-    if (read > 65536) return makeError(Code::kMeshParse, path + ": PLY header longer than 64 KiB");
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    std::istringstream words(line);
-    std::string keyword;
-    words >> keyword;
-    if (n == 1) {
-      if (keyword != "ply") return makeError(Code::kMeshParse, path + ": line 1: not a PLY file (no 'ply' magic)");
-      continue;
-    }
-    if (keyword == "end_header") {
-      ended = true;
-      break;
-    }
-    if (keyword == "comment" || keyword == "obj_info") continue;
-    std::vector<std::string> rest;
-    for (std::string w; words >> w;) rest.push_back(w);
-    for (const std::string& w : rest)
-      for (char ch : w)
-        if (ch < 0x21 || ch > 0x7e) return bad("PLY header holds a byte that is not printable ASCII");
-    if (keyword == "format") {
-      if (rest.size() != 2 || (rest[0] != "ascii" && rest[0] != "binary_little_endian" && rest[0] != "binary_big_endian") ||
-          rest[1] != "1.0")
-        return bad("PLY format line is not 'format ascii|binary_little_endian|binary_big_endian 1.0'");
-      format = rest[0];
-    } else if (keyword == "element") {
-      if (rest.size() != 2 || rest[1].empty() || rest[1].size() > 10 ||
-          rest[1].find_first_not_of("0123456789") != std::string::npos)
-        return bad("PLY element line is not 'element NAME COUNT'");
-      elements.push_back({std::stoull(rest[1]), {}});
-    } else if (keyword == "property") {
-      if (elements.empty()) return bad("PLY property before any element");
-      const bool list = !rest.empty() && rest[0] == "list";
-      if (list ? (rest.size() != 4 || !kTypes.count(rest[1]) || !kTypes.count(rest[2]) || rest[1] == "float" ||
-                  rest[1] == "float32" || rest[1] == "double" || rest[1] == "float64")
-               : (rest.size() != 2 || !kTypes.count(rest[0])))
-        return bad("PLY property line is not 'property TYPE NAME' or 'property list INTEGER-TYPE TYPE NAME'");
-      PlyProperty pr;
-      pr.list = list;
-      if (list) {
-        pr.countSize = kTypes.at(rest[1]).first;
-        pr.countSigned = kTypes.at(rest[1]).second;
-        pr.itemSize = kTypes.at(rest[2]).first;
-      } else {
-        pr.itemSize = kTypes.at(rest[0]).first;
-      }
-      elements.back().properties.push_back(pr);
-    } else {
-      return bad("unknown PLY header keyword '" + keyword.substr(0, 32) + "'");
-    }
-  }
-  if (!ended) return makeError(Code::kMeshParse, path + ": PLY header has no end_header line");
-  if (format.empty()) return makeError(Code::kMeshParse, path + ": PLY header has no format line");
-  return {};
-}
-
-// An ASCII body, row by row: every value a number, every list length an integer up to 65536.
-Status checkPlyAsciiBody(std::istream& in, const std::string& path, const std::vector<PlyElement>& elements) {
-  std::string word;
-  auto number = [&](bool integer, uint64_t* value) {
-    if (!(in >> word)) return false;
-    std::istringstream ws(word);
-    if (integer) {
-      long long v = 0;
-      if (!(ws >> v) || ws.peek() != EOF || v < 0) return false;
-      *value = uint64_t(v);
-      return true;
-    }
-    double d = 0;
-    return bool(ws >> d) && ws.peek() == EOF;
-  };
-  for (size_t e = 0; e < elements.size(); ++e)
-    for (uint64_t row = 0; row < elements[e].count && !elements[e].properties.empty(); ++row)
-      for (const PlyProperty& pr : elements[e].properties) {
-        uint64_t items = 1;
-        if (pr.list && (!number(true, &items) || items > kMaxPlyList))
-          return makeError(Code::kMeshParse, path + ": element " + std::to_string(e) + " row " + std::to_string(row) +
-                                                 ": a list length is not an integer from 0 to 65536");
-        for (uint64_t i = 0; i < items; ++i) {
-          uint64_t ignored = 0;
-          if (!number(false, &ignored))
-            return makeError(Code::kMeshParse, path + ": element " + std::to_string(e) + " row " +
-                                                   std::to_string(row) + ": missing or malformed value");
-        }
-      }
-  return {};
-}
-
-// A binary body: walk the rows through the file, reading only the list lengths. Elements without
-// lists have a fixed row size and are stepped over whole.
-Status checkPlyBinaryBody(std::istream& in, const std::string& path, const PlyHeader& header) {
-  const std::vector<PlyElement>& elements = header.elements;
-  const bool little = header.format == "binary_little_endian";
-  const uint64_t bodyStart = uint64_t(in.tellg());
-  in.seekg(0, std::ios::end);
-  const uint64_t size = uint64_t(in.tellg());
-  uint64_t pos = bodyStart;
-  auto ends = [&](size_t e, uint64_t row) {
-    return makeError(Code::kMeshParse, path + ": element " + std::to_string(e) + " row " + std::to_string(row) +
-                                           ": the file ends inside the body");
-  };
-  for (size_t e = 0; e < elements.size(); ++e) {
-    const PlyElement& el = elements[e];
-    bool hasList = false;
-    uint64_t rowBytes = 0;
-    for (const PlyProperty& pr : el.properties) {
-      hasList = hasList || pr.list;
-      rowBytes += uint64_t(pr.itemSize);
-    }
-    if (!hasList) {
-      if (rowBytes != 0 && el.count > (size - pos) / rowBytes) return ends(e, (size - pos) / rowBytes);
-      pos += el.count * rowBytes;
-      continue;
-    }
-    for (uint64_t row = 0; row < el.count; ++row)
-      for (const PlyProperty& pr : el.properties) {
-        uint64_t items = 1;
-        if (pr.list) {
-          if (pos + uint64_t(pr.countSize) > size) return ends(e, row);
-          unsigned char bytes[4] = {};
-          in.seekg(std::streamoff(pos));
-          in.read(reinterpret_cast<char*>(bytes), pr.countSize);
-          uint64_t v = 0;
-          for (int k = 0; k < pr.countSize; ++k) v |= uint64_t(bytes[little ? k : pr.countSize - 1 - k]) << (8 * k);
-          const bool negative = pr.countSigned && (v >> (8 * pr.countSize - 1)) != 0;
-          if (negative || v > kMaxPlyList)
-            return makeError(Code::kMeshParse, path + ": element " + std::to_string(e) + " row " + std::to_string(row) +
-                                                   ": a list length is not from 0 to 65536");
-          items = v;
-          pos += uint64_t(pr.countSize);
-        }
-        pos += items * uint64_t(pr.itemSize);
-        if (pos > size) return ends(e, row);
-      }
-  }
-  return {};
-}
-
-// OpenMesh's PLY reader loops forever, or for as many steps as a garbled count says, on a header
-// that never reaches `end_header`, holds an unknown or malformed line, or a body whose list counts
-// or element counts do not match the file (found by tests/fuzz, fuzz_mesh). The file is checked
-// first: the header's grammar (within 64 KiB), then the body against it, row by row for ASCII and
-// byte by byte for binary, with list lengths of at most 65536.
-Status checkPly(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return makeError(Code::kIoOpen, path + ": cannot open");
-  PlyHeader header;
-  if (Status st = parsePlyHeader(in, path, &header); !st) return st;
-  if (header.format == "ascii") return checkPlyAsciiBody(in, path, header.elements);
-  return checkPlyBinaryBody(in, path, header);
-}
 
 // OpenMesh's OBJ reader writes through invalid handles when a face refers to a vertex or normal
 // that does not exist, or a face token is malformed (found by tests/fuzz, fuzz_mesh: a heap
@@ -361,16 +175,35 @@ Status checkStl(const std::string& path) {
   return {};
 }
 
+using TriMesh = OpenMesh::TriMesh_ArrayKernelT<>;
+
+// Builds the mesh of a strip PLY through OpenMesh's importer, as its PLY reader does for a face
+// list (a non-manifold face gets its own vertices), so both give the same mesh.
+void importTriangles(const PlyTriangles& t, TriMesh* tm, OpenMesh::IO::Options* opt) {
+  OpenMesh::IO::ImporterT<TriMesh> importer(*tm);
+  const bool normals = !t.normals.empty();
+  for (size_t v = 0; v < t.positions.size(); v += 3) {
+    const auto vh = importer.add_vertex(OpenMesh::Vec3f(t.positions[v], t.positions[v + 1], t.positions[v + 2]));
+    if (normals) importer.set_normal(vh, OpenMesh::Vec3f(t.normals[v], t.normals[v + 1], t.normals[v + 2]));
+  }
+  OpenMesh::IO::BaseImporter::VHandles face(3);
+  for (size_t i = 0; i < t.triangles.size(); i += 3) {
+    for (int k = 0; k < 3; ++k) face[size_t(k)] = OpenMesh::VertexHandle(int(t.triangles[i + size_t(k)]));
+    importer.add_face(face);
+  }
+  *opt = normals ? OpenMesh::IO::Options::VertexNormal : OpenMesh::IO::Options::Default;
+}
+
 }  // namespace
 
 Result<Mesh> loadWithOpenMesh(const std::string& path, const std::string& ext) {
-  using TriMesh = OpenMesh::TriMesh_ArrayKernelT<>;
   // OpenMesh reports through global streams; the importer's own errors carry the message.
   omerr().disable();
   omlog().disable();
   omout().disable();
+  std::optional<PlyTriangles> strips;
   if (ext == "ply") {
-    if (Status s = checkPly(path); !s) return s.error();
+    if (Status s = checkPly(path, &strips); !s) return s.error();
   } else if (ext == "obj") {
     if (Status s = checkObjFaces(path); !s) return s.error();
   } else if (ext == "off") {
@@ -383,7 +216,12 @@ Result<Mesh> loadWithOpenMesh(const std::string& path, const std::string& ext) {
   OpenMesh::IO::Options opt = OpenMesh::IO::Options::VertexNormal;
   bool ok = false;
   try {
-    ok = OpenMesh::IO::read_mesh(tm, path, opt);
+    if (strips) {
+      importTriangles(*strips, &tm, &opt);
+      ok = true;
+    } else {
+      ok = OpenMesh::IO::read_mesh(tm, path, opt);
+    }
   } catch (const std::exception& e) {
     return makeError(Code::kMeshParse, path + ": " + e.what());
   }

@@ -1,6 +1,7 @@
 // vff/bake/mesh.h - triangle meshes for baking, and their importers.
 //
-// Supported inputs: OBJ, PLY, OFF, STL (through OpenMesh; polygons are triangulated) and glTF 2.0
+// Supported inputs: OBJ, PLY (face lists, or `tristrips` with -1 restarts), OFF, STL (through
+// OpenMesh; polygons are triangulated) and glTF 2.0
 // .gltf/.glb (through tinygltf: every triangle primitive of the default scene, node transforms
 // applied). Content that cannot be baked is an error, never a silently empty mesh:
 //   kIoOpen          the file is missing or unreadable

@@ -1,0 +1,102 @@
+// interrupt.cpp - vff-bake's temporaries: removed when the bake is interrupted (SIGINT, SIGTERM,
+// SIGHUP), and those of an earlier run that died are removed by the next (see bake.h).
+//
+// libvff's Writer writes DIR/.NAME.tmp-PID-N next to DIR/NAME and renames it when complete; it does
+// not say N, so the temporaries of this process are found by their name: every one that carries
+// this process's PID is this process's (a process that had the PID before is dead).
+#include <signal.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "bake.h"
+
+namespace vff::bake_tool {
+
+namespace {
+
+constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP};
+constexpr size_t kMaxPaths = 4;
+constexpr size_t kPathBytes = 4096;
+// The paths the handler removes: written before it is armed, read only by it.
+char gPaths[kMaxPaths][kPathBytes];
+volatile sig_atomic_t gPathCount = 0;
+
+// Async-signal-safe: unlink, sigaction and raise only. The signal is blocked while this runs, so the
+// raised one is delivered with the default action as the handler returns: the process ends killed
+// by it, as it would have without the handler.
+void onSignal(int sig) {
+  for (sig_atomic_t i = 0; i < gPathCount; ++i) ::unlink(gPaths[i]);
+  struct sigaction dfl {};
+  dfl.sa_handler = SIG_DFL;
+  sigemptyset(&dfl.sa_mask);
+  sigaction(sig, &dfl, nullptr);
+  raise(sig);
+}
+
+// The folder of `output` and the prefix of its temporaries' names (".NAME.tmp-").
+std::pair<std::filesystem::path, std::string> temporaryPattern(const std::string& output) {
+  const size_t slash = output.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : output.substr(0, slash));
+  return {dir, "." + (slash == std::string::npos ? output : output.substr(slash + 1)) + ".tmp-"};
+}
+
+// The PID in a temporary's name PREFIX PID-N, or 0 when the name is not one.
+pid_t temporaryPid(const std::string& name, const std::string& prefix) {
+  if (name.compare(0, prefix.size(), prefix) != 0) return 0;
+  const std::string rest = name.substr(prefix.size());
+  const size_t dash = rest.find('-');
+  if (dash == 0 || dash == std::string::npos || dash > 9 || rest.size() == dash + 1 ||
+      rest.find_first_not_of("0123456789-") != std::string::npos || rest.find('-', dash + 1) != std::string::npos)
+    return 0;
+  return pid_t(std::stol(rest.substr(0, dash)));
+}
+
+// The temporaries of `output` in its folder whose PID `keep` accepts.
+template <typename Keep>
+std::vector<std::filesystem::path> temporaries(const std::string& output, Keep keep) {
+  const auto [dir, prefix] = temporaryPattern(output);
+  std::vector<std::filesystem::path> found;
+  std::error_code ec;
+  for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const pid_t pid = temporaryPid(it->path().filename().string(), prefix);
+    if (pid > 0 && keep(pid)) found.push_back(it->path());
+  }
+  return found;
+}
+
+}  // namespace
+
+void removeStaleTemporaries(const std::string& output) {
+  auto dead = [](pid_t pid) { return ::kill(pid, 0) == -1 && errno == ESRCH; };
+  std::error_code ec;
+  for (const auto& p : temporaries(output, dead)) std::filesystem::remove(p, ec);
+}
+
+void removeTemporaryOnSignal(const std::string& output) {
+  const pid_t self = getpid();
+  sig_atomic_t n = 0;
+  for (const auto& p : temporaries(output, [self](pid_t pid) { return pid == self; })) {
+    const std::string s = p.string();
+    if (size_t(n) == kMaxPaths || s.size() >= kPathBytes) break;
+    std::memcpy(gPaths[n], s.c_str(), s.size() + 1);
+    ++n;
+  }
+  gPathCount = n;
+  for (int sig : kSignals) {
+    struct sigaction old {}, act {};
+    // A signal the caller ignores (nohup, a background job of a script) stays ignored.
+    if (sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+    act.sa_handler = onSignal;
+    sigemptyset(&act.sa_mask);
+    for (int other : kSignals) sigaddset(&act.sa_mask, other);
+    sigaction(sig, &act, nullptr);
+  }
+}
+
+}  // namespace vff::bake_tool
