@@ -402,6 +402,118 @@ class Parser {
     return true;
   }
 
+  // What one plane's block-index walk carries from one entry to the next.
+  struct BlockWalk {
+    uint64_t expected = 0;       // the canonical offset of the next block in the section
+    bool limitReported = false;  // kDecodedLimit: once per plane (every block but the last has one size)
+  };
+
+  // Entry `bi` of a plane's block index (spec/format.md section 8): its bounds, order, sizes,
+  // codec, filter and checksum, recorded in pi.blocks[bi]. Returns false when the parse stops (the
+  // verdict of report()); *usable says whether the block can be read.
+  bool blockEntry(Plane plane, const SectionInfo& s, std::span<const uint8_t> sec, uint32_t bi, PlaneInfo& pi,
+                  BlockWalk& walk, bool* usable) {
+    const uint32_t tag = plane == Plane::kDistance ? kTagDistance : kTagNormal;
+    const uint64_t at = kPlaneHeaderSize + uint64_t(bi) * kBlockEntrySize;
+    const uint8_t* e = &sec[at];
+    BlockInfo& blk = pi.blocks[bi];
+    const uint64_t rel = loadU64(e);
+    blk.storedSize = loadU64(e + 8);
+    blk.rawSize = loadU32(e + 16);
+    blk.codec = Codec(e[20]);
+    blk.filter = Filter(e[21]);
+    blk.checksum = loadU64(e + 24);
+    blk.firstMap = bi * pi.mapsPerBlock;
+    blk.mapCount = std::min(pi.mapsPerBlock, out_->field.mapCount - blk.firstMap);
+    blk.offset = s.offset + rel;
+    const uint64_t where = s.offset + at;
+    const FieldDesc& f = out_->field;
+    const uint64_t mapBytes = pi.mapBytes;
+    bool ok = true;
+    if (loadU16(e + 22) != 0) {
+      if (!report(Code::kBlockReserved, tag, where + 22, "reserved block-entry bytes are not zero")) return false;
+    }
+    if (!inRange(rel, blk.storedSize, sec.size())) {
+      ok = false;
+      if (!report(Code::kBlockBounds, tag, where,
+                  "block " + num(bi) + " at " + num(rel) + " of " + num(blk.storedSize) + " bytes ends past the section"))
+        return false;
+    } else if (rel % kBlockAlignment != 0) {
+      ok = false;
+      if (!report(Code::kBlockAlignment, tag, where, "block " + num(bi) + " offset " + num(rel) + " is not a multiple of 64"))
+        return false;
+    } else if (rel != walk.expected) {
+      ok = false;
+      if (!report(Code::kBlockOrder, tag, where,
+                  "block " + num(bi) + " starts at " + num(rel) + ", the canonical position is " + num(walk.expected)))
+        return false;
+    }
+    if (uint64_t(blk.rawSize) != uint64_t(blk.mapCount) * mapBytes) {
+      ok = false;
+      if (!report(Code::kBlockRawSize, tag, where + 16,
+                  "block " + num(bi) + " rawSize " + num(blk.rawSize) + " should be " + num(uint64_t(blk.mapCount) * mapBytes)))
+        return false;
+    } else if (blk.rawSize > opt_.limits.maxBlockBytes && !walk.limitReported) {
+      // Before anything is decoded: a valid zstd frame of a few KiB can really expand to 4 GiB.
+      walk.limitReported = true;  // once per plane: every block but the last has the same rawSize
+      if (!report(Code::kDecodedLimit, tag, where + 16,
+                  "block " + num(bi) + " of " + num(pi.blocks.size()) + " decodes to " + num(blk.rawSize) +
+                      " bytes, above the reader's limit of " + num(opt_.limits.maxBlockBytes) +
+                      " bytes per block (ReadOptions::maxBlockBytes)"))
+        return false;
+    }
+    if (blk.codec != Codec::kStored && blk.codec != Codec::kZstd) {
+      ok = false;
+      if (!report(Code::kBlockCodec, tag, where + 20, "block " + num(bi) + " has unknown codec " + num(e[20])))
+        return false;
+    } else if (blk.codec == Codec::kStored && blk.storedSize != blk.rawSize) {
+      ok = false;
+      if (!report(Code::kBlockCodec, tag, where + 8,
+                  "stored block " + num(bi) + " has storedSize " + num(blk.storedSize) + " != rawSize " + num(blk.rawSize)))
+        return false;
+    } else if (blk.codec == Codec::kZstd && !(out_->info.incompatFeatures & kFeatureZstd)) {
+      if (!report(Code::kFeatureBit, tag, where + 20, "block " + num(bi) + " uses zstd but the zstd feature bit is clear"))
+        return false;
+    }
+    if (blk.filter != Filter::kNone) {
+      if (blk.filter != Filter::kHitsMed) {
+        ok = false;
+        if (!report(Code::kBlockFilter, tag, where + 21, "block " + num(bi) + " has unknown filter " + num(e[21])))
+          return false;
+      } else if (!filterApplies(blk.filter, plane, f)) {
+        ok = false;
+        if (!report(Code::kBlockFilter, tag, where + 21,
+                    "block " + num(bi) + " uses filter hits-med, which applies only to distance planes with an "
+                    "8-bit encoding, not to this " + std::string(planeName(plane)) + " plane of " +
+                    (plane == Plane::kDistance ? distanceEncodingName(f.distanceEncoding)
+                                               : normalEncodingName(f.normalEncoding))))
+          return false;
+      } else if (blk.codec != Codec::kZstd) {
+        ok = false;
+        if (!report(Code::kBlockFilter, tag, where + 21,
+                    "block " + num(bi) + " uses filter hits-med with codec " + codecName(blk.codec) +
+                        "; a filtered block must use zstd"))
+          return false;
+      } else if (!(out_->info.incompatFeatures & kFeatureFilters)) {
+        if (!report(Code::kFeatureBit, tag, where + 21,
+                    "block " + num(bi) + " uses a filter but the filters feature bit (incompatFeatures bit 1) is clear"))
+          return false;
+      }
+    }
+    if (ok && opt_.verifyPlaneChecksums &&
+        xxh3(sec.subspan(rel, blk.storedSize)) != blk.checksum) {
+      if (!report(Code::kBlockChecksum, tag, where + 24, "block " + num(bi) + " checksum does not match its stored bytes"))
+        return false;
+    }
+    if (ok) {
+      out_->covered.emplace_back(blk.offset, blk.offset + blk.storedSize);
+      pi.storedBytes += blk.storedSize;
+      walk.expected = alignUp(rel + blk.storedSize, kBlockAlignment);
+    }
+    *usable = ok;
+    return true;
+  }
+
   bool planeSection(Plane plane) {
     const uint32_t tag = plane == Plane::kDistance ? kTagDistance : kTagNormal;
     const int idx = find(tag);
@@ -466,105 +578,11 @@ class Parser {
     pi.mapsPerBlock = g;
     pi.rawBytes = uint64_t(mapCount) * mapBytes;
     pi.blocks.resize(blockCount);
-    uint64_t expected = alignUp(indexEnd, kBlockAlignment);
-    bool blockLimitReported = false;
+    BlockWalk walk{alignUp(indexEnd, kBlockAlignment)};
     for (uint32_t bi = 0; bi < blockCount; ++bi) {
-      const uint64_t at = kPlaneHeaderSize + uint64_t(bi) * kBlockEntrySize;
-      const uint8_t* e = &sec[at];
-      BlockInfo& blk = pi.blocks[bi];
-      const uint64_t rel = loadU64(e);
-      blk.storedSize = loadU64(e + 8);
-      blk.rawSize = loadU32(e + 16);
-      blk.codec = Codec(e[20]);
-      blk.filter = Filter(e[21]);
-      blk.checksum = loadU64(e + 24);
-      blk.firstMap = bi * g;
-      blk.mapCount = std::min(g, mapCount - blk.firstMap);
-      blk.offset = s.offset + rel;
-      const uint64_t where = s.offset + at;
-      bool ok = true;
-      if (loadU16(e + 22) != 0) {
-        if (!report(Code::kBlockReserved, tag, where + 22, "reserved block-entry bytes are not zero")) return false;
-      }
-      if (!inRange(rel, blk.storedSize, sec.size())) {
-        ok = false;
-        if (!report(Code::kBlockBounds, tag, where,
-                    "block " + num(bi) + " at " + num(rel) + " of " + num(blk.storedSize) + " bytes ends past the section"))
-          return false;
-      } else if (rel % kBlockAlignment != 0) {
-        ok = false;
-        if (!report(Code::kBlockAlignment, tag, where, "block " + num(bi) + " offset " + num(rel) + " is not a multiple of 64"))
-          return false;
-      } else if (rel != expected) {
-        ok = false;
-        if (!report(Code::kBlockOrder, tag, where,
-                    "block " + num(bi) + " starts at " + num(rel) + ", the canonical position is " + num(expected)))
-          return false;
-      }
-      if (uint64_t(blk.rawSize) != uint64_t(blk.mapCount) * mapBytes) {
-        ok = false;
-        if (!report(Code::kBlockRawSize, tag, where + 16,
-                    "block " + num(bi) + " rawSize " + num(blk.rawSize) + " should be " + num(uint64_t(blk.mapCount) * mapBytes)))
-          return false;
-      } else if (blk.rawSize > opt_.limits.maxBlockBytes && !blockLimitReported) {
-        // Before anything is decoded: a valid zstd frame of a few KiB can really expand to 4 GiB.
-        blockLimitReported = true;  // once per plane: every block but the last has the same rawSize
-        if (!report(Code::kDecodedLimit, tag, where + 16,
-                    "block " + num(bi) + " of " + num(blockCount) + " decodes to " + num(blk.rawSize) +
-                        " bytes, above the reader's limit of " + num(opt_.limits.maxBlockBytes) +
-                        " bytes per block (ReadOptions::maxBlockBytes)"))
-          return false;
-      }
-      if (blk.codec != Codec::kStored && blk.codec != Codec::kZstd) {
-        ok = false;
-        if (!report(Code::kBlockCodec, tag, where + 20, "block " + num(bi) + " has unknown codec " + num(e[20])))
-          return false;
-      } else if (blk.codec == Codec::kStored && blk.storedSize != blk.rawSize) {
-        ok = false;
-        if (!report(Code::kBlockCodec, tag, where + 8,
-                    "stored block " + num(bi) + " has storedSize " + num(blk.storedSize) + " != rawSize " + num(blk.rawSize)))
-          return false;
-      } else if (blk.codec == Codec::kZstd && !(out_->info.incompatFeatures & kFeatureZstd)) {
-        if (!report(Code::kFeatureBit, tag, where + 20, "block " + num(bi) + " uses zstd but the zstd feature bit is clear"))
-          return false;
-      }
-      if (blk.filter != Filter::kNone) {
-        if (blk.filter != Filter::kHitsMed) {
-          ok = false;
-          if (!report(Code::kBlockFilter, tag, where + 21, "block " + num(bi) + " has unknown filter " + num(e[21])))
-            return false;
-        } else if (!filterApplies(blk.filter, plane, f)) {
-          ok = false;
-          if (!report(Code::kBlockFilter, tag, where + 21,
-                      "block " + num(bi) + " uses filter hits-med, which applies only to distance planes with an "
-                      "8-bit encoding, not to this " + std::string(planeName(plane)) + " plane of " +
-                      (plane == Plane::kDistance ? distanceEncodingName(f.distanceEncoding)
-                                                 : normalEncodingName(f.normalEncoding))))
-            return false;
-        } else if (blk.codec != Codec::kZstd) {
-          ok = false;
-          if (!report(Code::kBlockFilter, tag, where + 21,
-                      "block " + num(bi) + " uses filter hits-med with codec " + codecName(blk.codec) +
-                          "; a filtered block must use zstd"))
-            return false;
-        } else if (!(out_->info.incompatFeatures & kFeatureFilters)) {
-          if (!report(Code::kFeatureBit, tag, where + 21,
-                      "block " + num(bi) + " uses a filter but the filters feature bit (incompatFeatures bit 1) is clear"))
-            return false;
-        }
-      }
-      if (ok && opt_.verifyPlaneChecksums &&
-          xxh3(sec.subspan(rel, blk.storedSize)) != blk.checksum) {
-        if (!report(Code::kBlockChecksum, tag, where + 24, "block " + num(bi) + " checksum does not match its stored bytes"))
-          return false;
-      }
-      if (ok) {
-        out_->covered.emplace_back(blk.offset, blk.offset + blk.storedSize);
-        pi.storedBytes += blk.storedSize;
-        expected = alignUp(rel + blk.storedSize, kBlockAlignment);
-      } else {
-        planeOk = false;
-      }
+      bool blockOk = false;
+      if (!blockEntry(plane, s, sec, bi, pi, walk, &blockOk)) return false;
+      planeOk = planeOk && blockOk;
     }
     if (planeOk && blockCount > 0) {
       const BlockInfo& last = pi.blocks.back();
