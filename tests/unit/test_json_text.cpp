@@ -5,6 +5,8 @@
 #include <string>
 
 #include "../../libvff/src/json_text.h"  // private: the META check behind rule 8001
+#include "test_util.h"
+#include "vff/vff.h"
 
 namespace vff::detail {
 namespace {
@@ -80,6 +82,22 @@ TEST(JsonText, LimitsTheNesting) {
   EXPECT_EQ(problem(deep), "arrays/objects nest deeper than 64 levels at byte 68");
   // Far deeper than any stack would allow a recursive parser: still a clean answer.
   EXPECT_EQ(problem(std::string(1000000, '[')), "arrays/objects nest deeper than 64 levels at byte 64");
+}
+
+// The writer canonicalises META with nlohmann::json, which holds numbers only within binary64: it
+// refuses such text as rule 8001 (not 8002, as if the text were not an object), naming the reason.
+TEST(JsonText, WriterRefusesMetadataItCannotHoldAsMetadataJson) {
+  const FieldDesc f = vff::test::smallField(DistanceEncoding::kUnorm8Diameter);
+  WriteOptions wo;
+  wo.metadataJson = R"({"big":1e400})";
+  const auto big = Writer::createInMemory(f, wo);
+  ASSERT_FALSE(big.ok());
+  EXPECT_EQ(big.error().code, Code::kMetadataJson);
+  EXPECT_NE(big.error().message.find("binary64"), std::string::npos) << big.error().message;
+  wo.metadataJson = "{\"a\":";
+  EXPECT_EQ(Writer::createInMemory(f, wo).error().code, Code::kMetadataJson);
+  wo.metadataJson = "[1,2]";
+  EXPECT_EQ(Writer::createInMemory(f, wo).error().code, Code::kMetadataNotObject);
 }
 
 }  // namespace
