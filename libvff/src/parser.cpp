@@ -1,7 +1,6 @@
 #include "parser.h"
 
 #define ZSTD_STATIC_LINKING_ONLY  // ZSTD_getFrameHeader (exported by libzstd since 1.3)
-#include <nlohmann/json.hpp>
 #include <zstd.h>
 
 #include <algorithm>
@@ -9,6 +8,7 @@
 #include <string>
 
 #include "codec.h"
+#include "json_text.h"
 #include "le.h"
 
 namespace vff::detail {
@@ -16,27 +16,8 @@ namespace {
 
 std::string num(uint64_t v) { return std::to_string(v); }
 
-// Nesting depth of a JSON text (brackets outside strings), so that hostile metadata cannot
-// exhaust the stack of a recursive parser.
+// The deepest nesting of arrays/objects a META text may have (rule 8001).
 constexpr int kMaxJsonDepth = 64;
-int jsonDepth(const std::string& t) {
-  int depth = 0, worst = 0;
-  bool inString = false;
-  for (size_t i = 0; i < t.size(); ++i) {
-    const char c = t[i];
-    if (inString) {
-      if (c == '\\') ++i;
-      else if (c == '"') inString = false;
-    } else if (c == '"') {
-      inString = true;
-    } else if (c == '[' || c == '{') {
-      worst = std::max(worst, ++depth);
-    } else if (c == ']' || c == '}') {
-      --depth;
-    }
-  }
-  return worst;
-}
 
 class Parser {
  public:
@@ -609,17 +590,12 @@ class Parser {
     std::vector<uint8_t> raw;
     if (!sectionBytes(idx, &raw)) return usable_ = false, true;
     std::string text(raw.begin(), raw.end());
-    if (jsonDepth(text) > kMaxJsonDepth) {
+    const JsonTextCheck check = checkJsonText(text, kMaxJsonDepth);
+    if (!check.problem.empty()) {
       usable_ = false;
-      return report(Code::kMetadataJson, kTagMetadata, s.offset,
-                    "metadata JSON nests deeper than " + num(kMaxJsonDepth) + " levels");
+      return report(Code::kMetadataJson, kTagMetadata, s.offset, "metadata is not valid UTF-8 JSON: " + check.problem);
     }
-    auto j = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
-    if (j.is_discarded()) {
-      usable_ = false;
-      return report(Code::kMetadataJson, kTagMetadata, s.offset, "metadata is not valid UTF-8 JSON");
-    }
-    if (!j.is_object()) {
+    if (!check.isObject) {
       usable_ = false;
       return report(Code::kMetadataNotObject, kTagMetadata, s.offset, "metadata JSON is not an object");
     }

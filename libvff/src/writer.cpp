@@ -497,8 +497,11 @@ Result<std::unique_ptr<Writer::Impl>> prepare(const FieldDesc& field, const Writ
   std::string meta;
   if (!options.metadataJson.empty()) {
     auto j = nlohmann::json::parse(options.metadataJson, nullptr, false);
-    if (j.is_discarded() || !j.is_object())
-      return makeError(Code::kMetadataNotObject, "metadataJson must be a JSON object");
+    // Not JSON, or JSON this writer cannot canonicalise (numbers beyond binary64): rule 8001, not 8002.
+    if (j.is_discarded())
+      return makeError(Code::kMetadataJson,
+                       "metadataJson is not JSON the writer can hold (RFC 8259, numbers within binary64 range)");
+    if (!j.is_object()) return makeError(Code::kMetadataNotObject, "metadataJson must be a JSON object");
     try {
       meta = j.dump();
     } catch (const std::exception& e) {

@@ -351,6 +351,17 @@ void addLayoutAndMetadata(Mutations& g) {
   g.meta(8001, "invalid-utf8", "metadata with the invalid UTF-8 sequence C3 28 in a string", "{\"a\":\"\xC3\x28\"}");
   g.meta(8001, "too-deep", "metadata nesting 65 levels (the reader's limit is 64)",
          "{\"a\":" + std::string(64, '[') + std::string(64, ']') + "}");
+  g.meta(8001, "trailing-nul", "metadata '{\"a\":1}' followed by a NUL byte and 'garbage'",
+         std::string("{\"a\":1}\0garbage", 15));
+  g.meta(8001, "trailing-zeros", "metadata '{\"a\":1}' followed by four zero bytes (META has no padding)",
+         std::string("{\"a\":1}\0\0\0\0", 11));
+  g.meta(8001, "trailing-value", "metadata '{\"a\":1}{}' (a second value after the first)", "{\"a\":1}{}");
+  g.meta(8001, "byte-order-mark", "metadata '{\"a\":1}' after a UTF-8 byte-order mark EF BB BF",
+         "\xEF\xBB\xBF{\"a\":1}");
+  g.meta(8001, "lone-high-surrogate", "metadata '{\"a\":\"\\ud800\"}' (a high surrogate escape alone)",
+         R"({"a":"\ud800"})");
+  g.meta(8001, "lone-low-surrogate", "metadata '{\"a\":\"\\udc00\\ud800\"}' (a low surrogate escape first)",
+         R"({"a":"\udc00\ud800"})");
   g.meta(8002, "array", "metadata '[1,2]' (valid JSON, not an object)", "[1,2]");
 }
 

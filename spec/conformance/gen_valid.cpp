@@ -116,6 +116,24 @@ std::vector<ValidCase> validCases() {
   unknownCopySafe.description = "u16d-stored-meta-slices plus an unknown section 'XTSC' with flags COPY_SAFE";
   unknownCopySafe.post = Post::kUnknownCopySafe;
   v.push_back(unknownCopySafe);
+  // META texts at the edges of RFC 8259 that rule 8001 accepts (spec/format.md section 9).
+  const auto metaCase = [&](const char* name, const char* description, std::string text) {
+    ValidCase c = v[4];
+    c.name = name;
+    c.description = description;
+    c.post = Post::kMetaText;
+    c.metaText = std::move(text);
+    v.push_back(c);
+  };
+  metaCase("meta-whitespace", "u16d-stored-meta-slices with META ' \\t\\r\\n{\"a\" : [ 1 , 2 ] , \"b\" : { } }\\r\\n\\t ': "
+           "whitespace before, inside and after the object",
+           " \t\r\n{\"a\" : [ 1 , 2 ] , \"b\" : { } }\r\n\t ");
+  metaCase("meta-any-magnitude", "u16d-stored-meta-slices with META numbers beyond binary64: 1e400, -1E+400, 1e-400 "
+           "and a 30-digit integer",
+           R"({"big":1e400,"negative":-1E+400,"tiny":1e-400,"long":123456789012345678901234567890})");
+  metaCase("meta-escapes", "u16d-stored-meta-slices with META strings holding a surrogate pair escape, \\u0000, "
+           "\\/ and raw UTF-8 of 2 and 4 bytes",
+           "{\"pair\":\"\\ud83d\\ude00\",\"nul\":\"\\u0000\",\"slash\":\"\\/\",\"raw\":\"\xC3\xA9\xF0\x9F\x98\x80\"}");
   ValidCase roCompat = v[0];
   roCompat.name = "rocompat-bit0";
   roCompat.description = "u8d-stored with roCompatFeatures bit 0 set: readable, validator warning 3008";
@@ -162,13 +180,17 @@ BuiltValid buildValid(const ValidCase& c) {
       st64(f.b, 32, 1);
       f.sealHeader();
       break;
+    case Post::kMetaText:
+      f.replaceStored(kTagMetadata, c.metaText);
+      break;
   }
   v.bytes = std::move(f.b);
   v.layout = canonicalLayout(c.field, c.options.layout);
   auto check = computeLayout(c.field, c.options.layout);
   if (!check || !sameLayout(*check, v.layout))
     fail(c.name + ": libvff's computeLayout differs from the canonical rule");
-  if (c.metadata) v.metadata = nlohmann::json::parse(wo.metadataJson).dump();
+  if (c.post == Post::kMetaText) v.metadata = c.metaText;
+  else if (c.metadata) v.metadata = nlohmann::json::parse(wo.metadataJson).dump();
   v.zstd = c.options.codec == Codec::kZstd;
   return v;
 }

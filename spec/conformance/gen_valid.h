@@ -13,7 +13,9 @@
 namespace vff::gen {
 
 // What is done to the written file before it is stored.
-enum class Post { kNone, kUnknownOptional, kUnknownCopySafe, kRoCompat };
+// kMetaText: the stored META replaced by ValidCase::metaText, a valid JSON text that is not in the
+// writer's canonical form (spec/format.md section 9 edge cases).
+enum class Post { kNone, kUnknownOptional, kUnknownCopySafe, kRoCompat, kMetaText };
 
 struct ValidCase {
   std::string name;
@@ -22,13 +24,14 @@ struct ValidCase {
   WriteOptions options;
   bool metadata = false;
   Post post = Post::kNone;
+  std::string metaText{};  // kMetaText only
 };
 
 struct BuiltValid {
   ValidCase c;
   Content content;
   LayoutDesc layout;
-  std::string metadata;  // canonical text
+  std::string metadata;  // canonical text; for Post::kMetaText the stored text as it is
   Bytes bytes;
   bool zstd = false;
 };

@@ -251,6 +251,23 @@ test_json_conforms() {
   done
 }
 
+test_json_bc4_features() {
+  # A format 1.2 bc4 file: incompatFeatures zstd | bc4 (5), named as the schema says.
+  local v
+  v="$(dirname "$SCHEMA")/conformance/valid/bc4-zstd-normals-slices.vff"
+  inspect "$v" --format json
+  expect_rc 0
+  cp "$WORK/out" "$WORK/bc4.json"
+  conforms "$WORK/bc4.json"
+  tr -d ' \n' <"$WORK/bc4.json" >"$WORK/flat"
+  grep -qF '"incompatFeatures":{"names":["zstd","bc4"],"value":5}' "$WORK/flat" || fail "bc4 feature names: $(cat "$WORK/flat" | head -c 600)"
+  sed 's/"bc4"/"bc5"/' "$WORK/bc4.json" >"$WORK/bad.json"
+  ! "$SCHEMA_CHECK" "$SCHEMA" "$WORK/bad.json" 2>/dev/null || fail "the schema accepted a feature name the tool never prints"
+  inspect "$v"
+  expect_rc 0
+  expect_out "(zstd, bc4)"
+}
+
 test_json_values() {
   inspect "$FIXTURES/big.vff" --format json
   expect_rc 0

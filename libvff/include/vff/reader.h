@@ -114,7 +114,9 @@ class File {
   const LayoutDesc& layout() const noexcept;
   const PlaneInfo& plane(Plane p) const noexcept;
   bool hasNormals() const noexcept { return plane(Plane::kNormal).present; }
-  // The metadata JSON text (canonical: sorted keys, UTF-8), or empty when there is no META section.
+  // The metadata JSON text exactly as stored (one JSON object, rule 8001; libvff's writer makes it
+  // canonical: sorted keys, no spaces), or empty when there is no META section. Its numbers may lie
+  // beyond binary64 range (spec/format.md section 9).
   std::string_view metadata() const noexcept;
   // The whole file's bytes (mapped or borrowed).
   std::span<const uint8_t> bytes() const noexcept;
