@@ -7,6 +7,9 @@
 
 namespace vff::detail {
 
+// How deep META's arrays and objects may nest (spec/format.md section 9).
+inline constexpr int kMaxJsonDepth = 64;
+
 struct JsonTextCheck {
   std::string problem;    // empty when the text is valid; else what is wrong, with its byte offset
   bool isObject = false;  // the top-level value is an object (meaningful when problem is empty)

@@ -17,7 +17,6 @@ namespace {
 std::string num(uint64_t v) { return std::to_string(v); }
 
 // The deepest nesting of arrays/objects a META text may have (rule 8001).
-constexpr int kMaxJsonDepth = 64;
 
 class Parser {
  public:

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "codec.h"
+#include "json_text.h"
 #include "vff/reader.h"
 #include "le.h"
 
@@ -497,10 +498,14 @@ Result<std::unique_ptr<Writer::Impl>> prepare(const FieldDesc& field, const Writ
   std::string meta;
   if (!options.metadataJson.empty()) {
     auto j = nlohmann::json::parse(options.metadataJson, nullptr, false);
-    // Not JSON, or JSON this writer cannot canonicalise (numbers beyond binary64): rule 8001, not 8002.
-    if (j.is_discarded())
-      return makeError(Code::kMetadataJson,
-                       "metadataJson is not JSON the writer can hold (RFC 8259, numbers within binary64 range)");
+    // Valid META (rule 8001) that nlohmann cannot hold, a number beyond binary64, is content this
+    // writer does not support; anything else it refuses is not JSON.
+    if (j.is_discarded()) {
+      if (detail::checkJsonText(options.metadataJson, detail::kMaxJsonDepth).problem.empty())
+        return makeError(Code::kUnsupported,
+                         "metadataJson holds a number beyond the binary64 range, which the writer cannot canonicalise");
+      return makeError(Code::kMetadataJson, "metadataJson is not JSON (RFC 8259)");
+    }
     if (!j.is_object()) return makeError(Code::kMetadataNotObject, "metadataJson must be a JSON object");
     try {
       meta = j.dump();

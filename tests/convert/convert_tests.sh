@@ -392,4 +392,19 @@ test_failure_keeps_existing_output() {
 
 # ---- Runner --------------------------------------------------------------------------------------------
 [[ $# -eq 1 && $1 == test_* ]] || { echo "usage: $0 test_NAME" >&2; exit 2; }
+# A valid field whose META holds a number beyond binary64 (rule 8001 allows any magnitude) cannot be
+# carried into EXR, OpenVDB or a rewritten .vff, whose writers hold META in nlohmann::json: exit 5
+# (unsupported) naming the reason, and no output file.
+test_meta_beyond_binary64_is_unsupported() {
+  local src
+  src="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)/spec/conformance/valid/meta-any-magnitude.vff"
+  for out in big.exr big.vdb big.vff; do
+    run "$VFF_CONVERT" "$src" --to "${out##*.}" "$WORK/$out"
+    expect_rc 5
+    expect_err "unsupported (9005)"
+    expect_err "beyond the binary64 range"
+    [[ ! -e $WORK/$out ]] || fail "$out was written"
+  done
+}
+
 run_test "$1"

@@ -85,14 +85,15 @@ TEST(JsonText, LimitsTheNesting) {
 }
 
 // The writer canonicalises META with nlohmann::json, which holds numbers only within binary64: it
-// refuses such text as rule 8001 (not 8002, as if the text were not an object), naming the reason.
+// refuses such valid text as unsupported (not 8002, as if the text were not an object), naming the
+// reason, and text that is not JSON as 8001.
 TEST(JsonText, WriterRefusesMetadataItCannotHoldAsMetadataJson) {
   const FieldDesc f = vff::test::smallField(DistanceEncoding::kUnorm8Diameter);
   WriteOptions wo;
   wo.metadataJson = R"({"big":1e400})";
   const auto big = Writer::createInMemory(f, wo);
   ASSERT_FALSE(big.ok());
-  EXPECT_EQ(big.error().code, Code::kMetadataJson);
+  EXPECT_EQ(big.error().code, Code::kUnsupported);
   EXPECT_NE(big.error().message.find("binary64"), std::string::npos) << big.error().message;
   wo.metadataJson = "{\"a\":";
   EXPECT_EQ(Writer::createInMemory(f, wo).error().code, Code::kMetadataJson);

@@ -52,7 +52,8 @@ bool looksLikeExr(const std::string& path);
 
 // ---- Shared by the EXR and OpenVDB sides (interchange.cpp) ----------------------------------------
 // The "vff.field" JSON: {"format": formatName, "field", "layout", "metadata", "codec", "mapsPerBlock"}.
-nlohmann::json fieldJson(const FieldData& data, const char* formatName);
+// kUnsupported when the metadata holds a number beyond binary64, which nlohmann::json cannot hold.
+Result<nlohmann::json> fieldJson(const FieldData& data, const char* formatName);
 // Parses it into `data` (everything but the planes) and checks it with libvff; errors
 // (kMetadataJson, or libvff's) start with `where`, e.g. "attribute vff.field".
 Status parseFieldJson(const std::string& text, const char* formatName, const std::string& where, FieldData* data);

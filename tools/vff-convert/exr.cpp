@@ -144,6 +144,8 @@ Status writeExr(const std::string& path, const FieldData& d, const ExrWriteOptio
   const Imf::PixelType type = options.half ? Imf::HALF : Imf::FLOAT;
   const int w = static_cast<int>(l.sliceWidth), h = static_cast<int>(l.sliceHeight);
   const std::vector<float> cosines = texelCosines(f);
+  const Result<nlohmann::json> field = fieldJson(d, kFormatName);
+  if (!field) return field.error();
 
   std::vector<Imf::Header> headers;
   for (uint32_t plane = 0; plane < (normals ? 2u : 1u); ++plane) {
@@ -163,7 +165,7 @@ Status writeExr(const std::string& path, const FieldData& d, const ExrWriteOptio
       }
       hd.insert("vff.plane", Imf::StringAttribute(plane == 0 ? "distance" : "normal"));
       hd.insert("vff.slice", Imf::IntAttribute(static_cast<int>(s)));
-      if (headers.empty()) hd.insert("vff.field", Imf::StringAttribute(fieldJson(d, kFormatName).dump()));
+      if (headers.empty()) hd.insert("vff.field", Imf::StringAttribute(field->dump()));
       headers.push_back(std::move(hd));
     }
   }

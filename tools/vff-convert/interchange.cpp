@@ -34,7 +34,7 @@ bool parseEnum(const std::string& name, F nameOf, E* out) {
 
 }  // namespace
 
-json fieldJson(const FieldData& d, const char* formatName) {
+Result<json> fieldJson(const FieldData& d, const char* formatName) {
   const FieldDesc& f = d.field;
   const LayoutDesc& l = d.layout;
   json j;
@@ -61,6 +61,9 @@ json fieldJson(const FieldData& d, const char* formatName) {
                  {"maxTextureSize", l.maxTextureSize},
                  {"maxLayers", l.maxLayers}};
   j["metadata"] = d.metadata.empty() ? json(nullptr) : json::parse(d.metadata, nullptr, false);
+  // The reader has checked META (rule 8001): a text nlohmann cannot hold has a number beyond binary64.
+  if (j["metadata"].is_discarded())
+    return makeError(Code::kUnsupported, "the source's META holds a number beyond the binary64 range");
   j["codec"] = codecName(d.codec);
   j["mapsPerBlock"] = d.mapsPerBlock;
   return j;

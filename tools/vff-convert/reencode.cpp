@@ -76,7 +76,9 @@ Result<std::string> appendProvenance(const std::string& metadata, const FieldDes
   nlohmann::json meta = nlohmann::json::object();
   if (!metadata.empty()) {
     meta = nlohmann::json::parse(metadata, nullptr, /*allow_exceptions=*/false);
-    if (meta.is_discarded()) return makeError(Code::kMetadataJson, "the source's META is not valid JSON");
+    // The reader has checked META (rule 8001): a text nlohmann cannot hold has a number beyond binary64.
+    if (meta.is_discarded())
+      return makeError(Code::kUnsupported, "the source's META holds a number beyond the binary64 range");
     if (!meta.is_object()) return makeError(Code::kMetadataNotObject, "the source's META is not a JSON object");
   }
   nlohmann::json& list = meta["vff.provenance"];

@@ -44,8 +44,10 @@ Result<std::string> provenanceJson(const FieldData& d, const VdbWriteOptions& o)
   json list = json::array();
   if (!d.metadata.empty()) {
     const json meta = json::parse(d.metadata, nullptr, false);
-    if (meta.is_discarded() || !meta.is_object())
-      return makeError(Code::kMetadataJson, "the source's META is not a JSON object");
+    // The reader has checked META (rule 8001): a text nlohmann cannot hold has a number beyond binary64.
+    if (meta.is_discarded())
+      return makeError(Code::kUnsupported, "the source's META holds a number beyond the binary64 range");
+    if (!meta.is_object()) return makeError(Code::kMetadataNotObject, "the source's META is not a JSON object");
     if (const auto it = meta.find("vff.provenance"); it != meta.end()) {
       if (!it->is_array()) return makeError(Code::kMetadataJson, "the source's META key \"vff.provenance\" is not an array");
       list = *it;
@@ -153,7 +155,9 @@ Status writeVdb(const std::string& path, const FieldData& d, const VdbWriteOptio
     dist->setGridClass(openvdb::GRID_UNKNOWN);
     dist->setCreator(std::string("vff-convert ") + kLibraryVersion);
     dist->insertMeta("vff.plane", openvdb::StringMetadata("distance"));
-    dist->insertMeta("vff.field", openvdb::StringMetadata(fieldJson(d, kFormatName).dump()));
+    const Result<json> field = fieldJson(d, kFormatName);
+    if (!field) return field.error();
+    dist->insertMeta("vff.field", openvdb::StringMetadata(field->dump()));
     dist->insertMeta("vff.provenance", openvdb::StringMetadata(*provenance));
     openvdb::Vec3fGrid::Ptr norm;
     if (normals) {
