@@ -23,6 +23,7 @@ std::string meshMetadata(const Options& o, const bake::BakeOptions& bo, const ba
       {"vff.generator", "vff-bake"},
       {"vff.generatorVersion", kLibraryVersion},
       {"vff.source", {{"name", baseName(o.mesh)}, {"format", info.format}, {"xxh3", cli::hexDigits64(bake::meshHash(mesh))},
+                      {"geometryHash", cli::hexDigits64(bake::geometryHash(mesh))},
                       {"vertices", mesh.vertexCount()}, {"triangles", mesh.triangleCount()}}},
       {"vff.bake", {{"rayOrigin", "texel centre"}, {"sphere", bo.sphere ? "user" : "minimal-enclosing"},
                     {"twoSided", true}, {"normals", o.normals ? (mesh.normals.empty() ? "geometric" : "interpolated") : "none"}}}};

@@ -42,7 +42,15 @@ Result<Mesh> loadMesh(const std::string& path, MeshInfo* info = nullptr);
 // and fails when none remain. `what` names the source in messages.
 Status checkMesh(Mesh* mesh, const std::string& what);
 
-// Content hash (XXH3-64 of the positions and indices) for provenance metadata.
+// Content hash (XXH3-64 of the positions and indices) for provenance metadata: it changes with the
+// vertex order, so the same geometry read from two file formats usually has two.
 uint64_t meshHash(const Mesh& mesh);
+
+// Canonical hash of the triangles (META vff.source.geometryHash, spec/format.md section 9): XXH3-64
+// of the triangles as 9 f32 each (vertex coordinates, -0 written as +0), every triangle rotated so
+// that its lexicographically smallest vertex comes first (the winding kept), the triangles sorted
+// lexicographically. It depends on the geometry only, not on vertex sharing, vertex order, triangle
+// order or file format.
+uint64_t geometryHash(const Mesh& mesh);
 
 }  // namespace vff::bake
