@@ -59,15 +59,15 @@ std::optional<int> checkPlan(const Result<FieldDesc>& field, const LayoutLimits&
   return std::nullopt;
 }
 
-std::optional<int> writeBaked(const Options& o, Writer& writer, const bake::BakedField& baked, double* seconds,
-                              uint64_t* fileBytes) {
+std::optional<int> writeBaked(const Options& o, const std::string& output, Writer& writer,
+                              const bake::BakedField& baked, double* seconds, uint64_t* fileBytes) {
   const auto t0 = std::chrono::steady_clock::now();
   Status st = writer.writeMaps(Plane::kDistance, baked.distance);
   if (st && o.normals) st = writer.writeMaps(Plane::kNormal, baked.normals);
   if (st) st = writer.finish();
-  if (!st) return cli::reportError(kProg, o.output, st.error());
+  if (!st) return cli::reportError(kProg, output, st.error());
   *seconds = secondsSince(t0);
-  if (auto f = File::open(o.output, {.checksums = ChecksumPolicy::kNone})) *fileBytes = f->info().fileSize;
+  if (auto f = File::open(output, {.checksums = ChecksumPolicy::kNone})) *fileBytes = f->info().fileSize;
   return std::nullopt;
 }
 

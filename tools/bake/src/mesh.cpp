@@ -98,18 +98,25 @@ uint64_t geometryHash(const Mesh& m) {
   return XXH3_64bits(bytes.data(), bytes.size());
 }
 
-Result<Mesh> loadMesh(const std::string& path, MeshInfo* info) {
-  struct stat st {};
-  if (stat(path.c_str(), &st) != 0) return makeError(Code::kIoOpen, path + ": " + std::strerror(errno));
-  if (!S_ISREG(st.st_mode)) return makeError(Code::kIoOpen, path + ": not a regular file");
+namespace detail {
+Status checkReadable(const std::string& path, struct stat* st) {
+  if (stat(path.c_str(), st) != 0) return makeError(Code::kIoOpen, path + ": " + std::strerror(errno));
+  if (!S_ISREG(st->st_mode)) return makeError(Code::kIoOpen, path + ": not a regular file");
   if (!std::ifstream(path, std::ios::binary)) return makeError(Code::kIoOpen, path + ": cannot be read");
+  return {};
+}
+}  // namespace detail
+
+Result<Mesh> loadMesh(const std::string& path, MeshInfo* info, const MeshLoadOptions& options) {
+  struct stat st {};
+  if (Status s = detail::checkReadable(path, &st); !s) return std::move(s).error();
   const std::string ext = lowerExtension(path);
   Result<Mesh> mesh = makeError(Code::kMeshFormat, "");
   if (ext == "obj" || ext == "ply" || ext == "off" || ext == "stl") {
     if (st.st_size == 0) return makeError(Code::kMeshEmpty, path + ": the file is empty");
     mesh = detail::loadWithOpenMesh(path, ext);
   } else if (ext == "gltf" || ext == "glb") {
-    mesh = detail::loadWithTinyGltf(path, ext == "glb");
+    mesh = detail::loadWithTinyGltf(path, ext == "glb", options, info);
   } else {
     return makeError(Code::kMeshFormat, path + ": unknown mesh extension '" + ext +
                                             "' (supported: .obj .ply .off .stl .gltf .glb)");

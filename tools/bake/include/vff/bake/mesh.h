@@ -2,8 +2,8 @@
 //
 // Supported inputs: OBJ, PLY (face lists, or `tristrips` with -1 restarts), OFF, STL (through
 // OpenMesh; polygons are triangulated) and glTF 2.0
-// .gltf/.glb (through tinygltf: every triangle primitive of the default scene, node transforms
-// applied). Content that cannot be baked is an error, never a silently empty mesh:
+// .gltf/.glb (through tinygltf: every triangle primitive of the default scene or a chosen one, node
+// transforms applied; vff/bake/gltf.h splits a scene into its meshes or nodes). Content that cannot be baked is an error, never a silently empty mesh:
 //   kIoOpen          the file is missing or unreadable
 //   kMeshFormat      unknown extension
 //   kMeshParse       the importer cannot parse the file
@@ -33,10 +33,20 @@ struct Mesh {
 
 struct MeshInfo {
   std::string format;  // "obj", "ply", "off", "stl", "gltf", "glb"
+  // glTF: the file's scenes (their names, "" when unnamed) and the one loaded (-1 when the file has
+  // no scene and every mesh was loaded untransformed).
+  std::vector<std::string> gltfScenes;
+  int gltfScene = -1;
+};
+
+struct MeshLoadOptions {
+  // glTF: the scene to load; -1: the file's default scene (`scene`), else scene 0. A scene that
+  // does not exist is kInvalidArgument, naming the scenes there are.
+  int gltfScene = -1;
 };
 
 // Loads and checks a mesh (see the error list above). Messages name the file.
-Result<Mesh> loadMesh(const std::string& path, MeshInfo* info = nullptr);
+Result<Mesh> loadMesh(const std::string& path, MeshInfo* info = nullptr, const MeshLoadOptions& options = {});
 
 // Checks a mesh held in memory: finite coordinates, indices in range, drops zero-area triangles,
 // and fails when none remain. `what` names the source in messages.
