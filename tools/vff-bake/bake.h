@@ -16,6 +16,7 @@
 #include "enum_option.h"
 #include "options_codec.h"
 #include "options_layout.h"
+#include "progress.h"
 #include "vff/bake/baker.h"
 #include "vff/vff.h"
 
@@ -63,19 +64,6 @@ bool isVdbPath(const std::string& p);
 bool isGltfPath(const std::string& p);
 
 // ---- What both bakes share (common.cpp) ---------------------------------------------------------
-// A progress line on stderr, redrawn at most 10 times a second, only when enabled (on a terminal).
-class Progress {
- public:
-  Progress(bool enabled, uint64_t raysPerMap) : enabled_(enabled), raysPerMap_(raysPerMap) {}
-  void update(uint64_t done, uint64_t total);
-
- private:
-  bool enabled_;
-  uint64_t raysPerMap_;
-  std::mutex mu_;
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now(), last_{};
-};
-
 // Seconds since `t0`.
 double secondsSince(std::chrono::steady_clock::time_point t0);
 // The last component of a path.

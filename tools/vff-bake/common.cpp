@@ -1,4 +1,4 @@
-// common.cpp - what vff-bake's two bakes share: the progress line, the checks of a planned field,
+// common.cpp - what vff-bake's bakes share: the checks of a planned field,
 // writing the maps and the summary (see bake.h).
 #include <sys/resource.h>
 
@@ -9,21 +9,6 @@
 #include "cli.h"
 
 namespace vff::bake_tool {
-
-void Progress::update(uint64_t done, uint64_t total) {
-  if (!enabled_) return;
-  const auto now = std::chrono::steady_clock::now();
-  std::lock_guard<std::mutex> lock(mu_);
-  if (done != total && now - last_ < std::chrono::milliseconds(100)) return;
-  last_ = now;
-  const double secs = std::chrono::duration<double>(now - start_).count();
-  const double rate = secs > 0 ? double(done * raysPerMap_) / secs : 0;
-  const double eta = done ? secs * double(total - done) / double(done) : 0;
-  std::fprintf(stderr, "\r%s: %" PRIu64 "/%" PRIu64 " maps, %.1f Mrays/s, ETA %.1f s   ", kProg, done, total,
-               rate / 1e6, eta);
-  if (done == total) std::fputc('\n', stderr);
-  std::fflush(stderr);
-}
 
 double secondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

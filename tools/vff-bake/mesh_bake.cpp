@@ -124,7 +124,7 @@ std::optional<int> traceAndBake(const Options& o, bake::BakeOptions bo, const ba
       m->raw = r == 0 ? st->seconds : std::min(m->raw, st->seconds);
     }
   }
-  Progress progress(!o.quiet && !o.json && !o.benchmark && isatty(2), uint64_t(o.mapSize) * o.mapSize);
+  cli::Progress progress(kProg, !o.quiet && !o.json && !o.benchmark && isatty(2), uint64_t(o.mapSize) * o.mapSize);
   bo.progress = [&](uint64_t d, uint64_t t) { progress.update(d, t); };
   for (int r = 0; r < (o.benchmark ? o.repeat : 1); ++r) {
     auto b = bake::bakeField(scene, bo);

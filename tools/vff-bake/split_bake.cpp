@@ -92,7 +92,7 @@ int bakeGltfSplit(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
       removeAll(written);
       return cli::reportError(kProg, o.mesh, embree.error());
     }
-    Progress progress(!o.quiet && !o.json && isatty(2), uint64_t(o.mapSize) * o.mapSize);
+    cli::Progress progress(kProg, !o.quiet && !o.json && isatty(2), uint64_t(o.mapSize) * o.mapSize);
     bo.progress = [&](uint64_t d, uint64_t t) { progress.update(d, t); };
     auto baked = bake::bakeField(*embree, bo);
     if (!baked) {
