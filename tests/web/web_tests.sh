@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# web/ tests: each test_NAME is one ctest case web.NAME (tests/CMakeLists.txt, vff_script_tests).
+# Needs node and web/node_modules (scripts/setup.sh runs `npm ci`); the browser cases also need
+# Debian's chromium. A missing piece prints SKIP and the reason, and exits 77 (ctest: skipped).
+source "$(dirname "$0")/../common/cli_harness.sh"
+WEB="${VFF_SOURCE_DIR:-$(cd "$(dirname "$0")/../.." && pwd)}/web"
+
+skip() { echo "SKIP: $1"; exit 77; }
+need_node() {
+  command -v node >/dev/null || skip "node is not installed (scripts/setup.sh installs nodejs)"
+  [[ -d $WEB/node_modules/fzstd && -d $WEB/node_modules/hash-wasm ]] || skip "no $WEB/node_modules: run scripts/setup.sh (npm ci in web/)"
+}
+need_chromium() {
+  need_node
+  [[ -d $WEB/node_modules/playwright-core ]] || skip "no playwright-core in $WEB/node_modules: run scripts/setup.sh"
+  command -v "${VFF_CHROMIUM:-chromium}" >/dev/null || skip "no chromium (apt-get install chromium)"
+}
+node_test() {
+  (cd "$WEB" && node --test "$@") >"$WORK/out" 2>"$WORK/err"
+  RC=$?
+  grep -E '^# (pass|fail)' "$WORK/out"
+  [[ $RC -eq 0 ]] || { show; fail "node --test $* failed"; }
+}
+
+# Every valid conformance vector decodes to its expected.json; every invalid one raises its ID.
+test_node_conformance() { need_node; node_test test/conformance.test.js; }
+
+# The spec's worked examples: hits-med, BC4, normals, positions, nearest sample, layout.
+test_node_units() { need_node; node_test test/units.test.js; }
+
+run_test "$1"
