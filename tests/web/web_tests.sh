@@ -28,4 +28,7 @@ test_node_conformance() { need_node; node_test test/conformance.test.js; }
 # The spec's worked examples: hits-med, BC4, normals, positions, nearest sample, layout.
 test_node_units() { need_node; node_test test/units.test.js; }
 
+# web/src/vff_query_es.js is exactly what web/tools/gen-glsl-es.mjs makes from gpu/glsl/vff_query.glsl.
+test_glsl_es_generated() { need_node; node_test test/glsl.test.js; }
+
 run_test "$1"
