@@ -31,4 +31,16 @@ test_node_units() { need_node; node_test test/units.test.js; }
 # web/src/vff_query_es.js is exactly what web/tools/gen-glsl-es.mjs makes from gpu/glsl/vff_query.glsl.
 test_glsl_es_generated() { need_node; node_test test/glsl.test.js; }
 
+# In headless Chromium: the decoder decodes the conformance vectors as under node.
+test_browser_decoder() { need_chromium; node_test test/browser/decoder.browser.js; }
+
+# In headless Chromium: the page loads a baked bunny, renders it with WebGL2, and its ground
+# matches the C++ reference render (vff_web_reference) of the same view.
+test_browser_render() {
+  need_chromium
+  [[ -x ${VFF_BAKE:-} ]] || skip "vff-bake is not built (needs Embree)"
+  [[ -f /usr/share/glmark2/models/bunny.obj ]] || skip "no /usr/share/glmark2/models/bunny.obj (apt-get install glmark2-data)"
+  VFF_WORK="$WORK" node_test test/browser/render.browser.js
+}
+
 run_test "$1"

@@ -1,0 +1,85 @@
+// The decoder inside headless Chromium: the page's module decodes every conformance vector as
+// node does (valid ones to their expected values, invalid ones to their folder's ID).
+import { test, after, before } from 'node:test';
+import assert from 'node:assert/strict';
+import { readdirSync } from 'node:fs';
+import { join } from 'node:path';
+import { serve, launch, WEB } from './harness.js';
+
+const CONF = join(WEB, '..', 'spec', 'conformance');
+let srv, browser, page;
+before(async () => {
+  const extra = {};
+  for (const n of readdirSync(join(CONF, 'valid'))) extra[`/conf/valid/${n}`] = join(CONF, 'valid', n);
+  for (const id of readdirSync(join(CONF, 'invalid')))
+    for (const n of readdirSync(join(CONF, 'invalid', id))) extra[`/conf/invalid/${id}/${n}`] = join(CONF, 'invalid', id, n);
+  srv = await serve(extra);
+  browser = await launch();
+  page = await browser.newPage();
+  await page.goto(`${srv.url}/index.html`);
+});
+after(async () => { await browser?.close(); srv?.server.close(); });
+
+test('valid vectors decode in the browser as their expected.json says', async () => {
+  const names = readdirSync(join(CONF, 'valid')).filter((n) => n.endsWith('.vff'));
+  const results = await page.evaluate(async (names) => {
+    const { initVff, openVff, xxh3Hex } = await import('./src/vff.js');
+    await initVff();
+    const out = [];
+    for (const n of names) {
+      const bytes = new Uint8Array(await (await fetch(`/conf/valid/${n}`)).arrayBuffer());
+      const exp = await (await fetch(`/conf/valid/${n.replace(/\.vff$/, '.expected.json')}`)).json();
+      const bad = [];
+      try {
+        const f = openVff(bytes);
+        f.validateDeep();
+        for (const m of exp.maps) {
+          if (xxh3Hex(f.mapBytes('distance', m.map)) !== m.distanceXxh3) bad.push(`map ${m.map} hash`);
+          const d = f.distances(m.map);
+          m.distance.forEach((v, t) => {
+            const ok = v === null ? Number.isNaN(d[t]) : f.field.distanceEncoding === 4 ? !Number.isNaN(d[t]) === (v === 1) : Math.abs(d[t] - v) <= 2e-6 * Math.max(1, Math.abs(v));
+            if (!ok) bad.push(`map ${m.map} texel ${t}`);
+          });
+        }
+        for (const [p, hs] of Object.entries(exp.slices)) hs.forEach((h, s) => { if (xxh3Hex(f.slice(p, s)) !== h) bad.push(`${p} slice ${s}`); });
+      } catch (e) { bad.push(String(e.message)); }
+      out.push({ n, bad: bad.slice(0, 3) });
+    }
+    return out;
+  }, names);
+  assert.equal(results.length, 16);
+  for (const r of results) assert.deepEqual(r.bad, [], r.n);
+});
+
+test('invalid vectors are rejected in the browser with their IDs', async () => {
+  const cases = [];
+  for (const id of readdirSync(join(CONF, 'invalid')))
+    for (const n of readdirSync(join(CONF, 'invalid', id)).filter((x) => x.endsWith('.vff'))) cases.push([id, n]);
+  const got = await page.evaluate(async (cases) => {
+    const { initVff, openVff } = await import('./src/vff.js');
+    await initVff();
+    const out = [];
+    for (const [id, n] of cases) {
+      const bytes = new Uint8Array(await (await fetch(`/conf/invalid/${id}/${n}`)).arrayBuffer());
+      let code = 0;
+      try {
+        const f = openVff(bytes);
+        f.validateDeep();
+      } catch (e) { code = e.id ?? -1; }
+      out.push([id, n, code]);
+    }
+    return out;
+  }, cases);
+  assert.ok(got.length >= 80);
+  for (const [id, n, code] of got) assert.equal(code, Number(id), `${id}/${n}`);
+});
+
+test('the page names an invalid file\'s ID', async () => {
+  const r = await page.evaluate(async () => {
+    const bytes = new Uint8Array(await (await fetch('/conf/invalid/2002/magic-byte0.vff')).arrayBuffer());
+    const res = await window.vffViewer.loadBytes(bytes, 'magic-byte0.vff');
+    return { res, text: document.getElementById('error').textContent };
+  });
+  assert.equal(r.res.id, 2002);
+  assert.match(r.text, /bad-magic \(2002\)/);
+});
