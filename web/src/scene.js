@@ -79,8 +79,9 @@ void main() {
   // The object: the field answers the camera ray in object space.
   vec3 oo = c + transpose(uObject) * (uEye - c);
   vec3 od = transpose(uObject) * d;
-  VffHit h = uInterpolated != 0 ? vffIntersectInterpolated(oo, od, 0.0, 1e30, 0.0)
-                                : vffIntersect(oo, od, 0.0, 1e30, 0.0);
+  VffHit h;
+  if (uInterpolated != 0) h = vffIntersectInterpolated(oo, od, 0.0, 1e30, 0.0);
+  else h = vffIntersect(oo, od, 0.0, 1e30, 0.0);
   if (h.hit && h.t < tGround) {
     vec3 n = h.hasNormal ? uObject * h.normal : -d;
     if (dot(n, d) > 0.0) n = -n;
