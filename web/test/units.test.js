@@ -66,3 +66,18 @@ test('canonical layout of format.md section 12', () => {
   assert.equal(computeLayout({ mapCount: 4226, mapResolution: 64, distanceEncoding: 1 }, { gutter: 1 }).tilesPerRow, 31);
   assert.equal(computeLayout({ mapCount: 4226, mapResolution: 64, distanceEncoding: 1 }, { maxLayers: 4 }).id, 7003);
 });
+
+test('a layout beyond the context limits is repacked, naming the limit and vff-convert options', async () => {
+  const { chooseLayout } = await import('../src/gpu.js');
+  const field = { mapCount: 4226, mapResolution: 64, distanceEncoding: 1 };
+  const layout = { target: 1, gutter: 0, tileSize: 64, tilesPerRow: 64, tilesPerColumn: 64, sliceWidth: 4096, sliceHeight: 4096, sliceCount: 2 };
+  assert.equal(chooseLayout({ field, layout }, { maxTextureSize: 8192, maxLayers: 2048, max3d: 2048 }).layout, layout);
+  const r = chooseLayout({ field, layout }, { maxTextureSize: 2048, maxLayers: 256, max3d: 256 });
+  assert.equal(r.layout.sliceWidth, 2048);
+  assert.equal(r.layout.sliceCount, 5);
+  assert.match(r.note, /exceed MAX_TEXTURE_SIZE 2048/);
+  assert.match(r.note, /vff-convert in\.vff --to vff out\.vff --target 2d-array --max-texture-size 2048 --max-layers 256/);
+  const none = chooseLayout({ field, layout }, { maxTextureSize: 2048, maxLayers: 4, max3d: 256 });
+  assert.match(none.error, /5 slices exceed the layer limit 4/);
+  assert.match(none.error, /--map-size 32/);
+});

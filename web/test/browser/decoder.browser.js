@@ -83,3 +83,37 @@ test('the page names an invalid file\'s ID', async () => {
   assert.equal(r.res.id, 2002);
   assert.match(r.text, /bad-magic \(2002\)/);
 });
+
+test('the page uploads and renders every valid vector (2D array and 3D, every encoding, normals)', async () => {
+  const names = readdirSync(join(CONF, 'valid')).filter((n) => n.endsWith('.vff'));
+  const got = await page.evaluate(async (names) => {
+    const out = [];
+    const canvas = document.getElementById('view');
+    for (const n of names) {
+      const bytes = new Uint8Array(await (await fetch(`/conf/valid/${n}`)).arrayBuffer());
+      canvas.width = 32; canvas.height = 32;
+      let res;
+      try {
+        res = await window.vffViewer.loadBytes(bytes, n);
+        Object.assign(window.vffViewer.view, { reference: false, interpolated: true, aoRays: 4 });
+        window.vffViewer.redraw();
+        window.vffViewer.view.interpolated = false;
+        window.vffViewer.redraw();
+      } catch (e) { res = { error: String(e.message).slice(0, 300) }; }
+      const gl = canvas.getContext('webgl2');
+      const px = new Uint8Array(32 * 32 * 4);
+      gl.readPixels(0, 0, 32, 32, gl.RGBA, gl.UNSIGNED_BYTE, px);
+      let object = 0;  // pixels of the object's warm colours (red clearly above blue)
+      for (let i = 0; i < px.length; i += 4) object += px[i] > px[i + 2] + 40;
+      out.push({ n, res, glError: gl.getError(), object });
+    }
+    return out;
+  }, names);
+  console.log(got.map((r) => `${r.n}: ${r.object} object pixels of 1024`).join('\n'));
+  for (const r of got) {
+    assert.deepEqual(r.res, { ok: true, gl: true }, r.n);
+    assert.equal(r.glError, 0, r.n);
+  }
+  // Fields whose object fills part of the default view show it (all but the tiny-map ones may).
+  assert.ok(got.filter((r) => r.object > 0).length >= 8, JSON.stringify(got.map((r) => [r.n, r.object])));
+});
