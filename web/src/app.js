@@ -10,8 +10,11 @@ const $ = (id) => document.getElementById(id);
 const view = { yaw: 0.6, pitch: -0.35, distance: 5, objectYaw: 0, objectPitch: 0, lightYaw: -0.8, lightPitch: 0.9, interpolated: false, reference: false, aoRays: 16 };
 let state = null;
 
-/** Loads bytes named `name` into the page; returns {ok, id?, message?} (the tests call it). */
-export async function loadBytes(bytes, name) {
+/**
+ * Loads bytes named `name` into the page; returns {ok, gl, id?, message?} (the tests call it).
+ * options.bc4OnCpu: decode bc4-diameter maps on the CPU even where the context has RGTC.
+ */
+export async function loadBytes(bytes, name, options = {}) {
   await initVff();
   $('error').textContent = ''; $('note').textContent = ''; $('summary').textContent = '';
   let file;
@@ -26,12 +29,12 @@ export async function loadBytes(bytes, name) {
   attachSheet($('sheet'), file, $('under'));
   const gl = $('view').getContext('webgl2', { preserveDrawingBuffer: true, antialias: false });
   if (!gl) { $('error').textContent = 'This browser has no WebGL2 context.'; return { ok: true, gl: false }; }
-  const up = uploadField(gl, file);
+  const up = uploadField(gl, file, options);
   if (up.error) { $('error').textContent = up.error; return { ok: true, gl: false, message: up.error }; }
   if (up.note) $('note').textContent = up.note;
   state = { gl, file, field: up.field, program: createProgram(gl, up.field) };
   redraw();
-  return { ok: true, gl: true };
+  return { ok: true, gl: true, ...(up.bc4 ? { bc4: up.bc4 } : {}) };
 }
 
 /** Draws a frame now; returns the milliseconds until the GPU finished it. */

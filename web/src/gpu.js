@@ -52,10 +52,11 @@ function texture(gl, is3d, fmt, width, height, layers, sliceData) {
 
 /**
  * Uploads a file. Returns {field: {defines, center, radius}, layout, note} or {error}.
- * bc4-diameter maps are decoded to unorm8 codes on the CPU and uploaded as R8UI, which every
- * WebGL2 context has (RGTC is an extension).
+ * bc4-diameter blocks are uploaded as they are (COMPRESSED_RED_RGTC1) when the context has
+ * EXT_texture_compression_rgtc and options.bc4OnCpu is not set; otherwise they are decoded to unorm8
+ * codes on the CPU and uploaded as R8UI, which every WebGL2 context has.
  */
-export function uploadField(gl, file) {
+export function uploadField(gl, file, options = {}) {
   const chosen = chooseLayout(file, contextLimits(gl));
   if (chosen.error) return chosen;
   const L = chosen.layout, fd = file.field, e = fd.distanceEncoding, M = fd.mapResolution;
@@ -71,9 +72,20 @@ export function uploadField(gl, file) {
     else if (e === 5) data = (s) => composeSlice(L, plane('bytes', 1, 0xff), s, (k) => file.codes(k));
     else data = (s) => composeSlice(L, plane('bytes', 1, 0xff), s, (k) => file.mapBytes('distance', k));
   }
-  gl.activeTexture(gl.TEXTURE0);
-  texture(gl, is3d, fmt, width, L.sliceHeight, L.sliceCount, data);
   const defines = [];
+  const rgtc = e === 5 && !options.bc4OnCpu ? gl.getExtension('EXT_texture_compression_rgtc') : null;
+  gl.activeTexture(gl.TEXTURE0);
+  if (rgtc) {
+    defines.push('VFF_MAPS_BC4');
+    const t = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_2D_ARRAY, t);
+    gl.texParameteri(gl.TEXTURE_2D_ARRAY, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
+    gl.texParameteri(gl.TEXTURE_2D_ARRAY, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
+    gl.texStorage3D(gl.TEXTURE_2D_ARRAY, 1, rgtc.COMPRESSED_RED_RGTC1_EXT, L.sliceWidth, L.sliceHeight, L.sliceCount);
+    for (let s = 0; s < L.sliceCount; ++s)
+      gl.compressedTexSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, s, L.sliceWidth, L.sliceHeight, 1, rgtc.COMPRESSED_RED_RGTC1_EXT,
+        composeSlice(L, plane('bc4', 1, 0xff), s, (k) => file.mapBytes('distance', k)));
+  } else texture(gl, is3d, fmt, width, L.sliceHeight, L.sliceCount, data);
   if (is3d) defines.push('VFF_MAPS_3D');
   if (file.planes.normal) {
     gl.activeTexture(gl.TEXTURE1);
@@ -96,5 +108,5 @@ export function uploadField(gl, file) {
   gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
   gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
   gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, pw, ph, 0, gl.RGBA, gl.FLOAT, padded);
-  return { field: { defines, center: fd.sphere.center, radius: fd.sphere.radius }, layout: L, note: chosen.note };
+  return { field: { defines, center: fd.sphere.center, radius: fd.sphere.radius }, layout: L, note: chosen.note, bc4: rgtc ? 'gpu' : e === 5 ? 'cpu' : null };
 }
