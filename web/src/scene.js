@@ -21,6 +21,7 @@ uniform vec3 uLight;        // unit direction towards the light
 uniform int uInterpolated;
 uniform int uReference;     // 1: ground AO seen from straight above, grey levels
 uniform int uAoRays;
+uniform int uShadowRays;
 out vec4 fragColor;
 
 const int AO_RAYS = ${AO_RAYS};
@@ -56,10 +57,11 @@ float softShadow(vec3 p) {
   vec3 b = cross(uLight, t);
   float lit = 0.0;
   for (int i = 0; i < 8; ++i) {
-    float a = float(i) * 2.39996323, r = 0.12 * sqrt((float(i) + 0.5) / 8.0);
+    if (i >= uShadowRays) break;
+    float a = float(i) * 2.39996323, r = 0.12 * sqrt((float(i) + 0.5) / float(uShadowRays));
     lit += openShare(p, normalize(uLight + r * (cos(a) * t + sin(a) * b)), 1e30);
   }
-  return lit / 8.0;
+  return lit / float(uShadowRays);
 }
 
 void main() {
@@ -145,7 +147,7 @@ function rotation(yaw, pitch) {
 
 /**
  * Draws one frame. view: {yaw, pitch, distance (in R), objectYaw, objectPitch, lightYaw,
- * lightPitch, interpolated, reference, aoRays}.
+ * lightPitch, interpolated, reference, aoRays, moving}.
  */
 export function draw(gl, program, field, view) {
   const [w, h] = [gl.drawingBufferWidth, gl.drawingBufferHeight];
@@ -163,6 +165,8 @@ export function draw(gl, program, field, view) {
   gl.uniform3f(u('uLight'), Math.cos(lp) * Math.sin(ly), Math.sin(lp), Math.cos(lp) * Math.cos(ly));
   gl.uniform1i(u('uInterpolated'), view.interpolated ? 1 : 0);
   gl.uniform1i(u('uReference'), view.reference ? 1 : 0);
-  gl.uniform1i(u('uAoRays'), Math.min(view.aoRays ?? 16, AO_RAYS));
+  // While the user drags, fewer rays keep the view responsive; the full frame follows on release.
+  gl.uniform1i(u('uAoRays'), view.moving ? 4 : Math.min(view.aoRays ?? 16, AO_RAYS));
+  gl.uniform1i(u('uShadowRays'), view.moving ? 2 : 8);
   gl.drawArrays(gl.TRIANGLES, 0, 3);
 }
