@@ -25,6 +25,9 @@ node_test() {
 # Every valid conformance vector decodes to its expected.json; every invalid one raises its ID.
 test_node_conformance() { need_node; node_test test/conformance.test.js; }
 
+# Damaged vectors (cut, single bytes changed): read completely or rejected with a 2xxx-8xxx ID.
+test_node_robustness() { need_node; node_test test/robustness.test.js; }
+
 # The spec's worked examples: hits-med, BC4, normals, positions, nearest sample, layout.
 test_node_units() { need_node; node_test test/units.test.js; }
 
