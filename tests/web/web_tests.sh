@@ -28,6 +28,13 @@ test_node_conformance() { need_node; node_test test/conformance.test.js; }
 # Damaged vectors (cut, single bytes changed): read completely or rejected with a 2xxx-8xxx ID.
 test_node_robustness() { need_node; node_test test/robustness.test.js; }
 
+# The page's summary is, line for line, what vff-inspect prints for each valid vector.
+test_node_summary() {
+  need_node
+  [[ -x ${VFF_INSPECT:-} ]] || skip "vff-inspect is not built"
+  node_test test/summary.test.js
+}
+
 # The spec's worked examples: hits-med, BC4, normals, positions, nearest sample, layout.
 test_node_units() { need_node; node_test test/units.test.js; }
 

@@ -67,7 +67,7 @@ function readHeader(r, opt, warnings) {
   const sum = xxh3Hex(r.bytes.subarray(0, 56), r.bytes.subarray(to, to + 64 * count));
   require(sum === hex64(r.u64(56)), 3005, `headerChecksum ${hex64(r.u64(56))}, computed ${sum}`, { offset: 56 });
   return {
-    versionMajor, versionMinor: r.u16(10), fileSize: n, incompatFeatures: num(incompat),
+    versionMajor, versionMinor: r.u16(10), fileSize: n, incompatFeatures: num(incompat), headerChecksum: hex64(r.u64(56)),
     roCompatFeatures: num(roCompat), sectionTableOffset: to, sectionCount: count, checksumAlgorithm: 1,
   };
 }
