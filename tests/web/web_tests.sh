@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # web/ tests: each test_NAME is one ctest case web.NAME (tests/CMakeLists.txt, vff_script_tests).
 # Needs node and web/node_modules (scripts/setup.sh runs `npm ci`); the browser cases also need
-# Debian's chromium. A missing piece prints SKIP and the reason, and exits 77 (ctest: skipped).
+# Debian's chromium (VFF_CHROMIUM: another command name). A missing piece prints SKIP and the
+# reason, and exits 77 (ctest: skipped).
 source "$(dirname "$0")/../common/cli_harness.sh"
 WEB="${VFF_SOURCE_DIR:-$(cd "$(dirname "$0")/../.." && pwd)}/web"
 
@@ -13,7 +14,8 @@ need_node() {
 need_chromium() {
   need_node
   [[ -d $WEB/node_modules/playwright-core ]] || skip "no playwright-core in $WEB/node_modules: run scripts/setup.sh"
-  command -v "${VFF_CHROMIUM:-chromium}" >/dev/null || skip "no chromium (apt-get install chromium)"
+  VFF_CHROMIUM_PATH="$(command -v "${VFF_CHROMIUM:-chromium}")" || skip "no chromium (apt-get install chromium)"
+  export VFF_CHROMIUM_PATH
 }
 node_test() {
   (cd "$WEB" && node --test "$@") >"$WORK/out" 2>"$WORK/err"

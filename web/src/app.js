@@ -9,6 +9,7 @@ import { createProgram, draw } from './scene.js';
 const $ = (id) => document.getElementById(id);
 const view = { yaw: 0.6, pitch: -0.35, distance: 5, objectYaw: 0, objectPitch: 0, lightYaw: -0.8, lightPitch: 0.9, interpolated: false, reference: false, aoRays: 16 };
 let state = null;
+const programs = new Map();
 
 /**
  * Loads bytes named `name` into the page; returns {ok, gl, id?, message?} (the tests call it).
@@ -32,7 +33,10 @@ export async function loadBytes(bytes, name, options = {}) {
   const up = uploadField(gl, file, options);
   if (up.error) { $('error').textContent = up.error; return { ok: true, gl: false, message: up.error }; }
   if (up.note) $('note').textContent = up.note;
-  state = { gl, file, field: up.field, program: createProgram(gl, up.field) };
+  // Programs depend only on the defines (3D target, normals, BC4): compile each variant once.
+  const key = up.field.defines.join(' ');
+  if (!programs.has(key)) programs.set(key, createProgram(gl, up.field));
+  state = { gl, file, field: up.field, program: programs.get(key) };
   redraw();
   return { ok: true, gl: true, ...(up.bc4 ? { bc4: up.bc4 } : {}) };
 }

@@ -153,6 +153,7 @@ export function draw(gl, program, field, view) {
   const [w, h] = [gl.drawingBufferWidth, gl.drawingBufferHeight];
   gl.viewport(0, 0, w, h);
   gl.useProgram(program);
+  gl.uniformBlockBinding(program, gl.getUniformBlockIndex(program, 'VffFieldBlock'), 0);
   const u = (n) => gl.getUniformLocation(program, n);
   const c = field.center, R = field.radius;
   const cam = rotation(view.yaw, view.pitch);
