@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "gltf_extensions.h"
 #include "mesh_importers.h"
 
 namespace vff::bake::detail {
@@ -186,9 +187,10 @@ Result<std::shared_ptr<const tinygltf::Model>> parseGltf(const std::string& path
   auto model = std::make_shared<tinygltf::Model>();
   std::string err, warn;
   bool ok = false;
+  std::vector<unsigned char> bytes;
+  if (Status pre = prepareGltf(path, binary, &bytes); !pre) return std::move(pre).error();
   try {
-    ok = binary ? loader.LoadBinaryFromFile(model.get(), &err, &warn, path)
-                : loader.LoadASCIIFromFile(model.get(), &err, &warn, path);
+    ok = parsePreparedGltf(loader, model.get(), &err, &warn, bytes, path, binary);
   } catch (const std::exception& e) {
     return makeError(Code::kMeshParse, path + ": " + e.what());
   }
@@ -196,8 +198,6 @@ Result<std::shared_ptr<const tinygltf::Model>> parseGltf(const std::string& path
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
     return makeError(Code::kMeshParse, path + ": " + (err.empty() ? std::string("cannot parse glTF") : err));
   }
-  for (const std::string& ext : model->extensionsRequired)
-    return makeError(Code::kMeshUnsupported, path + ": required extension " + ext + " is not supported");
   return std::shared_ptr<const tinygltf::Model>(std::move(model));
 }
 
