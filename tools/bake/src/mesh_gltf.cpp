@@ -46,7 +46,7 @@ class Importer {
       std::vector<float> nrm;
       auto nit = p.attributes.find("NORMAL");
       if (nit != p.attributes.end()) {
-        s = readVec3(nit->second, where + " NORMAL", &nrm);
+        s = readVec3(nit->second, where + " NORMAL", &nrm, true);
         if (!s) return s;
         if (nrm.size() != xyz.size()) nrm.clear();
       }
@@ -128,17 +128,16 @@ class Importer {
     return {};
   }
 
-  Status readVec3(int accessor, const std::string& what, std::vector<float>* out3) {
+  Status readVec3(int accessor, const std::string& what, std::vector<float>* out3, bool isNormal = false) {
     const uint8_t* d;
     size_t stride, count;
     int ct, type;
-    Status s = view(accessor, what, 12, &d, &stride, &count, &ct, &type);
+    const bool known = accessor >= 0 && size_t(accessor) < model_.accessors.size();
+    const size_t cs = known ? gltfComponentSize(model_.accessors[size_t(accessor)].componentType) : 0;
+    Status s = view(accessor, what, 3 * (cs ? cs : 4), &d, &stride, &count, &ct, &type);
     if (!s) return s;
-    if (type != TINYGLTF_TYPE_VEC3 || ct != TINYGLTF_COMPONENT_TYPE_FLOAT)
-      return makeError(Code::kMeshUnsupported, what + ": only float VEC3 data is supported (quantised meshes are not)");
-    out3->resize(count * 3);
-    for (size_t i = 0; i < count; ++i) std::memcpy(&(*out3)[3 * i], d + i * stride, 12);
-    return {};
+    if (type != TINYGLTF_TYPE_VEC3) return makeError(Code::kMeshUnsupported, what + ": only VEC3 data is supported");
+    return convertVec3(d, stride, count, ct, model_.accessors[size_t(accessor)].normalized, isNormal, what, out3);
   }
 
   Status readIndices(int accessor, const std::string& what, size_t vertexCount, std::vector<uint32_t>* idx) {
