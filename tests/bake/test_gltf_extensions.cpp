@@ -14,6 +14,7 @@
 #include "gltf_writer.h"
 #include "vff/bake/baker.h"
 #include "vff/bake/procedural.h"
+#include "vff/bake/sphere.h"
 
 namespace vff::bake {
 namespace {
@@ -57,7 +58,7 @@ class GltfExtensions : public ::testing::Test {
     const std::string p = (dir_ / name).string();
     EXPECT_TRUE(save(doc, p, glb)) << p;
     Result<Mesh> m = loadMesh(p);
-    EXPECT_TRUE(m.ok()) << m.error().toString();
+    EXPECT_TRUE(m.ok()) << (m.ok() ? std::string() : m.error().toString());
     return m.ok() ? std::move(*m) : Mesh{};
   }
   fs::path dir_;
@@ -79,6 +80,38 @@ double maxNormalError(const Mesh& a, const Mesh& b) {
     for (size_t d = 0; d < 3; ++d) e = std::max(e, std::fabs(double(a.normals[i + d]) - b.normals[i + d] / l));
   }
   return e;
+}
+
+// The triangles of m as position triples, each rotated to start at its smallest vertex (winding
+// kept), sorted: equal for meshes with the same triangles in any vertex and triangle order.
+std::vector<std::array<float, 9>> triangleSet(const Mesh& m) {
+  std::vector<std::array<float, 9>> out;
+  for (size_t t = 0; t < m.indices.size(); t += 3) {
+    std::array<std::array<float, 3>, 3> v;
+    for (size_t k = 0; k < 3; ++k)
+      for (size_t d = 0; d < 3; ++d) v[k][d] = m.positions[3 * m.indices[t + k] + d];
+    std::rotate(v.begin(), std::min_element(v.begin(), v.end()), v.end());
+    std::array<float, 9> flat;
+    for (size_t k = 0; k < 9; ++k) flat[k] = v[k / 3][k % 3];
+    out.push_back(flat);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// The distance maps of a small bake of m inside the given sphere (the plain mesh's, so that only the
+// triangles can make a difference).
+std::vector<uint8_t> bakeDistances(const Mesh& m, const Sphere& sphere) {
+  BakeOptions o;
+  o.positionParam = 3;
+  o.mapResolution = 16;
+  o.sphere = sphere;
+  Result<Scene> scene = Scene::create(m, 1);
+  EXPECT_TRUE(scene.ok()) << scene.error().toString();
+  if (!scene.ok()) return {};
+  Result<BakedField> baked = bakeField(*scene, o);
+  EXPECT_TRUE(baked.ok()) << baked.error().toString();
+  return baked.ok() ? baked->distance : std::vector<uint8_t>{};
 }
 
 class GltfQuantized : public GltfExtensions, public ::testing::WithParamInterface<std::tuple<int, bool>> {};
@@ -130,6 +163,43 @@ TEST_F(GltfExtensions, DisallowedNormalTypeIsUnsupported) {
   ASSERT_FALSE(got.ok());
   EXPECT_EQ(got.error().code, Code::kMeshUnsupported);
   EXPECT_NE(got.error().message.find("NORMAL: component type 5123"), std::string::npos) << got.error().message;
+}
+
+// Sequential Draco keeps the vertex and triangle order: the importer returns the mesh itself.
+TEST_F(GltfExtensions, DracoSequentialLoadsTheMeshExactly) {
+  const Mesh m = knot();
+  const Mesh got = roundTrip(makeDracoGltf(m, true), "d.gltf", false);
+  EXPECT_EQ(got.positions, m.positions);
+  EXPECT_EQ(got.normals, m.normals);
+  EXPECT_EQ(got.indices, m.indices);
+}
+
+// Edgebreaker reorders vertices and triangles: the same triangles, and the same field as the plain
+// file's, loaded in the same process (Draco's copy of tinygltf must not replace the importer's).
+TEST_F(GltfExtensions, DracoEdgebreakerBakesTheSameField) {
+  const Mesh m = knot();
+  const Mesh plain = roundTrip(makeGltf(m, {}), "p.gltf", false);
+  const Mesh draco = roundTrip(makeDracoGltf(m, false), "d.glb", true);
+  ASSERT_EQ(draco.triangleCount(), m.triangleCount());
+  EXPECT_NE(draco.positions, plain.positions) << "edgebreaker kept the order: this test checks nothing";
+  EXPECT_EQ(triangleSet(draco), triangleSet(m));
+  const Sphere s = minimalEnclosingSphere(plain.positions);
+  const std::vector<uint8_t> a = bakeDistances(plain, s), b = bakeDistances(draco, s);
+  ASSERT_FALSE(a.empty());
+  EXPECT_EQ(a, b);
+}
+
+// Draco data that does not decode is invalid input naming the primitive.
+TEST_F(GltfExtensions, CorruptDracoDataIsInvalidInput) {
+  GltfDoc doc = makeDracoGltf(knot(), false);
+  for (size_t i = 16; i < doc.bin.size(); ++i) doc.bin[i] = uint8_t(i * 37);
+  const std::string p = (dir_ / "bad.glb").string();
+  ASSERT_TRUE(save(doc, p, true));
+  Result<Mesh> got = loadMesh(p);
+  ASSERT_FALSE(got.ok());
+  EXPECT_EQ(got.error().code, Code::kMeshParse);
+  EXPECT_NE(got.error().message.find("bad.glb: mesh '' primitive 0: Draco data cannot be decoded"), std::string::npos)
+      << got.error().message;
 }
 
 }  // namespace

@@ -16,8 +16,9 @@ namespace vff::bake::detail {
 
 // gltf_prepare.cpp: reads the file and refuses (kMeshUnsupported, naming the extension and the
 // file) any required extension that is not KHR_mesh_quantization, KHR_draco_mesh_compression or
-// EXT_meshopt_compression, before a parse error can hide it. Meshopt fallback buffers without a
-// uri get a placeholder so that tinygltf reads the file; *bytes is then what tinygltf should parse.
+// EXT_meshopt_compression, before a parse error can hide it. What tinygltf would refuse in a valid
+// compressed file is mended (meshopt fallback buffers without a uri get a placeholder, Draco
+// primitives lose indices that have no data); *bytes is then what tinygltf should parse.
 // A file whose JSON cannot be read is passed on unchanged: tinygltf reports the error.
 Status prepareGltf(const std::string& path, bool binary, std::vector<unsigned char>* bytes);
 

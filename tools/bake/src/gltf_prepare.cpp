@@ -58,6 +58,31 @@ bool placeholderFallbacks(nlohmann::json* doc) {
   return changed;
 }
 
+// tinygltf refuses a primitive whose indices accessor has no buffer view, as a Draco primitive's
+// has (its indices exist only compressed): such indices are left out, and the Draco decoder gives
+// the primitive the decoded ones.
+bool dropDracoIndices(nlohmann::json* doc) {
+  bool changed = false;
+  auto meshes = doc->find("meshes");
+  auto accessors = doc->find("accessors");
+  if (meshes == doc->end() || !meshes->is_array() || accessors == doc->end() || !accessors->is_array()) return false;
+  for (auto& m : *meshes) {
+    if (!m.is_object() || !m.contains("primitives") || !m["primitives"].is_array()) continue;
+    for (auto& p : m["primitives"]) {
+      if (!p.is_object() || !p.contains("extensions") || !p["extensions"].is_object() ||
+          !p["extensions"].contains("KHR_draco_mesh_compression") || !p.contains("indices"))
+        continue;
+      const auto& i = p["indices"];
+      if (!i.is_number_unsigned() || i.get<size_t>() >= accessors->size()) continue;
+      const auto& a = (*accessors)[i.get<size_t>()];
+      if (a.is_object() && a.contains("bufferView")) continue;
+      p.erase("indices");
+      changed = true;
+    }
+  }
+  return changed;
+}
+
 }  // namespace
 
 Status prepareGltf(const std::string& path, bool binary, std::vector<unsigned char>* bytes) {
@@ -83,7 +108,9 @@ Status prepareGltf(const std::string& path, bool binary, std::vector<unsigned ch
                              "KHR_draco_mesh_compression, EXT_meshopt_compression)");
     }
   }
-  if (!placeholderFallbacks(&doc)) return {};
+  const bool fallbacks = placeholderFallbacks(&doc);
+  const bool draco = dropDracoIndices(&doc);
+  if (!fallbacks && !draco) return {};
   std::string json = doc.dump();
   if (!binary) {
     bytes->assign(json.begin(), json.end());
