@@ -202,5 +202,76 @@ TEST_F(GltfExtensions, CorruptDracoDataIsInvalidInput) {
       << got.error().message;
 }
 
+// meshopt's vertex codec is lossless and its index codec keeps the triangles (rotated at most): the
+// same field as the plain file's, read past a fallback buffer without a uri.
+TEST_F(GltfExtensions, MeshoptBakesTheSameField) {
+  const Mesh m = knot();
+  const Mesh plain = roundTrip(makeGltf(m, {}), "p.glb", true);
+  const Mesh packed = roundTrip(makeMeshoptGltf(m, {}), "m.glb", true);
+  EXPECT_EQ(packed.positions, m.positions);
+  EXPECT_EQ(packed.normals, m.normals);
+  EXPECT_EQ(triangleSet(packed), triangleSet(m));
+  const Sphere s = minimalEnclosingSphere(plain.positions);
+  const std::vector<uint8_t> a = bakeDistances(plain, s), b = bakeDistances(packed, s);
+  ASSERT_FALSE(a.empty());
+  EXPECT_EQ(a, b);
+}
+
+// The INDICES mode gives the index sequence back exactly; a .gltf with an external buffer.
+TEST_F(GltfExtensions, MeshoptIndexSequenceLoadsTheMeshExactly) {
+  const Mesh m = knot();
+  Meshopt o;
+  o.indexSequence = true;
+  const Mesh got = roundTrip(makeMeshoptGltf(m, o), "m.gltf", false);
+  EXPECT_EQ(got.positions, m.positions);
+  EXPECT_EQ(got.indices, m.indices);
+}
+
+// The filters: EXPONENTIAL positions (16-bit mantissas) and OCTAHEDRAL (8-bit) or QUATERNION
+// (16-bit) normals decode to the mesh's values within what those bits keep. A quaternion and its
+// negation are the same rotation: the normals compare up to sign.
+TEST_F(GltfExtensions, MeshoptFiltersDecode) {
+  const Mesh m = knot();
+  for (const char* normalFilter : {"OCTAHEDRAL", "QUATERNION"}) {
+    SCOPED_TRACE(normalFilter);
+    Meshopt o;
+    o.exponentialPositions = true;
+    o.normalFilter = normalFilter;
+    o.indexSequence = true;
+    const Mesh got = roundTrip(makeMeshoptGltf(m, o), "f.glb", true);
+    ASSERT_EQ(got.positions.size(), m.positions.size());
+    ASSERT_EQ(got.normals.size(), m.normals.size());
+    EXPECT_EQ(got.indices, m.indices);
+    const double posError = maxPositionError(m, got);
+    EXPECT_GT(posError, 0.0);
+    EXPECT_LT(posError, 1.1 * std::ldexp(1.0, -14));
+    Mesh flipped = got;
+    for (float& x : flipped.normals) x = -x;
+    double nrmError = 0;
+    for (size_t i = 0; i < m.normals.size(); i += 3) {
+      double e[2] = {0, 0};
+      for (size_t d = 0; d < 3; ++d) {
+        e[0] = std::max(e[0], std::fabs(double(m.normals[i + d]) - got.normals[i + d]));
+        e[1] = std::max(e[1], std::fabs(double(m.normals[i + d]) - flipped.normals[i + d]));
+      }
+      nrmError = std::max(nrmError, std::string(normalFilter) == "OCTAHEDRAL" ? e[0] : std::min(e[0], e[1]));
+    }
+    EXPECT_LT(nrmError, std::string(normalFilter) == "OCTAHEDRAL" ? 0.03 : 2e-4);
+  }
+}
+
+// Compressed bytes that do not decode: invalid input naming the buffer view.
+TEST_F(GltfExtensions, CorruptMeshoptDataIsInvalidInput) {
+  GltfDoc doc = makeMeshoptGltf(knot(), {});
+  for (size_t i = 0; i < doc.bin.size(); ++i) doc.bin[i] = uint8_t(0xff - i % 7);
+  const std::string p = (dir_ / "bad.glb").string();
+  ASSERT_TRUE(save(doc, p, true));
+  Result<Mesh> got = loadMesh(p);
+  ASSERT_FALSE(got.ok());
+  EXPECT_EQ(got.error().code, Code::kMeshParse);
+  EXPECT_NE(got.error().message.find("bad.glb: bufferView 0: meshopt data cannot be decoded"), std::string::npos)
+      << got.error().message;
+}
+
 }  // namespace
 }  // namespace vff::bake

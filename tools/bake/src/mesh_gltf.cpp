@@ -197,6 +197,7 @@ Result<std::shared_ptr<const tinygltf::Model>> parseGltf(const std::string& path
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
     return makeError(Code::kMeshParse, path + ": " + (err.empty() ? std::string("cannot parse glTF") : err));
   }
+  if (Status s = decodeMeshoptViews(model.get(), path); !s) return std::move(s).error();
   if (Status s = decodeDracoPrimitives(model.get(), path); !s) return std::move(s).error();
   return std::shared_ptr<const tinygltf::Model>(std::move(model));
 }
