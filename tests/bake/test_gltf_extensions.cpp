@@ -273,5 +273,19 @@ TEST_F(GltfExtensions, CorruptMeshoptDataIsInvalidInput) {
       << got.error().message;
 }
 
+// A count the compressed bytes cannot hold is refused before the memory it claims is allocated.
+TEST_F(GltfExtensions, MeshoptCountBeyondTheDataIsRefused) {
+  GltfDoc doc = makeMeshoptGltf(knot(), {});
+  doc.json["bufferViews"][0]["extensions"]["EXT_meshopt_compression"]["count"] = 2000000000;
+  const std::string p = (dir_ / "huge.gltf").string();
+  ASSERT_TRUE(save(doc, p, false));
+  Result<Mesh> got = loadMesh(p);
+  ASSERT_FALSE(got.ok());
+  EXPECT_EQ(got.error().code, Code::kMeshParse);
+  EXPECT_NE(got.error().message.find("huge.gltf: bufferView 0: 2000000000 elements cannot come from"),
+            std::string::npos)
+      << got.error().message;
+}
+
 }  // namespace
 }  // namespace vff::bake

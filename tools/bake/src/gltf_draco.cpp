@@ -129,8 +129,15 @@ Status decodeDracoPrimitives(tinygltf::Model* model, const std::string& path) {
     for (size_t pi = 0; pi < m.primitives.size(); ++pi) {
       tinygltf::Primitive& p = m.primitives[pi];
       if (p.extensions.count(kDraco) == 0) continue;
-      Status s = decodePrimitive(model, &p, path + ": mesh '" + m.name + "' primitive " + std::to_string(pi));
-      if (!s) return s;
+      const std::string what = path + ": mesh '" + m.name + "' primitive " + std::to_string(pi);
+      // The Draco stream's own counts size the decoder's allocations: a corrupt one can ask for
+      // more than there is, which is the file's fault, not a crash.
+      try {
+        Status s = decodePrimitive(model, &p, what);
+        if (!s) return s;
+      } catch (const std::exception& e) {
+        return makeError(Code::kMeshParse, what + ": Draco data cannot be decoded: " + e.what());
+      }
     }
   return {};
 }
