@@ -110,9 +110,9 @@ Status decodePrimitive(tinygltf::Model* model, tinygltf::Primitive* p, const std
   }
   std::vector<unsigned char> idx(size_t(mesh.num_faces()) * 3 * sizeof(uint32_t));
   for (uint32_t f = 0; f < mesh.num_faces(); ++f)
-    for (int k = 0; k < 3; ++k) {
+    for (size_t k = 0; k < 3; ++k) {
       const uint32_t v = mesh.face(draco::FaceIndex(f))[k].value();
-      std::memcpy(idx.data() + (size_t(f) * 3 + size_t(k)) * 4, &v, 4);
+      std::memcpy(idx.data() + (size_t(f) * 3 + k) * 4, &v, 4);
     }
   const size_t count = idx.size() / 4;
   p->indices = addAccessor(model, addBuffer(model, std::move(idx)), TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, false,
