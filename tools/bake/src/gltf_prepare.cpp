@@ -118,7 +118,7 @@ Status prepareGltf(const std::string& path, bool binary, std::vector<unsigned ch
   }
   while (json.size() % 4) json.push_back(' ');
   // The same GLB with the new JSON chunk: header, JSON chunk, then every chunk after it as it was.
-  const size_t rest = off + len + (4 - len % 4) % 4;
+  const size_t rest = off + len;  // the chunk length includes its padding
   std::vector<unsigned char> out(kGlbHeader + kChunkHeader + json.size());
   std::memcpy(out.data(), bytes->data(), 8);
   put32(&out, kGlbHeader, uint32_t(json.size()));
