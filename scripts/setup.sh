@@ -6,7 +6,8 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config git
   libembree-dev libopenexr-dev openexr libopenvdb-dev libopenvdb-tools libboost-iostreams-dev
-  libopenmesh-dev libtinygltf-dev libcli11-dev libzstd-dev libxxhash-dev nlohmann-json3-dev
+  libopenmesh-dev libtinygltf-dev libdraco-dev libmeshoptimizer-dev libcli11-dev libzstd-dev libxxhash-dev
+  nlohmann-json3-dev
   libstb-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev glslang-tools
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
   clang libclang-rt-14-dev

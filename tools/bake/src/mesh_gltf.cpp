@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "gltf_extensions.h"
 #include "mesh_importers.h"
 
 namespace vff::bake::detail {
@@ -45,7 +46,7 @@ class Importer {
       std::vector<float> nrm;
       auto nit = p.attributes.find("NORMAL");
       if (nit != p.attributes.end()) {
-        s = readVec3(nit->second, where + " NORMAL", &nrm);
+        s = readVec3(nit->second, where + " NORMAL", &nrm, true);
         if (!s) return s;
         if (nrm.size() != xyz.size()) nrm.clear();
       }
@@ -127,17 +128,16 @@ class Importer {
     return {};
   }
 
-  Status readVec3(int accessor, const std::string& what, std::vector<float>* out3) {
+  Status readVec3(int accessor, const std::string& what, std::vector<float>* out3, bool isNormal = false) {
     const uint8_t* d;
     size_t stride, count;
     int ct, type;
-    Status s = view(accessor, what, 12, &d, &stride, &count, &ct, &type);
+    const bool known = accessor >= 0 && size_t(accessor) < model_.accessors.size();
+    const size_t cs = known ? gltfComponentSize(model_.accessors[size_t(accessor)].componentType) : 0;
+    Status s = view(accessor, what, 3 * (cs ? cs : 4), &d, &stride, &count, &ct, &type);
     if (!s) return s;
-    if (type != TINYGLTF_TYPE_VEC3 || ct != TINYGLTF_COMPONENT_TYPE_FLOAT)
-      return makeError(Code::kMeshUnsupported, what + ": only float VEC3 data is supported (quantised meshes are not)");
-    out3->resize(count * 3);
-    for (size_t i = 0; i < count; ++i) std::memcpy(&(*out3)[3 * i], d + i * stride, 12);
-    return {};
+    if (type != TINYGLTF_TYPE_VEC3) return makeError(Code::kMeshUnsupported, what + ": only VEC3 data is supported");
+    return convertVec3(d, stride, count, ct, model_.accessors[size_t(accessor)].normalized, isNormal, what, out3);
   }
 
   Status readIndices(int accessor, const std::string& what, size_t vertexCount, std::vector<uint32_t>* idx) {
@@ -186,9 +186,10 @@ Result<std::shared_ptr<const tinygltf::Model>> parseGltf(const std::string& path
   auto model = std::make_shared<tinygltf::Model>();
   std::string err, warn;
   bool ok = false;
+  std::vector<unsigned char> bytes;
+  if (Status pre = prepareGltf(path, binary, &bytes); !pre) return std::move(pre).error();
   try {
-    ok = binary ? loader.LoadBinaryFromFile(model.get(), &err, &warn, path)
-                : loader.LoadASCIIFromFile(model.get(), &err, &warn, path);
+    ok = parsePreparedGltf(loader, model.get(), &err, &warn, bytes, path, binary);
   } catch (const std::exception& e) {
     return makeError(Code::kMeshParse, path + ": " + e.what());
   }
@@ -196,8 +197,8 @@ Result<std::shared_ptr<const tinygltf::Model>> parseGltf(const std::string& path
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
     return makeError(Code::kMeshParse, path + ": " + (err.empty() ? std::string("cannot parse glTF") : err));
   }
-  for (const std::string& ext : model->extensionsRequired)
-    return makeError(Code::kMeshUnsupported, path + ": required extension " + ext + " is not supported");
+  if (Status s = decodeMeshoptViews(model.get(), path); !s) return std::move(s).error();
+  if (Status s = decodeDracoPrimitives(model.get(), path); !s) return std::move(s).error();
   return std::shared_ptr<const tinygltf::Model>(std::move(model));
 }
 

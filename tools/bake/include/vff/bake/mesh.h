@@ -3,12 +3,15 @@
 // Supported inputs: OBJ, PLY (face lists, or `tristrips` with -1 restarts), OFF, STL (through
 // OpenMesh; polygons are triangulated) and glTF 2.0
 // .gltf/.glb (through tinygltf: every triangle primitive of the default scene or a chosen one, node
-// transforms applied; vff/bake/gltf.h splits a scene into its meshes or nodes). Content that cannot be baked is an error, never a silently empty mesh:
+// transforms applied; quantized, Draco and meshopt compressed data decoded; vff/bake/gltf.h splits a
+// scene into its meshes or nodes). Content that cannot be baked is an error, never a silently empty
+// mesh:
 //   kIoOpen          the file is missing or unreadable
 //   kMeshFormat      unknown extension
 //   kMeshParse       the importer cannot parse the file
-//   kMeshUnsupported points/lines primitives, required glTF extensions (Draco, meshopt, ...),
-//                    non-float positions, sparse accessors
+//   kMeshUnsupported points/lines primitives, a required glTF extension other than
+//                    KHR_mesh_quantization, KHR_draco_mesh_compression and EXT_meshopt_compression,
+//                    attribute types those do not allow, sparse accessors
 //   kMeshIndex       an index or an accessor outside its buffer
 //   kMeshEmpty       no triangles; kMeshNonFinite a NaN/Inf coordinate (message names the vertex);
 //   kMeshDegenerate  every triangle has zero area
