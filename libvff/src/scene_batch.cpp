@@ -11,7 +11,7 @@ namespace vff {
 
 namespace {
 
-constexpr size_t kChunk = 4096;  // rays a chunk
+constexpr size_t kChunk = 32768;  // rays a chunk
 
 // The (instance, ray) pairs of a chunk, grouped by instance in ascending id, rays ascending within.
 struct Pairs {
@@ -92,15 +92,29 @@ Status Scene::occluded(std::span<const Ray> rays, std::span<uint8_t> out, const 
   std::fill(out.begin(), out.end(), uint8_t(0));
   if (!impl_) return {};
   Pairs p;
+  std::vector<Ray> open;
+  std::vector<uint32_t> openRay;
   std::vector<uint8_t> blocked;
   for (size_t c = 0; c < rays.size(); c += kChunk) {
     const std::span<const Ray> chunk = rays.subspan(c, std::min(kChunk, rays.size() - c));
+    const std::span<uint8_t> o = out.subspan(c, chunk.size());
     pairUp(*impl_, chunk, &p);
-    answerPairs(*impl_, p, &blocked, [&](const Instance& in, std::span<const Ray> r, std::span<uint8_t> o) {
-      in.occluded(r, o, options);
-    });
-    for (size_t k = 0; k < p.ray.size(); ++k)
-      if (blocked[k]) out[c + p.ray[k]] = 1;
+    // Instance by instance, only the rays no earlier instance has blocked: any instance's "yes"
+    // is the answer, so the rest are not asked.
+    for (size_t i = 0; i + 1 < p.first.size(); ++i) {
+      open.clear();
+      openRay.clear();
+      for (uint32_t k = p.first[i]; k < p.first[i + 1]; ++k)
+        if (!o[p.ray[k]]) {
+          open.push_back(p.rays[k]);
+          openRay.push_back(p.ray[k]);
+        }
+      if (open.empty()) continue;
+      blocked.resize(open.size());
+      impl_->instances[i].occluded(open, blocked, options);
+      for (size_t k = 0; k < open.size(); ++k)
+        if (blocked[k]) o[openRay[k]] = 1;
+    }
   }
   return {};
 }
