@@ -245,6 +245,8 @@ struct Options {
   std::vector<uint32_t> instanceCounts{1, 10, 100, 1000, 10000};
   uint32_t sceneRays = 1u << 18;  // AO rays per frame
   int frames = 3;
+  // scene
+  std::vector<std::string> objects;  // meshes besides --mesh (none: four procedural shapes)
 };
 
 // What every experiment needs first: the world, its exact tracer and the object's Embree scene.
@@ -272,6 +274,7 @@ int runShadows(const Options& o);
 int runReflections(const Options& o);
 int runBench(const Options& o);
 int runSceneBench(const Options& o);
+int runScene(const Options& o);
 
 // The CPU as Linux names it ("model name", family and model from /proc/cpuinfo), or "unknown CPU".
 std::string cpuName();

@@ -65,6 +65,18 @@ case "$case" in
     [ "$(awk -F'|' '/^\| [0-9]+ \|/ {print $12}' stdout.txt | tr -d ' ' | sort -u)" = "1.0000" ] \
       || { cat stdout.txt; fail "scene-bench: the hybrid answers otherwise than vff::Scene"; }
     ;;
+  scene_writes_frames_and_table)
+    "$exp" scene --mesh knot.obj --config 290x16x16 --size 48 --rays 8 --frames 2 -j 2 -o out >stdout.txt 2>stderr.txt \
+      || { cat stderr.txt; fail "scene failed"; }
+    grep -q "^Scene: 5 objects" stdout.txt || { cat stdout.txt; fail "scene: not five objects"; }
+    for f in 0 1; do for k in exact fields error; do
+      [ -s "out/scene-f$f-$k.png" ] || { ls out; fail "missing out/scene-f$f-$k.png"; }
+    done; done
+    [ "$(grep -cE '^\| [0-9]+ \|' out/scene-table.md)" -eq 2 ] || { cat out/scene-table.md; fail "scene: not one row per frame"; }
+    # The fields answer most AO rays as the exact trace: RMS well under 32 on the 8-bit scale.
+    awk -F'|' '/^\| [0-9]+ \|/ { if ($3 + 0 >= 32) bad = 1 } END { exit bad }' out/scene-table.md \
+      || { cat out/scene-table.md; fail "scene: RMS error too large"; }
+    ;;
   images_do_not_depend_on_threads)
     "$exp" ao "${small[@]}" --rays 8 -j 1 -o one >/dev/null 2>&1 || fail "ao -j 1 failed"
     "$exp" ao "${small[@]}" --rays 8 -j 2 -o two >/dev/null 2>&1 || fail "ao -j 2 failed"
