@@ -72,7 +72,9 @@ struct Builder {
       std::fill_n(binBox, kBins, emptyBox());
       const float scale = kBins / extent;
       auto binOf = [&](uint32_t prim) {
-        return std::min(kBins - 1, int((centre[3 * prim + axis] - cbox.lo[axis]) * scale));
+        // Written so that a huge or NaN product (a tiny extent) never reaches the conversion.
+        const float f = (centre[3 * prim + axis] - cbox.lo[axis]) * scale;
+        return f >= float(kBins - 1) ? kBins - 1 : (f > 0 ? int(f) : 0);
       };
       for (uint32_t i = 0; i < count; ++i) {
         const int b = binOf(p[i]);

@@ -273,6 +273,17 @@ TEST(Scene, ManyInstancesAreCulled) {
   checkAgainstLoop(s, v, randomRays(rng, v, 300, 24.0f), {});
 }
 
+TEST(Scene, CoincidentInstancesMatchTheLoop) {
+  // 150 instances in one place (the hierarchy cannot split them by position) and one far away:
+  // every hit is a 150-way tie, which the lowest id wins.
+  const RigidTransform x = RigidTransform::fromAxisAngle({1, 2, 3}, 0.7f, {0.5f, 0, 0}, 1.2f);
+  std::vector<Instance> v(150, Instance{&fields()[0]->query, x});
+  v.push_back(Instance{&fields()[1]->query, RigidTransform::fromAxisAngle({0, 1, 0}, 0, {40, 0, 0})});
+  const Scene s = sceneOf(v);
+  Rng rng(6);
+  EXPECT_GT(checkAgainstLoop(s, v, randomRays(rng, {v[0]}, 300, 1.5f), {}), 30u);
+}
+
 TEST(Scene, EmptySceneMissesEverything) {
   Scene never;  // never touched: committed and empty
   EXPECT_TRUE(never.committed());
