@@ -76,6 +76,8 @@ void inBatches(uint64_t b, uint64_t e, uint64_t batch, Fn&& fn) {
   for (uint64_t x = b; x < e; x += batch) fn(x, std::min(e, x + batch));
 }
 
+}  // namespace
+
 // The CPU as Linux names it ("model name", family and model from /proc/cpuinfo), or "unknown CPU".
 std::string cpuName() {
   std::ifstream in("/proc/cpuinfo");
@@ -98,7 +100,6 @@ std::string cpuName() {
   return family.empty() ? name : name + " (family " + family + ", model " + model + ")";
 }
 
-}  // namespace
 
 int runBench(const Options& o) {
   FieldConfig config;

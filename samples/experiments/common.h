@@ -241,6 +241,12 @@ struct Options {
   uint32_t benchRays = 1u << 21;
   uint32_t benchBatch = 4096;  // rays per batch call in (b), (d) and (e)
   int repeat = 3;
+  // scene-bench
+  std::vector<uint32_t> instanceCounts{1, 10, 100, 1000, 10000};
+  uint32_t sceneRays = 1u << 18;  // AO rays per frame
+  int frames = 3;
+  // scene
+  std::vector<std::string> objects;  // meshes besides --mesh (none: four procedural shapes)
 };
 
 // What every experiment needs first: the world, its exact tracer and the object's Embree scene.
@@ -267,6 +273,11 @@ int runIntraAo(const Options& o);
 int runShadows(const Options& o);
 int runReflections(const Options& o);
 int runBench(const Options& o);
+int runSceneBench(const Options& o);
+int runScene(const Options& o);
+
+// The CPU as Linux names it ("model name", family and model from /proc/cpuinfo), or "unknown CPU".
+std::string cpuName();
 
 // The shared driver of the image experiments (experiment.cpp): loads the world, builds the exact
 // tracer and the G-buffer, bakes the configurations, renders the reference and every (config,

@@ -5,6 +5,8 @@
 //   vff-experiments shadows                soft shadows from three spherical lights
 //   vff-experiments reflections            glossy reflection using the normal field
 //   vff-experiments bench                  Embree vs FieldQuery throughput on the same rays
+//   vff-experiments scene                  a room (exact) and moving objects through their fields (Fig. 6)
+//   vff-experiments scene-bench            N moving instances: Embree instancing vs vff::Scene vs hybrid
 //   vff-experiments ao --field lod.vff     also (or only) evaluate field files of the same mesh
 //
 // Images (PNG, EXR, error heat maps) and OUT/NAME-table.md go to --out (default out/experiments);
@@ -25,12 +27,12 @@ int main(int argc, char** argv) {
   vff::cli::addVersionFlag(app, kProg);
   const std::map<std::string, int (*)(const Options&)> experiments = {
       {"ao", runAo}, {"intra-ao", runIntraAo}, {"shadows", runShadows}, {"reflections", runReflections},
-      {"bench", runBench}};
+      {"bench", runBench}, {"scene-bench", runSceneBench}, {"scene", runScene}};
   // One option under two names: CLI11 would mark each REQUIRED, as if both were; the check after
   // parsing asks for one of them.
   app.add_option("experiment,--experiment", o.experiment,
-                 "ao | intra-ao | shadows | reflections | bench (required: as the positional or --experiment)")
-      ->check(CLI::IsMember({"ao", "intra-ao", "shadows", "reflections", "bench"}));
+                 "ao | intra-ao | shadows | reflections | bench | scene | scene-bench (required: as the positional or --experiment)")
+      ->check(CLI::IsMember({"ao", "intra-ao", "shadows", "reflections", "bench", "scene", "scene-bench"}));
   app.add_option("--mesh", o.mesh, "object mesh (.obj .ply .off .stl .gltf .glb)")->capture_default_str();
   app.add_option("-o,--out", o.out, "output folder for images and tables")->capture_default_str();
   app.add_option("--size", o.size, "image width and height in pixels")->capture_default_str()->check(CLI::Range(1, 8192));
@@ -55,14 +57,23 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1u, 1u << 26));
   app.add_option("--repeat", o.repeat, "bench: repetitions (best is reported)")->capture_default_str()
       ->check(CLI::Range(1, 100));
+  app.add_option("--object", o.objects, "scene: a moving object's mesh besides --mesh (repeatable; none: four "
+                 "procedural shapes)");
+  app.add_option("--instances", o.instanceCounts, "scene-bench: instance counts (one table row each)")
+      ->capture_default_str()
+      ->check(CLI::Range(1u, 1u << 20));
+  app.add_option("--scene-rays", o.sceneRays, "scene-bench: AO rays per frame")->capture_default_str()
+      ->check(CLI::Range(1u, 1u << 26));
+  app.add_option("--frames", o.frames, "scene, scene-bench: frames (each moves every object)")->capture_default_str()
+      ->check(CLI::Range(1, 1000));
   if (auto rc = vff::cli::parse(app, kProg, argc, argv)) return *rc;
   if (o.experiment.empty()) {
-    vff::cli::usageError(kProg, "an experiment is required: ao, intra-ao, shadows, reflections or bench (the "
+    vff::cli::usageError(kProg, "an experiment is required: ao, intra-ao, shadows, reflections, bench or scene-bench (the "
                                 "positional EXPERIMENT or --experiment)");
     return vff::cli::kExitUsage;
   }
-  if (o.experiment == "bench" && !o.fields.empty()) {
-    vff::cli::usageError(kProg, "--field applies to the image experiments, not to bench");
+  if ((o.experiment == "bench" || o.experiment == "scene-bench") && !o.fields.empty()) {
+    vff::cli::usageError(kProg, "--field applies to the image experiments, not to " + o.experiment);
     return vff::cli::kExitUsage;
   }
   try {

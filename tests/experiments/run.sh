@@ -55,6 +55,28 @@ case "$case" in
       || { cat stdout.txt; fail "one-thread batches answer otherwise"; }
     grep -q '(a1) Embree rtcOccluded1, 1 thread' stdout.txt || { cat stdout.txt; fail "bench lacks the one-thread baseline"; }
     ;;
+  scene_bench_prints_a_row_per_count)
+    "$exp" scene-bench --mesh knot.obj --config 290x16x16 --instances 1 7 40 --scene-rays 3000 --frames 1 -j 2 \
+      >stdout.txt 2>stderr.txt || { cat stderr.txt; fail "scene-bench failed"; }
+    grep -q "^Scene benchmark: .* threads, " stdout.txt || { cat stdout.txt; fail "scene-bench header names no CPU"; }
+    [ "$(grep -cE '^\| [0-9]+ \|' stdout.txt)" -eq 3 ] || { cat stdout.txt; fail "scene-bench: not one row per count"; }
+    for n in 1 7 40; do grep -qE "^\| $n \|" stdout.txt || { cat stdout.txt; fail "scene-bench: no row for $n"; }; done
+    # The hybrid (c) answers every ray as vff::Scene (b) does: its last column is 1.
+    [ "$(awk -F'|' '/^\| [0-9]+ \|/ {print $12}' stdout.txt | tr -d ' ' | sort -u)" = "1.0000" ] \
+      || { cat stdout.txt; fail "scene-bench: the hybrid answers otherwise than vff::Scene"; }
+    ;;
+  scene_writes_frames_and_table)
+    "$exp" scene --mesh knot.obj --config 290x16x16 --size 48 --rays 8 --frames 2 -j 2 -o out >stdout.txt 2>stderr.txt \
+      || { cat stderr.txt; fail "scene failed"; }
+    grep -q "^Scene: 5 objects" stdout.txt || { cat stdout.txt; fail "scene: not five objects"; }
+    for f in 0 1; do for k in exact fields error; do
+      [ -s "out/scene-f$f-$k.png" ] || { ls out; fail "missing out/scene-f$f-$k.png"; }
+    done; done
+    [ "$(grep -cE '^\| [0-9]+ \|' out/scene-table.md)" -eq 2 ] || { cat out/scene-table.md; fail "scene: not one row per frame"; }
+    # The fields answer most AO rays as the exact trace: RMS well under 32 on the 8-bit scale.
+    awk -F'|' '/^\| [0-9]+ \|/ { if ($3 + 0 >= 32) bad = 1 } END { exit bad }' out/scene-table.md \
+      || { cat out/scene-table.md; fail "scene: RMS error too large"; }
+    ;;
   images_do_not_depend_on_threads)
     "$exp" ao "${small[@]}" --rays 8 -j 1 -o one >/dev/null 2>&1 || fail "ao -j 1 failed"
     "$exp" ao "${small[@]}" --rays 8 -j 2 -o two >/dev/null 2>&1 || fail "ao -j 2 failed"

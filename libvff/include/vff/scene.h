@@ -1,0 +1,118 @@
+// vff/scene.h - a scene of field instances: many rigid objects, moved by the caller between frames.
+//
+// A Scene holds instances (vff::Instance: a FieldQuery and a RigidTransform). Fields are borrowed
+// and shared: a thousand bunnies hold one FieldQuery, which must outlive the Scene. The caller
+// moves instances with setTransform() between frames and calls commit(), which rebuilds the
+// top-level structure: a bounding volume hierarchy over the instances' world bounding spheres
+// (binned surface-area heuristic, O(n log n), four children per node, tested four at once in SSE2
+// lanes). Queries run on a committed scene only.
+//
+//   vff::Scene scene;
+//   for (int i = 0; i < 1000; ++i) (void)scene.add(&bunny, placement(i, 0));   // ids 0, 1, 2...
+//   for (int frame = 0; frame < frames; ++frame) {
+//     for (uint32_t i = 0; i < scene.size(); ++i) (void)scene.setTransform(i, placement(i, frame));
+//     if (vff::Status s = scene.commit(); !s) return s;
+//     vff::Status s = scene.intersect(rays, hits);            // hits[r].instance, .t, .point...
+//   }
+//
+// What a query answers: exactly what looping over the instances in id order answers, bit for bit.
+// * intersect: the nearest of the instances' hits (Instance::intersect); of hits at the same t, the
+//   one of the lowest id. SceneHit::instance says which; kNoInstance for a miss.
+// * occluded: whether any instance reports the ray occluded (Instance::occluded).
+// * visibility: the product, in id order, of the instances' visibility (Instance::visibility);
+//   the instances a ray never comes near contribute exactly 1.
+// The hierarchy only skips instances whose (slightly enlarged) world sphere the ray's [tmin, tmax]
+// segment never reaches: those answer a miss and a visibility of 1 anyway, so culling changes no
+// answer.
+//
+// Rays that start on an object. Each instance answers as Instance does: a ray whose origin lies
+// inside an instance's bounding sphere is answered for that instance by the intra-object test
+// (spec/geometry.md section 7.3, QueryOptions::intraBias), and for every other instance by the
+// inter-object lookup. A ray cast from a point of instance k's surface is therefore answered by
+// the intra-object test for k and the lookup for the rest, with no flag from the caller.
+//
+// Overlapping spheres. Where the bounding spheres of two instances overlap (objects close to or
+// touching each other), a ray from a point of one that lies inside the other's sphere is answered
+// for that other object by the intra-object test as well: the field then reports the LAST surface
+// of that object before the ray leaves its sphere (vff/query.h), which can be beyond a nearer
+// surface of it, and the intra bias (a fraction of its radius) can hide a surface closer than the
+// bias. Between the two objects, occlusion is approximate by that much; elsewhere overlap costs
+// nothing but the extra lookups of the instances whose spheres the ray crosses.
+//
+// Speed. The batch functions gather, for each instance, the rays of the batch that reach its
+// sphere and answer them through the instance's batch path (vff/query.h), then combine the
+// answers in id order: the one-ray answers, in the time of a few large batches when instances are
+// few and rays many. The one-ray functions walk the hierarchy nearest first and stop early
+// (intersect: at the nearest hit; occluded: at the first). An Embree renderer can instead hand
+// the top level to Embree (vff/embree.h); vff-experiments scene-bench measures both.
+//
+// Threads. The query functions are const and may run on many threads at once; add(),
+// setTransform() and commit() must not run while any query does.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "vff/error.h"
+#include "vff/query.h"
+
+namespace vff {
+
+inline constexpr uint32_t kNoInstance = ~uint32_t{0};
+
+struct SceneHit : QueryHit {
+  uint32_t instance = kNoInstance;  // the id of the instance hit; kNoInstance when nothing was
+};
+
+class Scene {
+ public:
+  Scene() noexcept;
+  Scene(Scene&&) noexcept;
+  Scene& operator=(Scene&&) noexcept;
+  ~Scene();
+
+  // Adds an instance of `field` (borrowed: it must outlive the Scene) placed by `transform`, and
+  // returns its id: the number of instances added before it. The scene needs a commit() before
+  // its next query. Errors: kInvalidArgument (null field, or a field with no maps), kSphere (the
+  // field's bounding sphere is not finite or has radius <= 0), and those of checkTransform().
+  Result<uint32_t> add(const FieldQuery* field, const RigidTransform& transform);
+  // Moves instance `id`; the scene needs a commit() before its next query. Errors: kOutOfRange
+  // (no such instance), those of checkTransform().
+  Status setTransform(uint32_t id, const RigidTransform& transform);
+  // Instance `id` as it stands (also before a commit). Errors: kOutOfRange.
+  Result<Instance> instance(uint32_t id) const;
+  uint32_t size() const noexcept;
+
+  // Rebuilds the hierarchy over the instances' world spheres. An empty scene commits (and every
+  // ray misses it).
+  Status commit();
+  // True when no add() or setTransform() happened since the last commit().
+  bool committed() const noexcept;
+
+  // World-space queries; the answers are described above. Errors: kBadState when the scene is
+  // not committed; for batches, kInvalidArgument when out.size() differs from rays.size().
+  Result<SceneHit> intersect(const Ray& ray, const QueryOptions& options = {}) const;
+  Result<bool> occluded(const Ray& ray, const QueryOptions& options = {}) const;
+  Result<float> visibility(const Ray& ray, const QueryOptions& options = {}) const;
+  Status intersect(std::span<const Ray> rays, std::span<SceneHit> out, const QueryOptions& options = {}) const;
+  Status occluded(std::span<const Ray> rays, std::span<uint8_t> out, const QueryOptions& options = {}) const;
+  Status visibility(std::span<const Ray> rays, std::span<float> out, const QueryOptions& options = {}) const;
+
+  // The instance ids whose enlarged world spheres the ray's [tmin, tmax] segment reaches, in
+  // ascending order (what the queries consider). Errors: kBadState when not committed.
+  Result<std::vector<uint32_t>> candidates(const Ray& ray) const;
+
+  struct Impl;  // opaque
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+// Checks that `transform` is rigid: a finite translation, a finite scale > 0, and a rotation whose
+// rows are orthonormal to within 1e-3 with determinant +1. Errors: kInvalidArgument naming the
+// problem.
+Status checkTransform(const RigidTransform& transform);
+
+}  // namespace vff

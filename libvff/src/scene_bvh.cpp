@@ -1,0 +1,238 @@
+// scene_bvh.cpp - building and testing the scene's top-level hierarchy (scene_bvh.h).
+#include "scene_bvh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#if defined(__SSE2__) || defined(_M_X64)
+#include <emmintrin.h>
+#define VFF_SCENE_SSE2 1
+#endif
+
+namespace vff::detail {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr int kBins = 16;
+constexpr uint32_t kLeafSize = 2;
+
+Box emptyBox() { return Box{{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}}; }
+
+void grow(Box* b, const Box& o) {
+  for (int a = 0; a < 3; ++a) {
+    b->lo[a] = std::min(b->lo[a], o.lo[a]);
+    b->hi[a] = std::max(b->hi[a], o.hi[a]);
+  }
+}
+
+float area(const Box& b) {
+  const float x = b.hi[0] - b.lo[0], y = b.hi[1] - b.lo[1], z = b.hi[2] - b.lo[2];
+  if (!(x >= 0) || !(y >= 0) || !(z >= 0)) return 0;
+  return x * y + y * z + z * x;
+}
+
+struct BNode {
+  Box box;
+  uint32_t left = 0, right = 0;  // children, for inner nodes
+  uint32_t start = 0, count = 0;  // primitives, for leaves (count > 0)
+};
+
+struct Builder {
+  const std::vector<Box>& boxes;
+  std::vector<float> centre;  // 3 per primitive
+  std::vector<uint32_t>& prims;
+  std::vector<BNode> nodes;
+
+  uint32_t build(uint32_t start, uint32_t count, int depth) {
+    const uint32_t id = uint32_t(nodes.size());
+    nodes.emplace_back();
+    Box box = emptyBox(), cbox = emptyBox();
+    for (uint32_t i = start; i < start + count; ++i) {
+      grow(&box, boxes[prims[i]]);
+      const float* c = &centre[3 * prims[i]];
+      grow(&cbox, Box{{c[0], c[1], c[2]}, {c[0], c[1], c[2]}});
+    }
+    nodes[id].box = box;
+    if (count <= kLeafSize) {
+      nodes[id].start = start;
+      nodes[id].count = count;
+      return id;
+    }
+    uint32_t mid = 0;
+    int axis = 0;
+    for (int a = 1; a < 3; ++a)
+      if (cbox.hi[a] - cbox.lo[a] > cbox.hi[axis] - cbox.lo[axis]) axis = a;
+    const float extent = cbox.hi[axis] - cbox.lo[axis];
+    uint32_t* p = prims.data() + start;
+    if (extent > 0 && depth < 48) {
+      // Binned SAH on the widest centroid axis.
+      Box binBox[kBins];
+      uint32_t binCount[kBins] = {};
+      std::fill_n(binBox, kBins, emptyBox());
+      const float scale = kBins / extent;
+      auto binOf = [&](uint32_t prim) {
+        // Written so that a huge or NaN product (a tiny extent) never reaches the conversion.
+        const float f = (centre[3 * prim + axis] - cbox.lo[axis]) * scale;
+        return f >= float(kBins - 1) ? kBins - 1 : (f > 0 ? int(f) : 0);
+      };
+      for (uint32_t i = 0; i < count; ++i) {
+        const int b = binOf(p[i]);
+        ++binCount[b];
+        grow(&binBox[b], boxes[p[i]]);
+      }
+      float rightArea[kBins];
+      uint32_t rightCount[kBins];
+      Box acc = emptyBox();
+      uint32_t n = 0;
+      for (int b = kBins - 1; b > 0; --b) {
+        grow(&acc, binBox[b]);
+        n += binCount[b];
+        rightArea[b] = area(acc);
+        rightCount[b] = n;
+      }
+      acc = emptyBox();
+      n = 0;
+      float best = kInf;
+      int bestSplit = -1;
+      for (int b = 1; b < kBins; ++b) {
+        grow(&acc, binBox[b - 1]);
+        n += binCount[b - 1];
+        if (n == 0 || rightCount[b] == 0) continue;
+        const float cost = area(acc) * float(n) + rightArea[b] * float(rightCount[b]);
+        if (cost < best) {
+          best = cost;
+          bestSplit = b;
+        }
+      }
+      if (bestSplit > 0) {
+        mid = uint32_t(std::stable_partition(p, p + count, [&](uint32_t q) { return binOf(q) < bestSplit; }) - p);
+      }
+    }
+    if (mid == 0 || mid == count) {
+      // Coincident centroids or a deep branch: split in the middle, in a fixed order.
+      mid = count / 2;
+      std::nth_element(p, p + mid, p + count, [&](uint32_t a, uint32_t b) {
+        const float ca = centre[3 * a + axis], cb = centre[3 * b + axis];
+        return ca < cb || (ca == cb && a < b);
+      });
+    }
+    const uint32_t l = build(start, mid, depth + 1);
+    const uint32_t r = build(start + mid, count - mid, depth + 1);
+    nodes[id].left = l;
+    nodes[id].right = r;
+    return id;
+  }
+};
+
+}  // namespace
+
+BoxRay boxRay(const Ray& ray) noexcept {
+  BoxRay r;
+  const float o[3] = {ray.origin.x, ray.origin.y, ray.origin.z};
+  const float d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
+  for (int a = 0; a < 3; ++a) {
+    r.origin[a] = o[a];
+    // A zero component becomes a tiny one: the slab test then never forms 0 * inf.
+    const float da = d[a] == 0 ? 1e-30f : d[a];
+    r.inv[a] = 1.0f / da;
+  }
+  r.tmax = ray.tmax;
+  return r;
+}
+
+unsigned hitNode4(const Node4& n, const BoxRay& r, float tmax, float entry[4]) noexcept {
+#if VFF_SCENE_SSE2
+  __m128 tn = _mm_setzero_ps(), tf = _mm_set1_ps(tmax);
+  for (int a = 0; a < 3; ++a) {
+    const __m128 o = _mm_set1_ps(r.origin[a]), inv = _mm_set1_ps(r.inv[a]);
+    const __m128 t1 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.lo[a]), o), inv);
+    const __m128 t2 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.hi[a]), o), inv);
+    tn = _mm_max_ps(tn, _mm_min_ps(t1, t2));
+    tf = _mm_min_ps(tf, _mm_max_ps(t1, t2));
+  }
+  _mm_storeu_ps(entry, tn);
+  return unsigned(_mm_movemask_ps(_mm_cmple_ps(tn, tf)));
+#else
+  unsigned mask = 0;
+  for (int c = 0; c < 4; ++c) {
+    float tn = 0, tf = tmax;
+    for (int a = 0; a < 3; ++a) {
+      const float t1 = (n.lo[a][c] - r.origin[a]) * r.inv[a], t2 = (n.hi[a][c] - r.origin[a]) * r.inv[a];
+      tn = std::max(tn, std::min(t1, t2));
+      tf = std::min(tf, std::max(t1, t2));
+    }
+    entry[c] = tn;
+    if (tn <= tf) mask |= 1u << c;
+  }
+  return mask;
+#endif
+}
+
+void Bvh4::build(const std::vector<Box>& boxes) {
+  nodes_.clear();
+  prims_.resize(boxes.size());
+  for (uint32_t i = 0; i < prims_.size(); ++i) prims_[i] = i;
+  if (boxes.empty()) return;
+  Builder b{boxes, std::vector<float>(3 * boxes.size()), prims_, {}};
+  b.nodes.reserve(2 * boxes.size());
+  for (size_t i = 0; i < boxes.size(); ++i)
+    for (int a = 0; a < 3; ++a) b.centre[3 * i + a] = 0.5f * (boxes[i].lo[a] + boxes[i].hi[a]);
+  b.build(0, uint32_t(boxes.size()), 0);
+  // Collapse to four children a node: open the child of largest area until there are four.
+  struct Pending {
+    uint32_t binary, slot;
+  };
+  std::vector<Pending> work{{0, 0}};
+  nodes_.reserve(b.nodes.size() / 2 + 1);
+  while (!work.empty()) {
+    const Pending w = work.back();
+    work.pop_back();
+    uint32_t kids[4];
+    int k = 0;
+    const BNode& root = b.nodes[w.binary];
+    if (root.count > 0) {
+      kids[k++] = w.binary;  // a lone leaf (a scene of one or two instances)
+    } else {
+      kids[k++] = root.left;
+      kids[k++] = root.right;
+      while (k < 4) {
+        int open = -1;
+        float best = -1;
+        for (int i = 0; i < k; ++i)
+          if (b.nodes[kids[i]].count == 0 && area(b.nodes[kids[i]].box) > best) {
+            best = area(b.nodes[kids[i]].box);
+            open = i;
+          }
+        if (open < 0) break;
+        const BNode& o = b.nodes[kids[open]];
+        kids[open] = o.left;
+        kids[k++] = o.right;
+      }
+    }
+    const uint32_t id = uint32_t(nodes_.size());
+    nodes_.emplace_back();
+    if (w.binary != 0) nodes_[w.slot >> 2].child[w.slot & 3] = id;
+    Node4& n = nodes_[id];
+    n.valid = (1u << k) - 1;
+    for (int c = 0; c < 4; ++c) {
+      const Box box = c < k ? b.nodes[kids[c]].box : emptyBox();
+      for (int a = 0; a < 3; ++a) {
+        n.lo[a][c] = box.lo[a];
+        n.hi[a][c] = box.hi[a];
+      }
+      n.child[c] = 0;
+      n.count[c] = 0;
+      if (c >= k) continue;
+      const BNode& kid = b.nodes[kids[c]];
+      if (kid.count > 0) {
+        n.child[c] = kid.start;
+        n.count[c] = kid.count;
+      } else {
+        work.push_back({kids[c], (id << 2) | uint32_t(c)});
+      }
+    }
+  }
+}
+
+}  // namespace vff::detail

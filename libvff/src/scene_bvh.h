@@ -1,0 +1,103 @@
+// scene_bvh.h - the top-level hierarchy of a vff::Scene (vff/scene.h): boxes around the instances'
+// world spheres, built with a binned surface-area heuristic and stored four children to a node,
+// so that a ray tests the four child boxes of a node at once in SSE2 lanes.
+#pragma once
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "vff/query.h"
+
+namespace vff::detail {
+
+struct Box {
+  float lo[3], hi[3];
+};
+
+// A node of four children. Child c is an inner node when count[c] == 0 (child[c] indexes nodes),
+// a leaf when count[c] > 0 (the primitives prims[child[c]] .. prims[child[c] + count[c] - 1]), and
+// absent when bit c of valid is clear.
+struct alignas(16) Node4 {
+  float lo[3][4], hi[3][4];
+  uint32_t child[4];
+  uint32_t count[4];
+  unsigned valid;  // bit c: child c exists
+};
+
+// A ray prepared for the box tests.
+struct BoxRay {
+  float origin[3], inv[3];
+  float tmax;
+};
+
+BoxRay boxRay(const Ray& ray) noexcept;
+
+class Bvh4 {
+ public:
+  static constexpr int kMaxDepth = 96;
+  // Rebuilds over `boxes` (primitive i is boxes[i]). Deterministic: the same boxes give the same
+  // hierarchy.
+  void build(const std::vector<Box>& boxes);
+  bool empty() const noexcept { return nodes_.empty(); }
+  const std::vector<Node4>& nodes() const noexcept { return nodes_; }
+  const std::vector<uint32_t>& prims() const noexcept { return prims_; }
+
+  // Calls visit(prim) for every primitive whose box the segment [0, tmax] of the ray reaches,
+  // nearest child first. visit returns the new tmax (the caller's best hit so far, or the same
+  // value to see everything); a negative value stops the walk.
+  template <class Visit>
+  void walk(const BoxRay& r, Visit&& visit) const;
+
+ private:
+  std::vector<Node4> nodes_;
+  std::vector<uint32_t> prims_;
+};
+
+// The entry distances of the ray into the four boxes of a node, and which it reaches within
+// [0, tmax] (bit c of the result).
+unsigned hitNode4(const Node4& n, const BoxRay& r, float tmax, float entry[4]) noexcept;
+
+template <class Visit>
+void Bvh4::walk(const BoxRay& r, Visit&& visit) const {
+  if (nodes_.empty()) return;
+  // Stack items: an inner node, or (kLeaf | node << 2 | child) for a leaf child of a node.
+  constexpr uint32_t kLeaf = 0x80000000u;
+  struct Item {
+    uint32_t ref;
+    float entry;
+  };
+  // At most three items per level stay behind; build() keeps the depth under kMaxDepth.
+  Item stack[3 * kMaxDepth + 4];
+  int top = 0;
+  stack[top++] = {0, 0.0f};
+  float tmax = r.tmax;
+  while (top > 0) {
+    const Item it = stack[--top];
+    if (it.entry > tmax) continue;
+    if (it.ref & kLeaf) {
+      const Node4& p = nodes_[(it.ref & ~kLeaf) >> 2];
+      const uint32_t c = it.ref & 3u;
+      for (uint32_t i = 0; i < p.count[c]; ++i) {
+        tmax = visit(prims_[p.child[c] + i]);
+        if (tmax < 0) return;
+      }
+      continue;
+    }
+    const Node4& n = nodes_[it.ref];
+    float entry[4];
+    const unsigned mask = hitNode4(n, r, tmax, entry) & n.valid;
+    uint32_t order[4];
+    int k = 0;
+    for (uint32_t c = 0; c < 4; ++c)
+      if (mask & (1u << c)) order[k++] = c;
+    for (int a = 1; a < k; ++a)
+      for (int b = a; b > 0 && entry[order[b]] < entry[order[b - 1]]; --b) std::swap(order[b], order[b - 1]);
+    for (int a = k - 1; a >= 0; --a) {  // the nearest child ends on top
+      const uint32_t c = order[a];
+      stack[top++] = {n.count[c] == 0 ? n.child[c] : (kLeaf | (it.ref << 2) | c), entry[c]};
+    }
+  }
+}
+
+}  // namespace vff::detail

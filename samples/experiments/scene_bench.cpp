@@ -1,0 +1,208 @@
+// scene_bench.cpp - the scene scaling benchmark: N moving instances of one object, exact Embree
+// instancing against field scenes, time per frame.
+//
+// For each instance count (--instances, default 1, 10, 100, 1000, 10000), N copies of the object
+// (one baked field, shared) stand at random in a cube whose volume grows with N (a constant
+// density: neighbours within a few R). Each of --frames frames gives every instance a new random
+// rotation and position, then casts the same number of AO rays (--scene-rays): each from a random
+// instance, 1.05 R to 2 R from its centre, cosine-weighted around the outward direction, range
+// aoDistance * R; every side answers occluded for each. Per frame and side, the rebuild (new
+// transforms and commit) and the rays are timed separately:
+//   (a) exact: Embree 3 instancing, the mesh's scene under N instance geometries; rtcOccluded1
+//   (b) vff::Scene, kNearest: setTransform + commit; occluded batches of 32768 rays
+//   (c) hybrid: Embree's top level over N vff::embree::FieldGeometry; rtcOccluded1
+// Rays run on --threads workers (timedParallelFor); commits on the calling thread (Embree's own
+// threads for (a) and (c)); a first frame, untimed, warms every side up. The table gives the mean per frame, the frame speed-up of (b) and (c)
+// over (a), and the share of rays on which (b) agrees with (a) and (c) with (b).
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <string>
+
+#include <embree3/rtcore.h>
+
+#include "cli.h"
+#include "common.h"
+#include "vff/embree.h"
+#include "vff/scene.h"
+
+namespace vffx {
+
+namespace {
+
+constexpr uint64_t kChunk = 4096;
+// (b)'s rays per call: vff::Scene gives each instance the rays of a call that reach it, so larger
+// calls fill its vectors better.
+constexpr uint64_t kSceneChunk = 32768;
+
+double now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+vff::RigidTransform randomPlacement(std::mt19937_64& g, float side) {
+  std::uniform_real_distribution<float> u(0, 1);
+  const Vec3 axis = uniformSphere(u(g), u(g));
+  const float angle = 2 * kPi * u(g);
+  return vff::RigidTransform::fromAxisAngle(axis, angle, {side * u(g), side * u(g), side * u(g)});
+}
+
+struct Side {
+  double commit = 0, rays = 0;  // seconds, summed over frames
+};
+
+void setEmbreeTransform(RTCGeometry g, const vff::RigidTransform& x) {
+  // Embree's RTC_FORMAT_FLOAT3X4_ROW_MAJOR: the 3 x 4 matrix [R | t] row by row.
+  float m[12];
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) m[4 * r + c] = x.rotation[r][c] * x.scale;
+  }
+  m[3] = x.translation.x, m[7] = x.translation.y, m[11] = x.translation.z;
+  rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, m);
+  rtcCommitGeometry(g);
+}
+
+bool occluded1(RTCScene scene, const vff::Ray& r) {
+  RTCRay ray{};
+  ray.org_x = r.origin.x, ray.org_y = r.origin.y, ray.org_z = r.origin.z;
+  ray.dir_x = r.direction.x, ray.dir_y = r.direction.y, ray.dir_z = r.direction.z;
+  ray.tnear = r.tmin, ray.tfar = r.tmax, ray.mask = ~0u;
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  rtcOccluded1(scene, &ctx, &ray);
+  return ray.tfar < 0;
+}
+
+}  // namespace
+
+int runSceneBench(const Options& o) {
+  FieldConfig config;
+  const std::string configName = o.configs.empty() ? "4226x64x64" : o.configs.front();
+  if (!parseFieldConfig(configName, &config)) {
+    vff::cli::usageError(kProg, "--config " + configName + ": expected MAPSxMxM with an octa-hemi2 map count");
+    return vff::cli::kExitUsage;
+  }
+  const unsigned threads = resolveThreads(o.threads);
+  auto setup = makeSetup(o, threads);
+  if (!setup) return vff::cli::reportError(kProg, o.mesh, setup.error());
+  const World& world = (*setup)->world;
+  auto field = bakeQuery(world, *(*setup)->scene, config, false, threads);
+  if (!field) return vff::cli::reportError(kProg, o.mesh, field.error());
+  const vff::FieldQuery& q = (*field)->query;
+  const float R = world.radius;
+  // The object centred on its sphere, so that a placement's translation is its sphere's centre.
+  const vff::Sphere& s = q.field().sphere;
+
+  RTCDevice device = rtcNewDevice(nullptr);
+  RTCScene mesh = rtcNewScene(device);
+  rtcSetSceneBuildQuality(mesh, RTC_BUILD_QUALITY_HIGH);
+  {
+    const vff::bake::Mesh& m = world.objectMesh;
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* v = static_cast<float*>(
+        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m.vertexCount()));
+    for (size_t i = 0; i < m.vertexCount(); ++i)
+      for (int a = 0; a < 3; ++a) v[3 * i + size_t(a)] = m.positions[3 * i + size_t(a)] - s.center[a];
+    auto* ix = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                              3 * sizeof(uint32_t), m.triangleCount()));
+    std::memcpy(ix, m.indices.data(), m.indices.size() * sizeof(uint32_t));
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(mesh, g);
+    rtcReleaseGeometry(g);
+    rtcCommitScene(mesh);
+  }
+  // The field's object space has its sphere's centre at s.center: the same shift.
+  auto fieldPlacement = [&](const vff::RigidTransform& x) {
+    vff::RigidTransform f = x;
+    f.translation = x.translation - x.toWorldVector(toVec(s.center));
+    return f;
+  };
+  const vff::QueryOptions qo{.reconstruction = vff::Reconstruction::kNearest, .intraBias = 0.0f};
+
+  std::printf("Scene benchmark: %s (%zu triangles), field %s, %u AO rays per frame (range %.1f R), %d frames, %u "
+              "threads, %s\n\n",
+              o.mesh.c_str(), world.objectMesh.triangleCount(), config.name().c_str(), o.sceneRays,
+              double(o.aoDistance), o.frames, threads, cpuName().c_str());
+  std::printf("| instances | (a) Embree rebuild ms | (a) rays ms | (b) vff::Scene rebuild ms | (b) rays ms | (c) hybrid "
+              "rebuild ms | (c) rays ms | frame (a)/(b) | frame (a)/(c) | (b) = (a) | (c) = (b) |\n");
+  std::printf("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  for (uint32_t n : o.instanceCounts) {
+    std::mt19937_64 g(n);
+    const float side = 4.0f * R * std::cbrt(float(n));
+    RTCScene exact = rtcNewScene(device);
+    RTCScene hybrid = rtcNewScene(device);
+    std::vector<RTCGeometry> inst(n);
+    std::vector<vff::embree::FieldGeometry> fields(n);
+    vff::Scene scene;
+    for (uint32_t i = 0; i < n; ++i) {
+      inst[i] = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+      rtcSetGeometryInstancedScene(inst[i], mesh);
+      rtcAttachGeometryByID(exact, inst[i], i);
+      const vff::RigidTransform x = fieldPlacement(randomPlacement(g, side));
+      fields[i] = std::move(vff::embree::FieldGeometry::attach(device, hybrid, &q, x, qo, i).value());
+      (void)scene.add(&q, x);
+    }
+    Side a, b, c;
+    uint64_t agreeAB = 0, agreeBC = 0, total = 0;
+    std::vector<vff::Ray> rays(o.sceneRays);
+    std::vector<uint8_t> ra(rays.size()), rb(rays.size()), rc(rays.size());
+    for (int frame = -1; frame < o.frames; ++frame) {  // frame -1 warms up (page faults, caches)
+      const double w = frame < 0 ? 0.0 : 1.0;
+      std::vector<vff::RigidTransform> placement(n);
+      for (auto& x : placement) x = randomPlacement(g, side);
+      std::uniform_real_distribution<float> u(0, 1);
+      for (auto& r : rays) {
+        const vff::RigidTransform& x = placement[std::min(n - 1, uint32_t(u(g) * float(n)))];
+        const Vec3 out = uniformSphere(u(g), u(g));
+        r.origin = x.translation + out * (R * (1.05f + 0.95f * u(g)));
+        r.direction = cosineDirection(out, u(g), u(g));
+        r.tmin = 0;
+        r.tmax = o.aoDistance * R;
+      }
+      double t0 = now();
+      for (uint32_t i = 0; i < n; ++i) setEmbreeTransform(inst[i], placement[i]);
+      rtcCommitScene(exact);
+      a.commit += w * (now() - t0);
+      t0 = now();
+      for (uint32_t i = 0; i < n; ++i) (void)scene.setTransform(i, fieldPlacement(placement[i]));
+      if (vff::Status st = scene.commit(); !st) return vff::cli::reportError(kProg, o.mesh, st.error());
+      b.commit += w * (now() - t0);
+      t0 = now();
+      for (uint32_t i = 0; i < n; ++i) (void)fields[i].setTransform(fieldPlacement(placement[i]));
+      rtcCommitScene(hybrid);
+      c.commit += w * (now() - t0);
+      a.rays += w * timedParallelFor(rays.size(), kChunk, threads, [&](uint64_t lo, uint64_t hi) {
+        for (uint64_t i = lo; i < hi; ++i) ra[i] = occluded1(exact, rays[i]);
+      });
+      b.rays += w * timedParallelFor(rays.size(), kSceneChunk, threads, [&](uint64_t lo, uint64_t hi) {
+        (void)scene.occluded(std::span<const vff::Ray>(rays).subspan(lo, hi - lo),
+                             std::span<uint8_t>(rb).subspan(lo, hi - lo), qo);
+      });
+      c.rays += w * timedParallelFor(rays.size(), kChunk, threads, [&](uint64_t lo, uint64_t hi) {
+        for (uint64_t i = lo; i < hi; ++i) rc[i] = occluded1(hybrid, rays[i]);
+      });
+      for (size_t i = 0; i < rays.size(); ++i) {
+        agreeAB += ra[i] == rb[i];
+        agreeBC += rb[i] == rc[i];
+      }
+      total += rays.size();
+      if (frame < 0) agreeAB = agreeBC = total = 0;
+    }
+    const double f = 1000.0 / o.frames;
+    std::printf("| %u | %.3f | %.2f | %.3f | %.2f | %.3f | %.2f | %.2f | %.2f | %.4f | %.4f |\n", n, a.commit * f,
+                a.rays * f, b.commit * f, b.rays * f, c.commit * f, c.rays * f,
+                (a.commit + a.rays) / (b.commit + b.rays), (a.commit + a.rays) / (c.commit + c.rays),
+                double(agreeAB) / double(total), double(agreeBC) / double(total));
+    std::fflush(stdout);
+    fields.clear();
+    for (RTCGeometry gi : inst) rtcReleaseGeometry(gi);
+    rtcReleaseScene(hybrid);
+    rtcReleaseScene(exact);
+  }
+  rtcReleaseScene(mesh);
+  rtcReleaseDevice(device);
+  return 0;
+}
+
+}  // namespace vffx
