@@ -1,5 +1,5 @@
-// progress.h - the progress line the tools print on stderr while they work: "tool: 1234/4226 maps,
-// 12.3 Mrays/s, ETA 4.5 s", redrawn at most 10 times a second, only when enabled (on a terminal,
+// progress.h - the progress line the tools print on stderr while they work: "tool: DONE/TOTAL maps,
+// RATE Mrays/s, ETA SECONDS s", redrawn at most 10 times a second, only when enabled (on a terminal,
 // not with --quiet or --json). Safe to update from several threads.
 #pragma once
 
