@@ -1,0 +1,250 @@
+// vff-query: answers rays with a visibility field, from the shell.
+//
+//   vff-query bunny.vff --ray 0 0 5 0 0 -1                    one ray (repeatable); CSV on stdout
+//   vff-query bunny.vff < rays.csv --format jsonl            CSV or JSON lines on stdin
+//   vff-query bunny.vff -i rays.npy -o hits.npy              (N, 6) or (N, 8) float32 in, (N, 9) out
+//   vff-query bunny.vff -i rays.csv --interpolated --visibility --rotate 0 1 0 0.5 --translate 2 0 0
+//
+// Every answer is the C++ batch query's (FieldQuery or Instance), split over threads in chunks;
+// the answers do not depend on the thread count.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <atomic>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <new>
+#include <thread>
+
+#include "cli.h"
+#include "npy.h"
+#include "rays.h"
+#include "vff/vff.h"
+
+namespace {
+
+using namespace vff;
+using namespace vff::query_tool;
+
+constexpr const char* kProg = "vff-query";
+constexpr size_t kChunk = 16384;  // rays per batch call on one thread
+
+struct Options {
+  std::string field;
+  std::vector<std::vector<float>> rays;
+  std::string input;
+  std::string output = "-";
+  std::string format;
+  bool interpolated = false;
+  bool visibility = false;
+  float tmin = 0.0f;
+  float tmax = std::numeric_limits<float>::infinity();
+  float intraBias = -1.0f;
+  std::vector<float> rotate, translate;
+  float scale = 1.0f;
+  unsigned threads = 0;
+};
+
+int run(int argc, char** argv);
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::bad_alloc&) {
+    return cli::reportError(kProg, "", makeError(Code::kOutOfMemory, "out of memory"));
+  } catch (const std::exception& e) {
+    return cli::reportError(kProg, "", makeError(Code::kBadState, std::string("internal error: ") + e.what()));
+  }
+}
+
+namespace {
+
+void addOptions(CLI::App& app, Options& o) {
+  cli::addVersionFlag(app, kProg);
+  app.add_option("field", o.field, "the .vff field to query")->required();
+  app.add_option("--ray", o.rays, "a ray: origin x y z, direction x y z (repeatable)")
+      ->expected(6)
+      ->allow_extra_args(false)
+      ->option_text("OX OY OZ DX DY DZ");
+  app.add_option("-i,--input", o.input,
+                 "rays from a file: a .npy float32 array (N, 6) or (N, 8) (ox oy oz dx dy dz [tmin tmax]), or text "
+                 "lines, CSV or JSON (- or nothing: standard input, when no --ray is given)");
+  app.add_option("-o,--output", o.output, "where the answers go (- : standard output; a file is written atomically)")
+      ->capture_default_str();
+  app.add_option("--format", o.format, "answers as csv, jsonl or npy (default: npy for an output named *.npy, else csv)")
+      ->check(CLI::IsMember({"csv", "jsonl", "npy"}));
+  app.add_flag("--interpolated", o.interpolated, "interpolated reconstruction (default: the paper's nearest)");
+  app.add_flag("--visibility", o.visibility, "add a column: the ray's visibility (0..1; 0 or 1 with nearest)");
+  app.add_option("--tmin", o.tmin, "the rays' tmin, unless a ray gives its own")->capture_default_str();
+  app.add_option("--tmax", o.tmax, "the rays' tmax, unless a ray gives its own (default: inf)");
+  app.add_option("--intra-bias", o.intraBias, "bias of rays from inside the sphere, a fraction of R (default: the field's)");
+  app.add_option("--rotate", o.rotate, "place the field: rotation about axis x y z by an angle in radians")
+      ->expected(4)
+      ->option_text("AX AY AZ RADIANS");
+  app.add_option("--translate", o.translate, "place the field: translation x y z (after rotation and scale)")
+      ->expected(3)
+      ->option_text("X Y Z");
+  app.add_option("--scale", o.scale, "place the field: uniform scale (> 0)")->check(CLI::PositiveNumber);
+  app.add_option("-j,--threads", o.threads, "threads (0: all cores); the answers do not depend on it")
+      ->capture_default_str();
+}
+
+// The whole of a file, or of standard input for "-".
+Result<std::vector<uint8_t>> readAll(const std::string& path) {
+  if (path == "-") return cli::readStdin();
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return makeError(Code::kIoOpen, "cannot open " + path + ": " + std::strerror(errno));
+  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) return makeError(Code::kIoRead, "cannot read " + path);
+  return bytes;
+}
+
+// The rays of a .npy matrix; a problem is an invalid-input message.
+std::optional<std::string> npyRays(std::span<const uint8_t> bytes, const Options& o, std::vector<Ray>* rays) {
+  NpyMatrix m;
+  if (auto e = readNpyMatrix(bytes, &m)) return *e;
+  if (m.cols != 6 && m.cols != 8)
+    return "expected shape (N, 6) or (N, 8), found (" + std::to_string(m.rows) + ", " + std::to_string(m.cols) + ")";
+  rays->resize(m.rows);
+  const float* v = reinterpret_cast<const float*>(m.data.data());
+  for (uint64_t i = 0; i < m.rows; ++i) {
+    float r[8];
+    std::memcpy(r, v + i * m.cols, m.cols * sizeof(float));
+    Ray& ray = (*rays)[i];
+    ray = Ray{{r[0], r[1], r[2]}, {r[3], r[4], r[5]}, o.tmin, o.tmax};
+    if (m.cols == 8) ray.tmin = r[6], ray.tmax = r[7];
+    if (auto bad = checkRay(ray))
+      return "row " + std::to_string(i) + ", column " + std::to_string(bad->second) + ": " + bad->first;
+  }
+  return std::nullopt;
+}
+
+// Answers the rays in chunks over `threads` threads.
+void answer(const FieldQuery& q, const std::optional<Instance>& inst, std::span<const Ray> rays, const QueryOptions& qo,
+            bool visibility, unsigned threads, std::vector<QueryHit>* hits, std::vector<float>* vis) {
+  hits->resize(rays.size());
+  if (visibility) vis->resize(rays.size());
+  const size_t chunks = (rays.size() + kChunk - 1) / kChunk;
+  std::atomic<size_t> next{0};
+  auto work = [&] {
+    for (size_t c; (c = next.fetch_add(1)) < chunks;) {
+      const size_t b = c * kChunk, n = std::min(kChunk, rays.size() - b);
+      auto in = rays.subspan(b, n);
+      std::span<QueryHit> out(hits->data() + b, n);
+      if (inst) inst->intersect(in, out, qo); else q.intersect(in, out, qo);
+      if (visibility) {
+        std::span<float> v(vis->data() + b, n);
+        if (inst) inst->visibility(in, v, qo); else q.visibility(in, v, qo);
+      }
+    }
+  };
+  const unsigned n = std::max(1u, std::min<unsigned>(threads, unsigned(chunks)));
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < n; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+}
+
+int run(int argc, char** argv) {
+  Options o;
+  CLI::App app{
+      "Answers rays with a visibility field: hit, t, point, normal and whether the origin was inside the\n"
+      "bounding sphere, one line (or .npy row) per ray, in the order given. Rays come from --ray, from\n"
+      "a .npy file, or as text lines (CSV: ox,oy,oz,dx,dy,dz[,tmin,tmax]; JSON: {\"origin\":[..],\n"
+      "\"direction\":[..],\"tmin\":..,\"tmax\":..} or [6 or 8 numbers]) from a file or standard input.\n"
+      "A bad line is reported as FILE:LINE:COLUMN (exit 3) after the rays before it are answered.\n"
+      "Output columns: hit,t,x,y,z,nx,ny,nz,inside[,visibility] (a miss: t inf, point nan; no normal: nan).\n\n"
+      "  vff-query field.vff --ray 0 0 5 0 0 -1\n"
+      "  vff-query field.vff -i rays.npy -o hits.npy --interpolated\n",
+      kProg};
+  app.footer(cli::exitCodeHelp());
+  addOptions(app, o);
+  if (auto rc = cli::parse(app, kProg, argc, argv)) return *rc;
+  if (!o.rays.empty() && !o.input.empty()) {
+    cli::usageError(kProg, "--ray and --input exclude each other");
+    return cli::kExitUsage;
+  }
+  if (o.tmin > o.tmax) {
+    cli::usageError(kProg, "--tmin is greater than --tmax");
+    return cli::kExitUsage;
+  }
+  const bool toNpyName = o.output.size() > 4 && o.output.compare(o.output.size() - 4, 4, ".npy") == 0;
+  const OutputFormat format = o.format == "npy" ? OutputFormat::kNpy
+                              : o.format == "jsonl" ? OutputFormat::kJsonLines
+                              : o.format == "csv"   ? OutputFormat::kCsv
+                              : toNpyName           ? OutputFormat::kNpy
+                                                    : OutputFormat::kCsv;
+
+  // The field first: a field that cannot be read answers nothing.
+  auto file = File::open(o.field);
+  if (!file) return cli::reportError(kProg, o.field, file.error());
+  auto q = FieldQuery::fromFile(*file);
+  if (!q) return cli::reportError(kProg, o.field, q.error());
+  std::optional<Instance> inst;
+  if (!o.rotate.empty() || !o.translate.empty() || o.scale != 1.0f) {
+    const Vec3 axis = o.rotate.empty() ? Vec3{0, 0, 1} : Vec3{o.rotate[0], o.rotate[1], o.rotate[2]};
+    if (axis.x == 0 && axis.y == 0 && axis.z == 0) {
+      cli::usageError(kProg, "--rotate needs a non-zero axis");
+      return cli::kExitUsage;
+    }
+    const Vec3 t = o.translate.empty() ? Vec3{} : Vec3{o.translate[0], o.translate[1], o.translate[2]};
+    inst = Instance{&*q, RigidTransform::fromAxisAngle(axis, o.rotate.empty() ? 0.0f : o.rotate[3], t, o.scale)};
+  }
+
+  // The rays.
+  std::vector<Ray> rays;
+  std::optional<std::string> badInput;  // the diagnostic of a bad line or array, printed after the answers
+  if (!o.rays.empty()) {
+    for (size_t i = 0; i < o.rays.size(); ++i) {
+      const auto& r = o.rays[i];
+      if (r.size() != 6) {
+        cli::usageError(kProg, "--ray number " + std::to_string(i + 1) + " has " + std::to_string(r.size()) +
+                                   " numbers: it takes 6 (ox oy oz dx dy dz)");
+        return cli::kExitUsage;
+      }
+      Ray ray{{r[0], r[1], r[2]}, {r[3], r[4], r[5]}, o.tmin, o.tmax};
+      if (auto bad = checkRay(ray)) {
+        cli::usageError(kProg, "--ray number " + std::to_string(i + 1) + ": " + bad->first);
+        return cli::kExitUsage;
+      }
+      rays.push_back(ray);
+    }
+  } else {
+    const std::string path = o.input.empty() ? "-" : o.input;
+    const std::string label = path == "-" ? "<stdin>" : path;
+    auto bytes = readAll(path);
+    if (!bytes) return cli::reportError(kProg, label, bytes.error());
+    if (bytes->size() >= 6 && std::memcmp(bytes->data(), "\x93NUMPY", 6) == 0) {
+      if (auto e = npyRays(*bytes, o, &rays)) {
+        cli::printError(kProg, label + ": " + *e);
+        return cli::kExitInvalidFile;
+      }
+    } else {
+      ParsedRays parsed = parseRayLines({reinterpret_cast<const char*>(bytes->data()), bytes->size()}, o.tmin, o.tmax);
+      rays = std::move(parsed.rays);
+      if (parsed.error)
+        badInput = label + ":" + std::to_string(parsed.error->line) + ":" + std::to_string(parsed.error->column) +
+                   ": " + parsed.error->message;
+    }
+  }
+
+  QueryOptions qo;
+  qo.reconstruction = o.interpolated ? Reconstruction::kInterpolated : Reconstruction::kNearest;
+  qo.intraBias = o.intraBias;
+  const unsigned threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
+  std::vector<QueryHit> hits;
+  std::vector<float> vis;
+  answer(*q, inst, rays, qo, o.visibility, threads, &hits, &vis);
+
+  const std::vector<uint8_t> out = formatAnswers(hits, vis, format);
+  if (auto st = cli::writeFileAtomic(o.output, out); !st) return cli::reportError(kProg, "", st.error());
+  if (badInput) {
+    cli::printError(kProg, *badInput);
+    return cli::kExitInvalidFile;
+  }
+  return cli::kExitSuccess;
+}
+
+}  // namespace
