@@ -103,6 +103,45 @@ py::array sliceArray(const PyFile& self, uint32_t slice, const std::string& plan
   return out;
 }
 
+// The decoded distances of one map, [j, i] for texel (i, j): NaN for a miss; bit1: 1 hit, 0 miss.
+py::array_t<float> distancesArray(const PyFile& self, uint32_t map) {
+  const File& f = self.file;
+  const FieldDesc& d = f.field();
+  if (map >= d.mapCount) throw py::index_error("map " + std::to_string(map) + " out of range");
+  const auto bytes = take(f.mapData(Plane::kDistance, map));
+  const uint32_t m = d.mapResolution;
+  py::array_t<float> out({py::ssize_t(m), py::ssize_t(m)});
+  float* dst = out.mutable_data();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (uint32_t j = 0; j < m; ++j)
+    for (uint32_t i = 0; i < m; ++i) {
+      const Vec3 dir = texelDirection(d.directionScheme, m, i, j);
+      const Texel t = decodeDistance(d.distanceEncoding, loadCode(d.distanceEncoding, bytes, m, i, j), d.sphere.radius, dir.z);
+      dst[j * m + i] = d.distanceEncoding == DistanceEncoding::kBit1 ? (t.hit ? 1.0f : 0.0f) : (t.hit ? t.distance : nan);
+    }
+  return out;
+}
+
+// The decoded normals of one map, [j, i, xyz]: NaN where the distance is a miss.
+py::array_t<float> normalsArray(const PyFile& self, uint32_t map) {
+  const File& f = self.file;
+  const FieldDesc& d = f.field();
+  if (map >= d.mapCount) throw py::index_error("map " + std::to_string(map) + " out of range");
+  if (!f.hasNormals()) raise(makeError(Code::kPlanePresence, "the field has no normal plane"));
+  const auto dist = take(f.mapData(Plane::kDistance, map));
+  const auto norm = take(f.mapData(Plane::kNormal, map));
+  const uint32_t m = d.mapResolution;
+  py::array_t<float> out({py::ssize_t(m), py::ssize_t(m), py::ssize_t(3)});
+  float* dst = out.mutable_data();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (uint32_t t = 0; t < m * m; ++t) {
+    const bool hit = loadCode(d.distanceEncoding, dist, m, t % m, t / m) != missCode(d.distanceEncoding);
+    const Vec3 n = decodeNormal(norm.data() + 4 * size_t(t));
+    dst[3 * t] = hit ? n.x : nan, dst[3 * t + 1] = hit ? n.y : nan, dst[3 * t + 2] = hit ? n.z : nan;
+  }
+  return out;
+}
+
 py::list validateFile(const PyFile& self, bool decodeBlocks) {
   ValidateOptions vo;
   vo.decodeBlocks = decodeBlocks;
@@ -211,8 +250,8 @@ keeps it alive, so `del f` never invalidates them.)doc")
       .def_property_readonly("normal_encoding", [](const PyFile& f) { return normalEncodingName(f.file.field().normalEncoding); },
                              "\"none\" or \"oct-snorm16\".")
       .def_property_readonly("has_normals", [](const PyFile& f) { return f.file.hasNormals(); }, "The file has a normal plane.")
-      .def_property_readonly("layout", [](const PyFile& f) { return describe(f.file)["layout"]; }, "The packed slice layout, as a dict.")
-      .def_property_readonly("sections", [](const PyFile& f) { return describe(f.file)["sections"]; }, "The section table, as a list of dicts.")
+      .def_property_readonly("layout", [](const PyFile& f) { return py::object(describe(f.file)["layout"]); }, "The packed slice layout, as a dict.")
+      .def_property_readonly("sections", [](const PyFile& f) { return py::object(describe(f.file)["sections"]); }, "The section table, as a list of dicts.")
       .def_property_readonly("metadata", &metadataDict, "The META JSON object as a dict ({} without META).")
       .def_property_readonly("metadata_text", [](const PyFile& f) { return std::string(f.file.metadata()); },
                              "The META JSON text exactly as stored (empty without META).")
@@ -229,6 +268,13 @@ plane="normal": (M, M, 2) '<i2' (octahedral snorm16). The array keeps the File a
       .def("maps", &mapsArray, py::arg("plane") = "distance", R"doc(
 Every map of a plane, shape (map_count,) + map(0).shape: a zero-copy view when the maps lie one
 after another in memory (stored blocks), else a copy.)doc")
+      .def("distances", &distancesArray, py::arg("index"), R"doc(
+The decoded distances of one map as a (M, M) float32 array (a copy), [j, i] for texel (i, j):
+object-space distance from the sphere entry to the surface, NaN for a miss; for bit1, 1 for a hit
+and 0 for a miss.)doc")
+      .def("normals", &normalsArray, py::arg("index"), R"doc(
+The decoded unit normals of one map as a (M, M, 3) float32 array (a copy), NaN where the ray
+missed. Raises vff.InvalidFileError (plane-presence) without a normal plane.)doc")
       .def("slice", &sliceArray, py::arg("index"), py::arg("plane") = "distance", R"doc(
 One packed slice of the layout (a copy): File::readSlice's bytes as a flat uint8 array.)doc")
       .def("__repr__", [](const PyFile& f) {
