@@ -41,7 +41,7 @@ uint32_t defaultCount(PositionScheme s) {
 struct Options {
   bake::BakeOptions bake;
   WriteOptions write;
-  py::object progress;
+  py::object progress = py::none();
 };
 
 Options optionsOf(const py::kwargs& kw) {
