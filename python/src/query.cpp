@@ -61,7 +61,11 @@ Bound bound(const py::object& obj, const char* name, float fallback, size_t n) {
   Bound b{fallback, std::nullopt};
   if (obj.is_none()) return b;
   if (!py::isinstance<py::array>(obj)) {
-    b.value = obj.cast<float>();
+    try {
+      b.value = obj.cast<float>();
+    } catch (const py::cast_error&) {
+      throw py::type_error(std::string(name) + ": expected None, a number or a float32 array of shape (N,)");
+    }
     return b;
   }
   py::array a = py::reinterpret_borrow<py::array>(obj);
@@ -231,8 +235,6 @@ field's default). threads: 0 for all cores; the answers do not depend on it. The
 // The batch and one-ray methods every query class has.
 template <class Py, class Get>
 void addQueries(py::class_<Py>& c, Get get) {
-  const auto kw = [](auto... extra) { return std::make_tuple(extra...); };
-  (void)kw;
   c.def("intersect", [get](const Py& self, const py::object& o, const py::object& d, const py::object& tmin, const py::object& tmax,
                            bool interpolated, float intraBias, unsigned threads) {
         return intersectBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, intraBias, threads));

@@ -119,6 +119,8 @@ def test_bad_shapes_and_dtypes_raise_clear_errors():
         q.intersect(o, o, tmax=np.ones(3, np.float32))
     with pytest.raises(TypeError, match="tmin: expected dtype float32"):
         q.intersect(o, o, tmin=np.ones(4))
+    with pytest.raises(TypeError, match=r"tmax: expected None, a number or a float32 array of shape \(N,\)"):
+        q.intersect(o, o, tmax="far")
     with pytest.raises(ValueError, match="scale"):
         vff.Instance(q, scale=0)
     with pytest.raises(ValueError, match="axis"):
