@@ -7,6 +7,11 @@
 //
 // Every answer is the C++ batch query's (FieldQuery or Instance), split over threads in chunks;
 // the answers do not depend on the thread count.
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
@@ -15,6 +20,7 @@
 #include <cstring>
 #include <new>
 #include <thread>
+#include <utility>
 
 #include "cli.h"
 #include "npy.h"
@@ -95,19 +101,51 @@ void addOptions(CLI::App& app, Options& o) {
                "rays per second of each (for benchmarks)");
 }
 
-// The whole of a file, or of standard input for "-".
-Result<std::vector<uint8_t>> readAll(const std::string& path) {
-  if (path == "-") return cli::readStdin();
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return makeError(Code::kIoOpen, "cannot open " + path + ": " + std::strerror(errno));
-  std::vector<uint8_t> bytes;
-  uint8_t buf[1 << 16];
-  for (size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) bytes.insert(bytes.end(), buf, buf + n);
-  const bool failed = std::ferror(f) != 0;
-  std::fclose(f);
-  if (failed) return makeError(Code::kIoRead, "cannot read " + path + ": " + std::strerror(errno));
-  return bytes;
-}
+// The bytes of an input: a regular file is mapped read-only (no copy), standard input ("-") and
+// other files are read whole.
+class Input {
+ public:
+  static Result<Input> open(const std::string& path) {
+    Input in;
+    if (path == "-") {
+      auto bytes = cli::readStdin();
+      if (!bytes) return std::move(bytes).error();
+      in.owned_ = std::move(*bytes);
+      return in;
+    }
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return makeError(Code::kIoOpen, "cannot open " + path + ": " + std::strerror(errno));
+    struct stat st {};
+    if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
+      void* p = ::mmap(nullptr, size_t(st.st_size), PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+      if (p != MAP_FAILED) {
+        ::close(fd);
+        in.map_ = static_cast<const uint8_t*>(p);
+        in.mapSize_ = size_t(st.st_size);
+        return in;
+      }
+    }
+    uint8_t buf[1 << 16];
+    ssize_t n;
+    while ((n = ::read(fd, buf, sizeof buf)) > 0) in.owned_.insert(in.owned_.end(), buf, buf + n);
+    const int err = errno;
+    ::close(fd);
+    if (n < 0) return makeError(Code::kIoRead, "cannot read " + path + ": " + std::strerror(err));
+    return in;
+  }
+  Input() = default;
+  Input(Input&& o) noexcept : owned_(std::move(o.owned_)), map_(std::exchange(o.map_, nullptr)), mapSize_(o.mapSize_) {}
+  Input& operator=(Input&&) = delete;
+  ~Input() {
+    if (map_) ::munmap(const_cast<uint8_t*>(map_), mapSize_);
+  }
+  std::span<const uint8_t> bytes() const { return map_ ? std::span(map_, mapSize_) : std::span<const uint8_t>(owned_); }
+
+ private:
+  std::vector<uint8_t> owned_;
+  const uint8_t* map_ = nullptr;
+  size_t mapSize_ = 0;
+};
 
 // The rays of a .npy matrix; a problem is an invalid-input message.
 std::optional<std::string> npyRays(std::span<const uint8_t> bytes, const Options& o, std::vector<Ray>* rays) {
@@ -129,23 +167,26 @@ std::optional<std::string> npyRays(std::span<const uint8_t> bytes, const Options
   return std::nullopt;
 }
 
-// Answers the rays in chunks over `threads` threads.
+// Answers the rays in chunks over `threads` threads; each chunk's answers go to store(first, hits,
+// visibility) (visibility empty unless asked for), from the thread that made them.
+template <class Store>
 void answer(const FieldQuery& q, const std::optional<Instance>& inst, std::span<const Ray> rays, const QueryOptions& qo,
-            bool visibility, unsigned threads, std::vector<QueryHit>* hits, std::vector<float>* vis) {
-  hits->resize(rays.size());
-  if (visibility) vis->resize(rays.size());
+            bool visibility, unsigned threads, Store store) {
   const size_t chunks = (rays.size() + kChunk - 1) / kChunk;
   std::atomic<size_t> next{0};
   auto work = [&] {
+    std::vector<QueryHit> hits(kChunk);
+    std::vector<float> vis(visibility ? kChunk : 0);
     for (size_t c; (c = next.fetch_add(1)) < chunks;) {
       const size_t b = c * kChunk, n = std::min(kChunk, rays.size() - b);
       auto in = rays.subspan(b, n);
-      std::span<QueryHit> out(hits->data() + b, n);
+      std::span<QueryHit> out(hits.data(), n);
       if (inst) inst->intersect(in, out, qo); else q.intersect(in, out, qo);
+      std::span<float> v(vis.data(), visibility ? n : 0);
       if (visibility) {
-        std::span<float> v(vis->data() + b, n);
         if (inst) inst->visibility(in, v, qo); else q.visibility(in, v, qo);
       }
+      store(b, std::span<const QueryHit>(out), std::span<const float>(v));
     }
   };
   const unsigned n = std::max(1u, std::min<unsigned>(threads, unsigned(chunks)));
@@ -223,15 +264,16 @@ int run(int argc, char** argv) {
   } else {
     const std::string path = o.input.empty() ? "-" : o.input;
     const std::string label = path == "-" ? "<stdin>" : path;
-    auto bytes = readAll(path);
-    if (!bytes) return cli::reportError(kProg, label, bytes.error());
-    if (bytes->size() >= 6 && std::memcmp(bytes->data(), "\x93NUMPY", 6) == 0) {
-      if (auto e = npyRays(*bytes, o, &rays)) {
+    auto input = Input::open(path);
+    if (!input) return cli::reportError(kProg, label, input.error());
+    const std::span<const uint8_t> bytes = input->bytes();
+    if (bytes.size() >= 6 && std::memcmp(bytes.data(), "\x93NUMPY", 6) == 0) {
+      if (auto e = npyRays(bytes, o, &rays)) {
         cli::printError(kProg, label + ": " + *e);
         return cli::kExitInvalidFile;
       }
     } else {
-      ParsedRays parsed = parseRayLines({reinterpret_cast<const char*>(bytes->data()), bytes->size()}, o.tmin, o.tmax);
+      ParsedRays parsed = parseRayLines({reinterpret_cast<const char*>(bytes.data()), bytes.size()}, o.tmin, o.tmax);
       rays = std::move(parsed.rays);
       if (parsed.error)
         badInput = label + ":" + std::to_string(parsed.error->line) + ":" + std::to_string(parsed.error->column) +
@@ -243,13 +285,29 @@ int run(int argc, char** argv) {
   qo.reconstruction = o.interpolated ? Reconstruction::kInterpolated : Reconstruction::kNearest;
   qo.intraBias = o.intraBias;
   const unsigned threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
+  // .npy answers go straight into the output's rows; text ones are formatted after.
+  const auto t1 = std::chrono::steady_clock::now();
+  std::vector<uint8_t> out;
   std::vector<QueryHit> hits;
   std::vector<float> vis;
-  const auto t1 = std::chrono::steady_clock::now();
-  answer(*q, inst, rays, qo, o.visibility, threads, &hits, &vis);
+  if (format == OutputFormat::kNpy) {
+    const size_t cols = kColumnCount + (o.visibility ? 1 : 0);
+    out = npyMatrixHeader(rays.size(), cols);
+    const size_t head = out.size();
+    out.resize(head + rays.size() * cols * sizeof(float));
+    float* rows = reinterpret_cast<float*>(out.data() + head);  // head is a multiple of 64
+    answer(*q, inst, rays, qo, o.visibility, threads,
+           [&](size_t first, std::span<const QueryHit> h, std::span<const float> v) { answerRows(h, v, rows + first * cols); });
+  } else {
+    hits.resize(rays.size());
+    if (o.visibility) vis.resize(rays.size());
+    answer(*q, inst, rays, qo, o.visibility, threads, [&](size_t first, std::span<const QueryHit> h, std::span<const float> v) {
+      std::copy(h.begin(), h.end(), hits.begin() + ptrdiff_t(first));
+      std::copy(v.begin(), v.end(), vis.begin() + ptrdiff_t(first));
+    });
+  }
   const auto t2 = std::chrono::steady_clock::now();
-
-  const std::vector<uint8_t> out = formatAnswers(hits, vis, format);
+  if (format != OutputFormat::kNpy) out = formatAnswers(hits, vis, format);
   if (auto st = cli::writeFileAtomic(o.output, out); !st) return cli::reportError(kProg, "", st.error());
   if (o.timing) {
     const auto t3 = std::chrono::steady_clock::now();

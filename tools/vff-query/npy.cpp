@@ -95,21 +95,28 @@ std::optional<std::string> readNpyMatrix(std::span<const uint8_t> bytes, NpyMatr
   return std::nullopt;
 }
 
-std::vector<uint8_t> npyMatrixBytes(std::span<const float> values, uint64_t rows, uint64_t cols) {
+std::vector<uint8_t> npyMatrixHeader(uint64_t rows, uint64_t cols) {
   std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" + std::to_string(rows) + ", " +
                        std::to_string(cols) + "), }";
   // The data starts on a 64-byte boundary; the header ends with '\n'.
   const size_t total = 10 + header.size() + 1;
   header.append((64 - total % 64) % 64, ' ');
   header.push_back('\n');
-  std::vector<uint8_t> out(10 + header.size() + values.size_bytes());
+  std::vector<uint8_t> out(10 + header.size());
   std::memcpy(out.data(), kNpyMagic, 6);
   out[6] = 1;
   out[7] = 0;
   out[8] = uint8_t(header.size() & 0xff);
   out[9] = uint8_t(header.size() >> 8);
   std::memcpy(out.data() + 10, header.data(), header.size());
-  if (!values.empty()) std::memcpy(out.data() + 10 + header.size(), values.data(), values.size_bytes());
+  return out;
+}
+
+std::vector<uint8_t> npyMatrixBytes(std::span<const float> values, uint64_t rows, uint64_t cols) {
+  std::vector<uint8_t> out = npyMatrixHeader(rows, cols);
+  const size_t head = out.size();
+  out.resize(head + values.size_bytes());
+  if (!values.empty()) std::memcpy(out.data() + head, values.data(), values.size_bytes());
   return out;
 }
 

@@ -25,5 +25,7 @@ std::optional<std::string> readNpyMatrix(std::span<const uint8_t> bytes, NpyMatr
 
 // A .npy file (format 1.0) holding `values` as a (rows, cols) '<f4' array.
 std::vector<uint8_t> npyMatrixBytes(std::span<const float> values, uint64_t rows, uint64_t cols);
+// The header alone of that file (its size a multiple of 64): the data follows it.
+std::vector<uint8_t> npyMatrixHeader(uint64_t rows, uint64_t cols);
 
 }  // namespace vff::query_tool

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 
 #include "npy.h"
 
@@ -162,27 +163,33 @@ ParsedRays parseRayLines(std::string_view text, float tmin, float tmax) {
   return out;
 }
 
+void answerRows(std::span<const QueryHit> hits, std::span<const float> visibility, float* rows) {
+  const bool vis = !visibility.empty();
+  const size_t cols = kColumnCount + (vis ? 1 : 0);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (size_t i = 0; i < hits.size(); ++i) {
+    const QueryHit& h = hits[i];
+    float* r = rows + i * cols;
+    r[0] = h.hit ? 1.0f : 0.0f;
+    r[1] = h.t;
+    r[2] = h.hit ? h.point.x : nan;
+    r[3] = h.hit ? h.point.y : nan;
+    r[4] = h.hit ? h.point.z : nan;
+    r[5] = h.hasNormal ? h.normal.x : nan;
+    r[6] = h.hasNormal ? h.normal.y : nan;
+    r[7] = h.hasNormal ? h.normal.z : nan;
+    r[8] = h.inside ? 1.0f : 0.0f;
+    if (vis) r[9] = visibility[i];
+  }
+}
+
 std::vector<uint8_t> formatAnswers(std::span<const QueryHit> hits, std::span<const float> visibility,
                                    OutputFormat format) {
   const bool vis = !visibility.empty();
   if (format == OutputFormat::kNpy) {
     const uint64_t cols = kColumnCount + (vis ? 1 : 0);
     std::vector<float> m(hits.size() * cols);
-    const float nan = std::numeric_limits<float>::quiet_NaN();
-    for (size_t i = 0; i < hits.size(); ++i) {
-      const QueryHit& h = hits[i];
-      float* r = &m[i * cols];
-      r[0] = h.hit ? 1.0f : 0.0f;
-      r[1] = h.t;
-      r[2] = h.hit ? h.point.x : nan;
-      r[3] = h.hit ? h.point.y : nan;
-      r[4] = h.hit ? h.point.z : nan;
-      r[5] = h.hasNormal ? h.normal.x : nan;
-      r[6] = h.hasNormal ? h.normal.y : nan;
-      r[7] = h.hasNormal ? h.normal.z : nan;
-      r[8] = h.inside ? 1.0f : 0.0f;
-      if (vis) r[9] = visibility[i];
-    }
+    answerRows(hits, visibility, m.data());
     return npyMatrixBytes(m, hits.size(), cols);
   }
   std::string out;

@@ -44,6 +44,10 @@ inline constexpr int kColumnCount = 9;
 
 enum class OutputFormat { kCsv, kJsonLines, kNpy };
 
+// The .npy rows of answers: kColumnCount floats per ray (hit and inside as 0/1, NaN where there is
+// no point or normal), and visibility last when `visibility` is not empty.
+void answerRows(std::span<const QueryHit> hits, std::span<const float> visibility, float* rows);
+
 // The answers as one output document. `visibility`, when not empty, adds a last column
 // "visibility" (one value per ray).
 std::vector<uint8_t> formatAnswers(std::span<const QueryHit> hits, std::span<const float> visibility,
