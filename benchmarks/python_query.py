@@ -7,9 +7,11 @@
 Makes `--rays` ambient-occlusion rays about the field (origins on a disc around its foot, up to
 2R, cosine-weighted; as vff-experiments bench's "ao" set) and writes them as an (N, 6) float32
 .npy. Then, best of --repeat each, alternating:
-  C++ batch    vff-query --timing: the batch calls alone (FieldQuery::intersect over its threads)
+  C++ batch    vff-query --timing: the batch calls alone on warm memory (FieldQuery::intersect in
+               chunks over its threads, the answers dropped)
   vff-query    the same command end to end: reading the .npy, querying, writing the answers .npy
-  Python       FieldQuery.intersect(origins, directions) on numpy arrays (threads as vff-query's)
+  Python       FieldQuery.intersect(origins, directions) on numpy arrays (threads as vff-query's),
+               and FieldQuery.occluded for reference
 and prints each in Mrays/s with its ratio to the C++ batch, naming the CPU.
 """
 import argparse
@@ -54,7 +56,7 @@ def main():
     q = vff.FieldQuery(f)
     o, d = ao_rays(f, a.rays)
     extra = ["--interpolated"] if a.interpolated else []
-    best = {"cpp": 0.0, "cli": 0.0, "py": 0.0}
+    best = {"cpp": 0.0, "cli": 0.0, "py": 0.0, "occ": 0.0}
     with tempfile.TemporaryDirectory() as tmp:
         rays = os.path.join(tmp, "rays.npy")
         out = os.path.join(tmp, "hits.npy")
@@ -62,7 +64,7 @@ def main():
         cmd = [a.query, a.field, "-i", rays, "-o", out, "-j", str(a.threads), *extra]
         for _ in range(a.repeat):
             r = subprocess.run(cmd + ["--timing"], capture_output=True, text=True, check=True)
-            m = re.search(r"query [0-9.]+ s \(([0-9.]+) Mrays/s\)", r.stderr)
+            m = re.search(r"batch alone, warm: [0-9.]+ s \(([0-9.]+) Mrays/s\)", r.stderr)
             best["cpp"] = max(best["cpp"], float(m.group(1)))
             t0 = time.perf_counter()
             subprocess.run(cmd, check=True)
@@ -70,6 +72,9 @@ def main():
             t0 = time.perf_counter()
             h = q.intersect(o, d, interpolated=a.interpolated, threads=a.threads)
             best["py"] = max(best["py"], a.rays / 1e6 / (time.perf_counter() - t0))
+            t0 = time.perf_counter()
+            q.occluded(o, d, interpolated=a.interpolated, threads=a.threads)
+            best["occ"] = max(best["occ"], a.rays / 1e6 / (time.perf_counter() - t0))
         got = np.load(out)
         assert np.array_equal(got[:, 1], h.t), "vff-query and the Python batch disagree"
     print("cpu: %s, %d threads, batch kernel %s" % (cpu_name(), a.threads, vff.batch_kernel()))
@@ -78,9 +83,10 @@ def main():
         "interpolated" if a.interpolated else "nearest", a.repeat))
     print("| path | Mrays/s | x C++ batch |")
     print("|---|---:|---:|")
-    print("| C++ batch (FieldQuery::intersect, vff-query --timing) | %.1f | 1.00 |" % best["cpp"])
+    print("| C++ batch (FieldQuery::intersect, warm, vff-query --timing) | %.1f | 1.00 |" % best["cpp"])
     print("| vff-query, .npy in and out, end to end | %.1f | %.2f |" % (best["cli"], best["cli"] / best["cpp"]))
     print("| Python FieldQuery.intersect, numpy in and out | %.1f | %.2f |" % (best["py"], best["py"] / best["cpp"]))
+    print("| Python FieldQuery.occluded (a byte per ray out; no C++ baseline here) | %.1f | - |" % best["occ"])
     return 0
 
 
