@@ -153,11 +153,22 @@ struct Hits {
   py::array_t<bool> inside;
 };
 
+// The Hits to fill: `out` when given (its arrays must hold n rays), else new arrays.
+Hits hitsFor(const py::object& out, size_t count) {
+  const auto n = py::ssize_t(count);
+  if (out.is_none())
+    return Hits{py::array_t<bool>(n), py::array_t<float>(n), py::array_t<float>({n, py::ssize_t(3)}),
+                py::array_t<float>({n, py::ssize_t(3)}), py::array_t<bool>(n)};
+  if (!py::isinstance<Hits>(out)) throw py::type_error("out: expected a vff.Hits from an earlier intersect()");
+  Hits h = out.cast<Hits>();
+  if (h.hit.size() != n)
+    throw py::value_error("out: holds " + std::to_string(h.hit.size()) + " rays, the call has " + std::to_string(n));
+  return h;
+}
+
 template <class Target>
-Hits intersectBatch(const Target& target, const RayBatch& b) {
-  const auto n = py::ssize_t(b.n);
-  Hits h{py::array_t<bool>(n), py::array_t<float>(n), py::array_t<float>({n, py::ssize_t(3)}),
-         py::array_t<float>({n, py::ssize_t(3)}), py::array_t<bool>(n)};
+Hits intersectBatch(const Target& target, const RayBatch& b, const py::object& reuse) {
+  Hits h = hitsFor(reuse, b.n);
   bool* hit = h.hit.mutable_data();
   float* t = h.t.mutable_data();
   float* point = h.point.mutable_data();
@@ -236,13 +247,15 @@ field's default). threads: 0 for all cores; the answers do not depend on it. The
 template <class Py, class Get>
 void addQueries(py::class_<Py>& c, Get get) {
   c.def("intersect", [get](const Py& self, const py::object& o, const py::object& d, const py::object& tmin, const py::object& tmax,
-                           bool interpolated, float intraBias, unsigned threads) {
-        return intersectBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, intraBias, threads));
+                           bool interpolated, float intraBias, unsigned threads, const py::object& out) {
+        return intersectBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, intraBias, threads), out);
       },
       py::arg("origins"), py::arg("directions"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(), py::kw_only(),
-      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("threads") = 0u,
+      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("threads") = 0u, py::arg("out") = py::none(),
       (std::string(kBatchDoc) + "\nReturns a vff.Hits: hit (N,) bool, t (N,) float32 (inf for a miss), point (N, 3) and "
-                                "normal (N, 3) float32 (NaN where there is none), inside (N,) bool.").c_str());
+                                "normal (N, 3) float32 (NaN where there is none), inside (N,) bool. out: the Hits of an "
+                                "earlier call of the same length, filled again instead of new arrays (fresh arrays "
+                                "cost the first touch of their memory; a loop over batches saves it).").c_str());
   c.def("occluded", [get](const Py& self, const py::object& o, const py::object& d, const py::object& tmin, const py::object& tmax,
                           bool interpolated, float intraBias, unsigned threads) {
         return occludedBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, intraBias, threads));

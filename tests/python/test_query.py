@@ -100,6 +100,13 @@ def test_bounds_layouts_and_threads():
     tmin = np.zeros(5000, np.float32)
     assert np.array_equal(q.intersect(o, d, tmin).t, h.t)
     assert len(q.intersect(o[:0], d[:0])) == 0
+    # out= fills the arrays of an earlier answer again.
+    again = q.intersect(o[::-1], d[::-1])
+    filled = q.intersect(o, d, out=again)
+    assert filled.t is again.t or np.shares_memory(filled.t, again.t)
+    assert np.array_equal(again.t, h.t) and np.array_equal(again.point, h.point, equal_nan=True)
+    with pytest.raises(ValueError, match="out: holds 5000 rays, the call has 4"):
+        q.intersect(o[:4], d[:4], out=again)
 
 
 def test_bad_shapes_and_dtypes_raise_clear_errors():
