@@ -73,6 +73,9 @@ const char* codeName(Code code) noexcept {
     case Code::kMeshNonFinite: return "mesh-non-finite";
     case Code::kMeshDegenerate: return "mesh-degenerate";
     case Code::kMeshIndex: return "mesh-index";
+    case Code::kSceneJson: return "scene-json";
+    case Code::kSceneVersion: return "scene-version";
+    case Code::kSceneValue: return "scene-value";
     case Code::kInvalidArgument: return "invalid-argument";
     case Code::kOutOfRange: return "out-of-range";
     case Code::kBadState: return "bad-state";

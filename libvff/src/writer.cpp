@@ -179,6 +179,7 @@ struct Writer::Impl {
   std::vector<SectionRecord> sections;
   PlaneState planes[2];
   uint64_t cursor = 0;
+  uint64_t mapsWritten = 0;  // for options.progress
   bool finished = false;
   bool failed = false;
   std::string metaPending;  // canonical metadata JSON, written by writePrologue()
@@ -235,7 +236,7 @@ struct Writer::Impl {
   // its block) while each thread's zstd context serves many blocks.
   static constexpr uint64_t kWindowBytes = 32u << 20;
   Status writeBlocks(Plane p, const std::vector<std::span<const uint8_t>>& raws) {
-    const size_t threads = std::max(1u, std::thread::hardware_concurrency());
+    const size_t threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
     for (size_t first = 0; first < raws.size();) {
       size_t n = 0;
       uint64_t bytes = 0;
@@ -243,6 +244,13 @@ struct Writer::Impl {
       Status st = writeWindow(p, std::span<const std::span<const uint8_t>>(raws).subspan(first, n), threads);
       if (!st) return st;
       first += n;
+      if (options.progress) {
+        const uint64_t mapBytes = p == Plane::kDistance ? distanceMapBytes(field.distanceEncoding, field.mapResolution)
+                                                        : normalMapBytes(field.normalEncoding, field.mapResolution);
+        for (size_t i = first - n; i < first; ++i) mapsWritten += raws[i].size() / mapBytes;
+        const uint64_t planesPresent = field.normalEncoding == NormalEncoding::kNone ? 1 : 2;
+        options.progress(mapsWritten, uint64_t(field.mapCount) * planesPresent);
+      }
     }
     return {};
   }

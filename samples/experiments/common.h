@@ -166,8 +166,9 @@ vff::Result<std::unique_ptr<BakedQuery>> bakeQuery(const World& world, const vff
                                                    const FieldConfig& config, bool normals, unsigned threads);
 // Loads a field file (--field) of the world's object: every block decoded into memory, queried like a
 // bake. The file must describe the same object: its sphere must be the mesh's minimal enclosing
-// sphere (what bakeQuery uses), within 1e-5 R, and when META names the source mesh's XXH3
-// (vff.source.xxh3, kept by vff-convert) it must be the loaded mesh's. Errors: those of File::open;
+// sphere (what bakeQuery uses), within 1e-5 R, and when META names the source geometry's hash
+// (vff.source.geometryHash, kept by vff-convert; older files: the mesh hash vff.source.xxh3) it must
+// be the loaded mesh's. Errors: those of File::open;
 // kInvalidArgument naming the mismatch (the caller exits 3); kUnsupported when `normals` are
 // needed and the file has none.
 vff::Result<std::unique_ptr<BakedQuery>> loadQuery(const World& world, const std::string& path, bool normals);

@@ -77,14 +77,23 @@ vff::Result<std::unique_ptr<BakedQuery>> loadQuery(const World& world, const std
     return vff::makeError(vff::Code::kInvalidArgument, buf);
   }
   if (!file->metadata().empty()) {
+    // The geometry hash matches the same triangles read from any file format; files from before it
+    // existed carry only the hash of the mesh as baked (vertex order included).
     const auto meta = nlohmann::json::parse(file->metadata(), nullptr, false);
-    if (meta.is_object() && meta.contains("vff.source") && meta["vff.source"].is_object() &&
-        meta["vff.source"].contains("xxh3") && meta["vff.source"]["xxh3"].is_string()) {
-      const std::string want = vff::cli::hexDigits64(vff::bake::meshHash(world.objectMesh));
-      const std::string got = meta["vff.source"]["xxh3"].get<std::string>();
+    const nlohmann::json* source = meta.is_object() && meta.contains("vff.source") && meta["vff.source"].is_object()
+                                       ? &meta["vff.source"]
+                                       : nullptr;
+    for (const char* key : {"geometryHash", "xxh3"}) {
+      if (!source || !source->contains(key) || !(*source)[key].is_string()) continue;
+      const uint64_t h = std::string(key) == "xxh3" ? vff::bake::meshHash(world.objectMesh)
+                                                    : vff::bake::geometryHash(world.objectMesh);
+      const std::string want = vff::cli::hexDigits64(h);
+      const std::string got = (*source)[key].get<std::string>();
       if (got != want)
-        return vff::makeError(vff::Code::kInvalidArgument, "the field was baked from a mesh with XXH3 " + got +
-                                                               " (META vff.source.xxh3), the loaded mesh has " + want);
+        return vff::makeError(vff::Code::kInvalidArgument, "the field was baked from other geometry: META vff.source." +
+                                                               std::string(key) + " is " + got +
+                                                               ", the loaded mesh's is " + want);
+      break;
     }
   }
   if (normals && !file->hasNormals())

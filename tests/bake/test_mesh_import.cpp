@@ -109,11 +109,12 @@ TEST_F(MeshImport, GltfPointsAreAnError) {
   EXPECT_NE(m.error().message.find("p.gltf"), std::string::npos);
 }
 
-TEST_F(MeshImport, GltfRequiredCompressionIsAnError) {
-  auto m = loadMesh(write("d.gltf", triangleGltf("", R"("extensionsUsed":["KHR_draco_mesh_compression"],"extensionsRequired":["KHR_draco_mesh_compression"],)")));
+TEST_F(MeshImport, GltfRequiredUnknownExtensionIsUnsupported) {
+  auto m = loadMesh(write("d.gltf", triangleGltf("", R"("extensionsUsed":["EXT_unheard_of"],"extensionsRequired":["KHR_draco_mesh_compression","EXT_unheard_of"],)")));
   ASSERT_FALSE(m.ok());
-  EXPECT_TRUE(m.error().code == Code::kMeshUnsupported || m.error().code == Code::kMeshParse) << m.error().toString();
-  EXPECT_NE(m.error().message.find("draco"), std::string::npos) << m.error().message;
+  EXPECT_EQ(m.error().code, Code::kMeshUnsupported) << m.error().toString();
+  EXPECT_NE(m.error().message.find("d.gltf: requires the glTF extension EXT_unheard_of"), std::string::npos)
+      << m.error().message;
 }
 
 TEST_F(MeshImport, GltfAccessorOutOfBoundsIsAnError) {

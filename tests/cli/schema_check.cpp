@@ -1,6 +1,6 @@
 // schema_check: checks a JSON document against a JSON Schema (draft 2020-12), for the subset of
-// keywords that spec/inspect-schema.json uses. A keyword outside that subset is an error, so the
-// schema cannot grow past what this checker enforces.
+// keywords that spec/inspect-schema.json and spec/scene-schema.json use. A keyword outside that
+// subset is an error, so the schema cannot grow past what this checker enforces.
 //
 //   vff_cli_schema_check SCHEMA.json INSTANCE.json    (INSTANCE "-" reads stdin)
 //   exit 0: conforms; 1: does not (every violation printed); 2: bad arguments, files or schema.
@@ -20,7 +20,8 @@ namespace {
 const std::set<std::string> kSupported = {"$schema", "$id",      "title",      "description", "$defs",
                                           "$ref",    "type",     "properties", "required",    "additionalProperties",
                                           "items",   "minItems", "maxItems",   "enum",        "const",
-                                          "minimum", "maximum",  "anyOf",      "pattern"};
+                                          "minimum", "maximum",  "anyOf",      "pattern",
+                                          "exclusiveMinimum"};
 
 struct SchemaError {
   std::string what;
@@ -58,6 +59,8 @@ class Checker {
     if (v.is_number()) {
       if (schema.contains("minimum") && v.get<double>() < schema["minimum"].get<double>())
         errors.push_back(path + ": " + v.dump() + " < minimum " + schema["minimum"].dump());
+      if (schema.contains("exclusiveMinimum") && v.get<double>() <= schema["exclusiveMinimum"].get<double>())
+        errors.push_back(path + ": " + v.dump() + " <= exclusiveMinimum " + schema["exclusiveMinimum"].dump());
       if (schema.contains("maximum") && v.get<double>() > schema["maximum"].get<double>())
         errors.push_back(path + ": " + v.dump() + " > maximum " + schema["maximum"].dump());
     }

@@ -82,6 +82,33 @@ test_same_bytes_every_time() {
   cmp "$WORK/1.vff" "$WORK/3.vff" || fail "compressing a compressed file changed it"
 }
 
+test_same_bytes_whatever_the_thread_count() {
+  bake "$WORK/a.vff"
+  compress "$WORK/a.vff" "$WORK/1.vff" -q -j 1 --maps-per-block 4
+  expect_rc 0
+  compress "$WORK/a.vff" "$WORK/3.vff" -q -j 3 --maps-per-block 4
+  expect_rc 0
+  cmp "$WORK/1.vff" "$WORK/3.vff" || fail "-j 1 and -j 3 wrote different files"
+}
+
+# On a terminal (a pseudo-terminal from script(1)) the progress line is drawn and ends at the total;
+# with --quiet, or off a terminal, nothing is.
+test_progress_line_on_a_terminal() {
+  if ! command -v script >/dev/null; then
+    echo "SKIP: script(1) is not installed"
+    return 0
+  fi
+  bake "$WORK/a.vff"
+  script -qec "'$VFF_COMPRESS' '$WORK/a.vff' '$WORK/t.vff' --maps-per-block 4" /dev/null >"$WORK/tty" 2>&1 ||
+    fail "vff-compress on a terminal failed: $(cat "$WORK/tty")"
+  grep -q "vff-compress: 170/170 maps" "$WORK/tty" || fail "no progress line ending at 170/170 maps: $(cat "$WORK/tty")"
+  script -qec "'$VFF_COMPRESS' '$WORK/a.vff' '$WORK/q.vff' -q" /dev/null >"$WORK/tty" 2>&1 || fail "--quiet failed"
+  [[ ! -s $WORK/tty ]] || fail "--quiet printed: $(cat "$WORK/tty")"
+  compress "$WORK/a.vff" "$WORK/p.vff"
+  expect_rc 0
+  ! grep -q "maps, ETA" "$WORK/err" || fail "a progress line off a terminal"
+}
+
 test_inspect_shows_codec_filter_and_blocks() {
   bake "$WORK/a.vff"
   compress "$WORK/a.vff" "$WORK/z.vff" --blocks

@@ -1,4 +1,6 @@
 #include <gtest/gtest.h>
+
+#include <algorithm>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -41,6 +43,38 @@ TEST_F(WriterFile, WritesAtomicallyAndOpensMapped) {
   std::ifstream in(path, std::ios::binary);
   std::vector<uint8_t> disk((std::istreambuf_iterator<char>(in)), {});
   EXPECT_EQ(disk, *mem);
+}
+
+// The thread count changes nothing in the bytes; progress counts every map of both planes, in order,
+// ending at the total.
+TEST_F(WriterFile, ThreadsKeepTheBytesAndProgressReachesTheTotal) {
+  FieldDesc f = test::smallField(DistanceEncoding::kUnorm8Diameter, NormalEncoding::kOctSnorm16);
+  auto dist = test::syntheticDistance(f);
+  auto norm = test::syntheticNormals(f, dist);
+  std::vector<std::vector<uint8_t>> outs;
+  for (unsigned threads : {1u, 3u, 0u}) {
+    WriteOptions o;
+    o.codec = Codec::kZstd;
+    o.mapsPerBlock = 1;
+    o.threads = threads;
+    std::vector<uint64_t> seen;
+    o.progress = [&](uint64_t done, uint64_t total) {
+      EXPECT_EQ(total, uint64_t(f.mapCount) * 2);
+      seen.push_back(done);
+    };
+    auto w = Writer::createInMemory(f, o);
+    ASSERT_TRUE(w) << w.error().toString();
+    ASSERT_TRUE(w->writeMaps(Plane::kDistance, dist));
+    ASSERT_TRUE(w->writeMaps(Plane::kNormal, norm));
+    auto bytes = w->finishToMemory();
+    ASSERT_TRUE(bytes) << bytes.error().toString();
+    outs.push_back(std::move(*bytes));
+    ASSERT_FALSE(seen.empty());
+    EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+    EXPECT_EQ(seen.back(), uint64_t(f.mapCount) * 2);
+  }
+  EXPECT_EQ(outs[0], outs[1]);
+  EXPECT_EQ(outs[0], outs[2]);
 }
 
 TEST_F(WriterFile, AbandonedWriterLeavesOldFileAndNoTemporary) {

@@ -25,7 +25,8 @@ int exitCodeFor(Code code) noexcept {
   if (c >= 2000 && c < 9000) return kExitInvalidFile;
   if (code == Code::kUnsupported) return kExitUnsupported;
   if (code == Code::kMeshFormat || code == Code::kMeshUnsupported) return kExitUnsupported;
-  if (c >= 10000 && c < 11000) return kExitInvalidFile;
+  if (code == Code::kSceneVersion) return kExitUnsupported;
+  if (c >= 10000 && c < 12000) return kExitInvalidFile;  // mesh inputs, scene descriptions
   return kExitRuntime;
 }
 

@@ -40,7 +40,8 @@ inline constexpr int kExitUnsupported = 5;  // a valid request this build or thi
 // The exit code for a libvff error code:
 //   1xxx (I/O) -> 2; 2xxx..8xxx (file problems) -> 3; 9005 (unsupported) -> 5;
 //   10xxx (mesh input): 10001 unknown mesh format and 10003 unsupported mesh content -> 5,
-//   the other 10xxx (an unparsable or unusable mesh) -> 3; everything else (9xxx API, unknown) -> 4.
+//   the other 10xxx (an unparsable or unusable mesh) -> 3; 11xxx (scene description): 11002 (not a
+//   vff-scene version 1) -> 5, the others -> 3; everything else (9xxx API, unknown) -> 4.
 int exitCodeFor(Code code) noexcept;
 
 // The "Exit codes:" paragraph for the end of every tool's --help text.

@@ -16,6 +16,7 @@
 #include "enum_option.h"
 #include "options_codec.h"
 #include "options_layout.h"
+#include "progress.h"
 #include "vff/bake/baker.h"
 #include "vff/vff.h"
 
@@ -28,6 +29,8 @@ struct Options {
   std::string mesh;
   std::string output;
   std::string grid;  // .vdb input: the level set grid to bake (empty: the first)
+  int scene = -1;     // glTF input: the scene to bake (-1: the file's default scene)
+  std::string split;  // glTF input: "mesh" or "node": a field each and a scene description
   cli::EnumOption<PositionScheme> positions{"--positions", cli::kPositionSchemes, PositionScheme::kOctaHemi2};
   uint32_t count = 0;  // 0: the scheme's default
   uint32_t mapSize = 64;
@@ -56,23 +59,11 @@ std::optional<std::string> checkOptions(const Options& o);
 // The baker's options and the writer's, from the command line.
 bake::BakeOptions bakeOptions(const Options& o);
 WriteOptions writeOptions(const Options& o);
-// The input is an OpenVDB file (by its extension).
+// The input is an OpenVDB file, a glTF file (by its extension).
 bool isVdbPath(const std::string& p);
+bool isGltfPath(const std::string& p);
 
 // ---- What both bakes share (common.cpp) ---------------------------------------------------------
-// A progress line on stderr, redrawn at most 10 times a second, only when enabled (on a terminal).
-class Progress {
- public:
-  Progress(bool enabled, uint64_t raysPerMap) : enabled_(enabled), raysPerMap_(raysPerMap) {}
-  void update(uint64_t done, uint64_t total);
-
- private:
-  bool enabled_;
-  uint64_t raysPerMap_;
-  std::mutex mu_;
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now(), last_{};
-};
-
 // Seconds since `t0`.
 double secondsSince(std::chrono::steady_clock::time_point t0);
 // The last component of a path.
@@ -85,10 +76,11 @@ double peakRssMiB();
 // printed here; returns the exit code then, else nothing, with the payload bytes in *payload.
 std::optional<int> checkPlan(const Result<FieldDesc>& field, const LayoutLimits& limits, uint64_t* payload);
 
-// Writes the baked maps (the normals too with o.normals) through `writer` and finishes the file;
-// *seconds: the time it took, *fileBytes: the file's size. Returns the exit code of a failure.
-std::optional<int> writeBaked(const Options& o, Writer& writer, const bake::BakedField& baked, double* seconds,
-                              uint64_t* fileBytes);
+// Writes the baked maps (the normals too with o.normals) through `writer` of `output` and finishes
+// the file; *seconds: the time it took, *fileBytes: the file's size. Returns the exit code of a
+// failure.
+std::optional<int> writeBaked(const Options& o, const std::string& output, Writer& writer,
+                              const bake::BakedField& baked, double* seconds, uint64_t* fileBytes);
 
 // The --json keys every bake reports (the callers add their input's and timing keys).
 nlohmann::json bakeSummary(const bake::BakeOptions& bo, const FieldDesc& field, const bake::BakeStats& s,
@@ -99,12 +91,25 @@ nlohmann::json bakeSummary(const bake::BakeOptions& bo, const FieldDesc& field, 
 // exist; those of live processes stay.
 void removeStaleTemporaries(const std::string& output);
 // Once the Writer of `output` exists: on SIGINT, SIGTERM or SIGHUP, its temporary is removed and the
-// process ends killed by the signal (the old file at `output`, if any, stays as it was). A signal
-// ignored when this is called stays ignored.
-void removeTemporaryOnSignal(const std::string& output);
+// process ends killed by the signal (the old file at `output`, if any, stays as it was), and so are
+// the files `finished` (the outputs this run completed before, which are incomplete without it). A
+// signal ignored when this is called stays ignored. Each call replaces the previous one's paths.
+void removeTemporaryOnSignal(const std::string& output, const std::vector<std::string>& finished = {});
 
 // ---- The bakes; each returns the tool's exit code -----------------------------------------------
 int bakeFromMesh(const Options& o, bake::BakeOptions bo, WriteOptions wo);      // mesh_bake.cpp
 int bakeFromLevelSet(const Options& o, bake::BakeOptions bo, WriteOptions wo);  // levelset_bake.cpp
+// --split: a field per mesh or node of a glTF scene and a scene description (split_bake.cpp).
+int bakeGltfSplit(const Options& o, bake::BakeOptions bo, WriteOptions wo);
+
+// ---- Shared by the mesh bakes (mesh_bake.cpp) ----------------------------------------------------
+// META of a field baked from `mesh` (read from o.mesh); `clipped`: a user sphere cuts it; `gltf`:
+// where in a glTF file the object came from (split bakes), or null.
+std::string meshMetadata(const Options& o, const bake::BakeOptions& bo, const bake::Mesh& mesh,
+                         const bake::MeshInfo& info, bool clipped, const nlohmann::json& gltf = nullptr);
+// Reports an error of loading `input`; returns the exit code (a scene the file lacks: usage, 1).
+int reportLoadError(const Error& e, const std::string& input);
+// The note that a glTF file has scenes this run does not bake (not with --quiet).
+void noteUnbakedScenes(const Options& o, const bake::MeshInfo& info);
 
 }  // namespace vff::bake_tool

@@ -1,4 +1,4 @@
-// common.cpp - what vff-bake's two bakes share: the progress line, the checks of a planned field,
+// common.cpp - what vff-bake's bakes share: the checks of a planned field,
 // writing the maps and the summary (see bake.h).
 #include <sys/resource.h>
 
@@ -9,21 +9,6 @@
 #include "cli.h"
 
 namespace vff::bake_tool {
-
-void Progress::update(uint64_t done, uint64_t total) {
-  if (!enabled_) return;
-  const auto now = std::chrono::steady_clock::now();
-  std::lock_guard<std::mutex> lock(mu_);
-  if (done != total && now - last_ < std::chrono::milliseconds(100)) return;
-  last_ = now;
-  const double secs = std::chrono::duration<double>(now - start_).count();
-  const double rate = secs > 0 ? double(done * raysPerMap_) / secs : 0;
-  const double eta = done ? secs * double(total - done) / double(done) : 0;
-  std::fprintf(stderr, "\r%s: %" PRIu64 "/%" PRIu64 " maps, %.1f Mrays/s, ETA %.1f s   ", kProg, done, total,
-               rate / 1e6, eta);
-  if (done == total) std::fputc('\n', stderr);
-  std::fflush(stderr);
-}
 
 double secondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -59,15 +44,15 @@ std::optional<int> checkPlan(const Result<FieldDesc>& field, const LayoutLimits&
   return std::nullopt;
 }
 
-std::optional<int> writeBaked(const Options& o, Writer& writer, const bake::BakedField& baked, double* seconds,
-                              uint64_t* fileBytes) {
+std::optional<int> writeBaked(const Options& o, const std::string& output, Writer& writer,
+                              const bake::BakedField& baked, double* seconds, uint64_t* fileBytes) {
   const auto t0 = std::chrono::steady_clock::now();
   Status st = writer.writeMaps(Plane::kDistance, baked.distance);
   if (st && o.normals) st = writer.writeMaps(Plane::kNormal, baked.normals);
   if (st) st = writer.finish();
-  if (!st) return cli::reportError(kProg, o.output, st.error());
+  if (!st) return cli::reportError(kProg, output, st.error());
   *seconds = secondsSince(t0);
-  if (auto f = File::open(o.output, {.checksums = ChecksumPolicy::kNone})) *fileBytes = f->info().fileSize;
+  if (auto f = File::open(output, {.checksums = ChecksumPolicy::kNone})) *fileBytes = f->info().fileSize;
   return std::nullopt;
 }
 

@@ -9,6 +9,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <deque>
 #include <filesystem>
 #include <string>
 #include <system_error>
@@ -21,17 +22,22 @@ namespace vff::bake_tool {
 namespace {
 
 constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP};
-constexpr size_t kMaxPaths = 4;
-constexpr size_t kPathBytes = 4096;
-// The paths the handler removes: written before it is armed, read only by it.
-char gPaths[kMaxPaths][kPathBytes];
+// The paths the handler removes. Each arming builds a new list and publishes it whole; lists are
+// never freed (a handler could be reading one), and are kept reachable here.
+struct PathList {
+  std::vector<std::string> paths;
+  std::vector<const char*> cStrings;
+};
+std::deque<PathList> gLists;
+PathList* volatile gList = nullptr;
 volatile sig_atomic_t gPathCount = 0;
 
 // Async-signal-safe: unlink, sigaction and raise only. The signal is blocked while this runs, so the
 // raised one is delivered with the default action as the handler returns: the process ends killed
 // by it, as it would have without the handler.
 void onSignal(int sig) {
-  for (sig_atomic_t i = 0; i < gPathCount; ++i) ::unlink(gPaths[i]);
+  const PathList* list = gList;
+  for (sig_atomic_t i = 0; list && i < gPathCount; ++i) ::unlink(list->cStrings[size_t(i)]);
   struct sigaction dfl {};
   dfl.sa_handler = SIG_DFL;
   sigemptyset(&dfl.sa_mask);
@@ -78,16 +84,15 @@ void removeStaleTemporaries(const std::string& output) {
   for (const auto& p : temporaries(output, dead)) std::filesystem::remove(p, ec);
 }
 
-void removeTemporaryOnSignal(const std::string& output) {
+void removeTemporaryOnSignal(const std::string& output, const std::vector<std::string>& finished) {
   const pid_t self = getpid();
-  sig_atomic_t n = 0;
-  for (const auto& p : temporaries(output, [self](pid_t pid) { return pid == self; })) {
-    const std::string s = p.string();
-    if (size_t(n) == kMaxPaths || s.size() >= kPathBytes) break;
-    std::memcpy(gPaths[n], s.c_str(), s.size() + 1);
-    ++n;
-  }
-  gPathCount = n;
+  PathList& list = gLists.emplace_back();
+  for (const auto& p : temporaries(output, [self](pid_t pid) { return pid == self; })) list.paths.push_back(p.string());
+  list.paths.insert(list.paths.end(), finished.begin(), finished.end());
+  for (const std::string& p : list.paths) list.cStrings.push_back(p.c_str());
+  gPathCount = 0;
+  gList = &list;
+  gPathCount = sig_atomic_t(list.cStrings.size());
   for (int sig : kSignals) {
     struct sigaction old {}, act {};
     // A signal the caller ignores (nohup, a background job of a script) stays ignored.

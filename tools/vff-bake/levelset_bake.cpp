@@ -80,11 +80,11 @@ int bakeFromLevelSet(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
   if (!writer) return cli::reportError(kProg, o.output, writer.error());
   removeTemporaryOnSignal(o.output);
 
-  Progress progress(!o.quiet && !o.json && isatty(2), uint64_t(o.mapSize) * o.mapSize);
+  cli::Progress progress(kProg, !o.quiet && !o.json && isatty(2), uint64_t(o.mapSize) * o.mapSize);
   bo.progress = [&](uint64_t d, uint64_t total) { progress.update(d, total); };
   auto baked = bake::bakeLevelSet(*ls, bo);
   if (!baked) return cli::reportError(kProg, o.mesh, baked.error());
-  if (auto rc = writeBaked(o, *writer, *baked, &t.write, &t.fileBytes)) return *rc;
+  if (auto rc = writeBaked(o, o.output, *writer, *baked, &t.write, &t.fileBytes)) return *rc;
   reportLevelSetBake(o, bo, info, *field, baked->stats, payload, t);
   return cli::kExitSuccess;
 }

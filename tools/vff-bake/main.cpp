@@ -4,8 +4,9 @@
 //   vff-bake mesh.glb -o f.vff --normals --encoding unorm16-diameter --codec zstd
 //   vff-bake mesh.obj --benchmark           Embree's raw throughput on the bake's rays vs the bake
 //   vff-bake shape.vdb -o f.vff [--grid NAME]   from an OpenVDB level set (vff/bake/levelset.h)
+//   vff-bake scene.glb --split mesh -o s.vffscene.json   a field per mesh and a scene description
 //
-// options.cpp reads the command line, mesh_bake.cpp and levelset_bake.cpp bake, common.cpp holds
+// options.cpp reads the command line, mesh_bake.cpp, split_bake.cpp and levelset_bake.cpp bake, common.cpp holds
 // what the two bakes share (bake.h).
 #include "bake.h"
 #include "cli.h"
@@ -26,5 +27,6 @@ int main(int argc, char** argv) {
     return vff::cli::kExitUsage;
   }
   if (isVdbPath(o.mesh)) return bakeFromLevelSet(o, bakeOptions(o), writeOptions(o));
+  if (!o.split.empty()) return bakeGltfSplit(o, bakeOptions(o), writeOptions(o));
   return bakeFromMesh(o, bakeOptions(o), writeOptions(o));
 }

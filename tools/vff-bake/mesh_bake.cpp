@@ -16,20 +16,6 @@ namespace vff::bake_tool {
 
 namespace {
 
-// A user sphere that cuts the mesh is recorded (`clipped`); other files keep their bytes.
-std::string meshMetadata(const Options& o, const bake::BakeOptions& bo, const bake::Mesh& mesh,
-                         const bake::MeshInfo& info, bool clipped) {
-  nlohmann::json meta = {
-      {"vff.generator", "vff-bake"},
-      {"vff.generatorVersion", kLibraryVersion},
-      {"vff.source", {{"name", baseName(o.mesh)}, {"format", info.format}, {"xxh3", cli::hexDigits64(bake::meshHash(mesh))},
-                      {"vertices", mesh.vertexCount()}, {"triangles", mesh.triangleCount()}}},
-      {"vff.bake", {{"rayOrigin", "texel centre"}, {"sphere", bo.sphere ? "user" : "minimal-enclosing"},
-                    {"twoSided", true}, {"normals", o.normals ? (mesh.normals.empty() ? "geometric" : "interpolated") : "none"}}}};
-  if (clipped) meta["vff.bake"]["sphereEnclosesMesh"] = false;
-  return meta.dump();
-}
-
 // The distance of the mesh's farthest vertex from the sphere's centre.
 double farthestVertex(const bake::Mesh& mesh, const Sphere& s) {
   double far2 = 0;
@@ -138,7 +124,7 @@ std::optional<int> traceAndBake(const Options& o, bake::BakeOptions bo, const ba
       m->raw = r == 0 ? st->seconds : std::min(m->raw, st->seconds);
     }
   }
-  Progress progress(!o.quiet && !o.json && !o.benchmark && isatty(2), uint64_t(o.mapSize) * o.mapSize);
+  cli::Progress progress(kProg, !o.quiet && !o.json && !o.benchmark && isatty(2), uint64_t(o.mapSize) * o.mapSize);
   bo.progress = [&](uint64_t d, uint64_t t) { progress.update(d, t); };
   for (int r = 0; r < (o.benchmark ? o.repeat : 1); ++r) {
     auto b = bake::bakeField(scene, bo);
@@ -151,13 +137,52 @@ std::optional<int> traceAndBake(const Options& o, bake::BakeOptions bo, const ba
 
 }  // namespace
 
+// A user sphere that cuts the mesh is recorded (`clipped`); other files keep their bytes.
+std::string meshMetadata(const Options& o, const bake::BakeOptions& bo, const bake::Mesh& mesh,
+                         const bake::MeshInfo& info, bool clipped, const nlohmann::json& gltf) {
+  nlohmann::json meta = {
+      {"vff.generator", "vff-bake"},
+      {"vff.generatorVersion", kLibraryVersion},
+      {"vff.source", {{"name", baseName(o.mesh)}, {"format", info.format}, {"xxh3", cli::hexDigits64(bake::meshHash(mesh))},
+                      {"geometryHash", cli::hexDigits64(bake::geometryHash(mesh))},
+                      {"vertices", mesh.vertexCount()}, {"triangles", mesh.triangleCount()}}},
+      {"vff.bake", {{"rayOrigin", "texel centre"}, {"sphere", bo.sphere ? "user" : "minimal-enclosing"},
+                    {"twoSided", true}, {"normals", o.normals ? (mesh.normals.empty() ? "geometric" : "interpolated") : "none"}}}};
+  if (clipped) meta["vff.bake"]["sphereEnclosesMesh"] = false;
+  if (!gltf.is_null()) meta["vff.source"]["gltf"] = gltf;
+  return meta.dump();
+}
+
+int reportLoadError(const Error& e, const std::string& input) {
+  if (e.code == Code::kInvalidArgument) {  // a --scene the file does not have
+    cli::usageError(kProg, e.message);
+    return cli::kExitUsage;
+  }
+  return cli::reportError(kProg, input, e);
+}
+
+void noteUnbakedScenes(const Options& o, const bake::MeshInfo& info) {
+  if (o.quiet || info.gltfScenes.size() < 2) return;
+  std::string others;
+  for (size_t i = 0; i < info.gltfScenes.size(); ++i) {
+    if (int(i) == info.gltfScene) continue;
+    others += (others.empty() ? "" : ", ") + std::to_string(i);
+    if (!info.gltfScenes[i].empty()) others += " '" + info.gltfScenes[i] + "'";
+  }
+  const std::string& name = info.gltfScenes[size_t(info.gltfScene)];
+  std::fprintf(stderr, "%s: note: %s has %zu scenes; baked scene %d%s; not baked: %s (--scene N bakes another)\n",
+               kProg, o.mesh.c_str(), info.gltfScenes.size(), info.gltfScene,
+               name.empty() ? "" : (" '" + name + "'").c_str(), others.c_str());
+}
+
 int bakeFromMesh(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
   // Load and check the mesh, then the parameters, before any output exists.
   Measures m;
   bake::MeshInfo info;
   auto t0 = std::chrono::steady_clock::now();
-  auto mesh = bake::loadMesh(o.mesh, &info);
-  if (!mesh) return cli::reportError(kProg, o.mesh, mesh.error());
+  auto mesh = bake::loadMesh(o.mesh, &info, {.gltfScene = o.scene});
+  if (!mesh) return reportLoadError(mesh.error(), o.mesh);
+  noteUnbakedScenes(o, info);
   m.load = secondsSince(t0);
   if (mesh->droppedDegenerate && !o.quiet)
     std::fprintf(stderr, "%s: %s: dropped %llu degenerate (zero-area) triangle%s\n", kProg, o.mesh.c_str(),
@@ -186,7 +211,7 @@ int bakeFromMesh(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
   std::optional<bake::BakedField> baked;
   if (auto rc = traceAndBake(o, bo, *scene, &m, &baked)) return *rc;
   if (writer)
-    if (auto rc = writeBaked(o, *writer, *baked, &m.write, &m.fileBytes)) return *rc;
+    if (auto rc = writeBaked(o, o.output, *writer, *baked, &m.write, &m.fileBytes)) return *rc;
   reportMeshBake(o, bo, *mesh, *scene, *field, baked->stats, m, writer.has_value());
   return cli::kExitSuccess;
 }

@@ -25,6 +25,13 @@ void addOptions(CLI::App& app, Options& o) {
   app.add_option("mesh", o.mesh, "input mesh, or OpenVDB level set (.vdb)")->required();
   app.add_option("-o,--output", o.output, "output .vff file (written atomically)");
   app.add_option("--grid", o.grid, ".vdb input: name of the level set grid to bake (default: the first level set by name)");
+  app.add_option("--scene", o.scene, "glTF input: the scene to bake (default: the file's default scene)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--split", o.split,
+                 "glTF input: bake each mesh (one field per mesh, placed at every node using it) or each node "
+                 "into its own field, and write a scene description (spec/scene.md) to -o, which must end in "
+                 ".json; the fields go beside it as STEM.meshI.vff / STEM.nodeJ.vff")
+      ->check(CLI::IsMember({"mesh", "node"}));
   o.positions.add(app, "positional-sample scheme")->capture_default_str();
   app.add_option("-n,--count", o.count,
                  "scheme parameter: octa-hemi2 n (maps = 2(2n^2+2n+1), default 32 = 4226 maps), "
@@ -61,6 +68,15 @@ std::optional<std::string> checkOptions(const Options& o) {
   } else if (!o.grid.empty()) {
     return "--grid applies to a .vdb level set input only";
   }
+  if (!isGltfPath(o.mesh) && (o.scene >= 0 || !o.split.empty()))
+    return std::string(o.scene >= 0 ? "--scene" : "--split") + " applies to a glTF input (.gltf, .glb) only";
+  if (!o.split.empty()) {
+    const std::string& out = o.output;
+    if (out.size() < 6 || out.compare(out.size() - 5, 5, ".json") != 0)
+      return "--split writes a scene description: -o must name a .json file (e.g. scene.vffscene.json)";
+    if (!o.center.empty()) return "--split bakes each object in its own sphere: --center/--radius do not apply";
+    if (o.benchmark) return "--benchmark measures one mesh; it does not apply to --split";
+  }
   return std::nullopt;
 }
 
@@ -86,11 +102,16 @@ WriteOptions writeOptions(const Options& o) {
   return wo;
 }
 
-bool isVdbPath(const std::string& p) {
-  if (p.size() < 4) return false;
-  std::string ext = p.substr(p.size() - 4);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  return ext == ".vdb";
+namespace {
+bool hasExtension(const std::string& p, const std::string& ext) {
+  if (p.size() < ext.size()) return false;
+  std::string e = p.substr(p.size() - ext.size());
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return e == ext;
 }
+}  // namespace
+
+bool isVdbPath(const std::string& p) { return hasExtension(p, ".vdb"); }
+bool isGltfPath(const std::string& p) { return hasExtension(p, ".gltf") || hasExtension(p, ".glb"); }
 
 }  // namespace vff::bake_tool

@@ -5,6 +5,7 @@
 //   vff-compress --decompress small.vff field.vff    stored blocks (zero-copy GPU upload)
 //   vff-compress --benchmark a.vff [b.vff ...]       our codec vs zstd -19, xz -9, EXR ZIP/PIZ/DWAA
 #include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -15,6 +16,7 @@
 
 #include "cli.h"
 #include "compress.h"
+#include "progress.h"
 #include "resample.h"
 #include "vff/vff.h"
 
@@ -34,6 +36,7 @@ struct Options {
   std::string filter = "auto";
   uint32_t mapsPerBlock = 0;
   int repeat = 3;
+  unsigned threads = 0;
   std::string tmpDir;
   vff::cli::CommonOptions common;
 };
@@ -89,11 +92,13 @@ void addOptions(CLI::App& app, Options& o) {
                "lossy, GPU-native: re-encode an unorm8-diameter distance plane as bc4-diameter (BC4 blocks the "
                "texture unit decodes, half the GPU memory; format 1.2), then compress; prints the code error");
   app.add_flag("--blocks", o.blocks, "also list every block's stored size");
+  app.add_option("-j,--threads", o.threads, "compressing threads (0: all cores); the output does not depend on it")
+      ->capture_default_str();
   app.add_option("--repeat", o.repeat, "benchmark repetitions (the best time is reported)")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();
   app.add_option("--tmp", o.tmpDir, "benchmark: folder for the EXR files (default: the system's temporary folder)");
-  app.add_flag("-q,--quiet", o.quiet, "print nothing on success");
+  app.add_flag("-q,--quiet", o.quiet, "print nothing on success (and no progress line)");
 }
 
 // The field the output will hold, and how the input's maps become its maps.
@@ -153,6 +158,7 @@ vff::Result<vff::WriteOptions> writeOptions(const Options& o, const std::string&
   w.zstdLevel = o.level;
   w.filter = !o.decompress && plan.eightBit && o.filter != "none" ? vff::Filter::kHitsMed : vff::Filter::kNone;
   w.mapsPerBlock = o.mapsPerBlock;
+  w.threads = o.threads;
   w.layout.target = in.layout().target;
   w.layout.maxTextureSize = in.layout().maxTextureSize;
   w.layout.maxLayers = in.layout().maxLayers;
@@ -250,6 +256,9 @@ int main(int argc, char** argv) {
   if (auto rc = planRewrite(o, input, *in, &plan)) return *rc;
   auto w = writeOptions(o, input, *in, plan);
   if (!w) return vff::cli::reportError(kProg, input, w.error());
+  // The progress line (on a terminal, not with --quiet or --format json), as vff-bake's.
+  vff::cli::Progress progress(kProg, !o.quiet && o.common.format != vff::cli::OutputFormat::kJson && isatty(2));
+  w->progress = [&](uint64_t done, uint64_t total) { progress.update(done, total); };
   vff::compress::Report report;
   if (vff::Status st = vff::compress::rewrite(*in, output, plan.field, *w, plan.reencode, &report); !st)
     return vff::cli::reportError(kProg, st.error().code == vff::Code::kIoWrite ? output : input, st.error());

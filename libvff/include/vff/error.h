@@ -6,7 +6,7 @@
 //              format specification (spec/validation.md), grouped by thousands:
 //              1xxx I/O, 2xxx identity, 3xxx header, 4xxx section table, 5xxx field description,
 //              6xxx planes and blocks, 7xxx packed layout, 8xxx metadata, 9xxx API usage,
-//              10xxx mesh input (baking).
+//              10xxx mesh input (baking), 11xxx scene descriptions (spec/scene.md).
 //   - section: the FourCC of the section concerned (0 when none), see sectionTagName().
 //   - offset:  the absolute byte offset in the file where the problem was found (kNoOffset if none).
 //   - message: one human-readable sentence without a trailing newline.
@@ -96,6 +96,10 @@ enum class Code : uint32_t {
   kMeshNonFinite = 10005,      // a vertex coordinate is NaN or infinite
   kMeshDegenerate = 10006,     // every triangle has zero area
   kMeshIndex = 10007,          // an index or accessor points outside its data
+  // 11xxx: scene descriptions (spec/scene.md)
+  kSceneJson = 11001,          // not one JSON object
+  kSceneVersion = 11002,       // not a vff-scene, or a version this reader does not implement
+  kSceneValue = 11003,         // a member is missing or has a value the spec does not allow
   // 9xxx: API usage and resources (not file problems)
   kInvalidArgument = 9001,     // a caller-supplied argument is invalid
   kOutOfRange = 9002,          // an index is out of range

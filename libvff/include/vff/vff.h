@@ -9,6 +9,7 @@
 #include "vff/positions.h"
 #include "vff/query.h"
 #include "vff/reader.h"
+#include "vff/scene_description.h"
 #include "vff/validate.h"
 #include "vff/version.h"
 #include "vff/writer.h"

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -40,6 +41,11 @@ struct WriteOptions {
   // are reserved for the names in spec/format.md.
   std::string metadataJson;
   bool sync = true;  // fsync the file and its folder before and after the rename
+  // Threads compressing blocks (0: one per core). The bytes written do not depend on it.
+  unsigned threads = 0;
+  // Called after each run of blocks is written, from the writing thread, with the maps written so
+  // far and the maps of every plane the field has (distance, and normals when present); may be empty.
+  std::function<void(uint64_t done, uint64_t total)> progress;
 };
 
 class Writer {

@@ -4,6 +4,7 @@
 #include <xxhash.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -70,18 +71,52 @@ uint64_t meshHash(const Mesh& m) {
   return h;
 }
 
-Result<Mesh> loadMesh(const std::string& path, MeshInfo* info) {
-  struct stat st {};
-  if (stat(path.c_str(), &st) != 0) return makeError(Code::kIoOpen, path + ": " + std::strerror(errno));
-  if (!S_ISREG(st.st_mode)) return makeError(Code::kIoOpen, path + ": not a regular file");
+uint64_t geometryHash(const Mesh& m) {
+  using Tri = std::array<float, 9>;
+  std::vector<Tri> tris(m.triangleCount());
+  for (size_t t = 0; t < tris.size(); ++t) {
+    std::array<std::array<float, 3>, 3> v;
+    for (size_t k = 0; k < 3; ++k)
+      for (size_t c = 0; c < 3; ++c) {
+        const float x = m.positions[3 * size_t(m.indices[3 * t + k]) + c];
+        v[k][c] = x == 0.0f ? 0.0f : x;  // one spelling of zero
+      }
+    size_t first = 0;
+    for (size_t k = 1; k < 3; ++k)
+      if (v[k] < v[first]) first = k;
+    for (size_t k = 0; k < 3; ++k)
+      for (size_t c = 0; c < 3; ++c) tris[t][3 * k + c] = v[(first + k) % 3][c];
+  }
+  std::sort(tris.begin(), tris.end());
+  std::vector<uint8_t> bytes(tris.size() * 36);
+  for (size_t t = 0; t < tris.size(); ++t)
+    for (size_t i = 0; i < 9; ++i) {
+      uint32_t u;
+      std::memcpy(&u, &tris[t][i], 4);
+      for (size_t b = 0; b < 4; ++b) bytes[36 * t + 4 * i + b] = uint8_t(u >> (8 * b));  // little-endian
+    }
+  return XXH3_64bits(bytes.data(), bytes.size());
+}
+
+namespace detail {
+Status checkReadable(const std::string& path, struct stat* st) {
+  if (stat(path.c_str(), st) != 0) return makeError(Code::kIoOpen, path + ": " + std::strerror(errno));
+  if (!S_ISREG(st->st_mode)) return makeError(Code::kIoOpen, path + ": not a regular file");
   if (!std::ifstream(path, std::ios::binary)) return makeError(Code::kIoOpen, path + ": cannot be read");
+  return {};
+}
+}  // namespace detail
+
+Result<Mesh> loadMesh(const std::string& path, MeshInfo* info, const MeshLoadOptions& options) {
+  struct stat st {};
+  if (Status s = detail::checkReadable(path, &st); !s) return std::move(s).error();
   const std::string ext = lowerExtension(path);
   Result<Mesh> mesh = makeError(Code::kMeshFormat, "");
   if (ext == "obj" || ext == "ply" || ext == "off" || ext == "stl") {
     if (st.st_size == 0) return makeError(Code::kMeshEmpty, path + ": the file is empty");
     mesh = detail::loadWithOpenMesh(path, ext);
   } else if (ext == "gltf" || ext == "glb") {
-    mesh = detail::loadWithTinyGltf(path, ext == "glb");
+    mesh = detail::loadWithTinyGltf(path, ext == "glb", options, info);
   } else {
     return makeError(Code::kMeshFormat, path + ": unknown mesh extension '" + ext +
                                             "' (supported: .obj .ply .off .stl .gltf .glb)");

@@ -1,56 +1,18 @@
-// glTF 2.0 (.gltf and .glb) through tinygltf: the triangle primitives of the default scene.
+// glTF 2.0 (.gltf and .glb) through tinygltf: parsing, and the triangles of meshes (which meshes and
+// where: gltf_scene.cpp).
 #include <tiny_gltf.h>
 
 #include <array>
 #include <cmath>
 #include <cstring>
 
+#include "gltf_extensions.h"
 #include "mesh_importers.h"
 
 namespace vff::bake::detail {
 namespace {
 
-using Mat4 = std::array<double, 16>;  // column-major, as glTF stores it
-
-Mat4 identity() { return {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}; }
-
-Mat4 mul(const Mat4& a, const Mat4& b) {
-  Mat4 r{};
-  for (int c = 0; c < 4; ++c)
-    for (int rr = 0; rr < 4; ++rr) {
-      double s = 0;
-      for (int k = 0; k < 4; ++k) s += a[size_t(k * 4 + rr)] * b[size_t(c * 4 + k)];
-      r[size_t(c * 4 + rr)] = s;
-    }
-  return r;
-}
-
-Mat4 nodeMatrix(const tinygltf::Node& n) {
-  if (n.matrix.size() == 16) {
-    Mat4 m;
-    std::copy(n.matrix.begin(), n.matrix.end(), m.begin());
-    return m;
-  }
-  Mat4 t = identity(), r = identity(), s = identity();
-  if (n.translation.size() == 3) {
-    t[12] = n.translation[0];
-    t[13] = n.translation[1];
-    t[14] = n.translation[2];
-  }
-  if (n.rotation.size() == 4) {
-    const double x = n.rotation[0], y = n.rotation[1], z = n.rotation[2], w = n.rotation[3];
-    r = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w),     2 * (x * z - y * w),     0,
-         2 * (x * y - z * w),     1 - 2 * (x * x + z * z), 2 * (y * z + x * w),     0,
-         2 * (x * z + y * w),     2 * (y * z - x * w),     1 - 2 * (x * x + y * y), 0,
-         0,                       0,                       0,                       1};
-  }
-  if (n.scale.size() == 3) {
-    s[0] = n.scale[0];
-    s[5] = n.scale[1];
-    s[10] = n.scale[2];
-  }
-  return mul(t, mul(r, s));
-}
+using Mat4 = GltfMatrix;
 
 // Inverse transpose of the upper 3x3 (for normals), row-major 3x3.
 std::array<double, 9> normalMatrix(const Mat4& m) {
@@ -68,25 +30,6 @@ class Importer {
  public:
   Importer(const tinygltf::Model& model, const std::string& path) : model_(model), path_(path) {}
 
-  Status node(int index, const Mat4& parent, int depth) {
-    if (index < 0 || size_t(index) >= model_.nodes.size())
-      return makeError(Code::kMeshIndex, path_ + ": node index " + std::to_string(index) + " out of range");
-    if (depth > 64) return makeError(Code::kMeshParse, path_ + ": node hierarchy deeper than 64 (a cycle?)");
-    const tinygltf::Node& n = model_.nodes[size_t(index)];
-    const Mat4 world = mul(parent, nodeMatrix(n));
-    if (n.mesh >= 0) {
-      if (size_t(n.mesh) >= model_.meshes.size())
-        return makeError(Code::kMeshIndex, path_ + ": node " + std::to_string(index) + " references a missing mesh");
-      Status s = mesh(model_.meshes[size_t(n.mesh)], world);
-      if (!s) return s;
-    }
-    for (int c : n.children) {
-      Status s = node(c, world, depth + 1);
-      if (!s) return s;
-    }
-    return {};
-  }
-
   Status mesh(const tinygltf::Mesh& mesh, const Mat4& world) {
     for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
       const tinygltf::Primitive& p = mesh.primitives[pi];
@@ -103,7 +46,7 @@ class Importer {
       std::vector<float> nrm;
       auto nit = p.attributes.find("NORMAL");
       if (nit != p.attributes.end()) {
-        s = readVec3(nit->second, where + " NORMAL", &nrm);
+        s = readVec3(nit->second, where + " NORMAL", &nrm, true);
         if (!s) return s;
         if (nrm.size() != xyz.size()) nrm.clear();
       }
@@ -185,17 +128,16 @@ class Importer {
     return {};
   }
 
-  Status readVec3(int accessor, const std::string& what, std::vector<float>* out3) {
+  Status readVec3(int accessor, const std::string& what, std::vector<float>* out3, bool isNormal = false) {
     const uint8_t* d;
     size_t stride, count;
     int ct, type;
-    Status s = view(accessor, what, 12, &d, &stride, &count, &ct, &type);
+    const bool known = accessor >= 0 && size_t(accessor) < model_.accessors.size();
+    const size_t cs = known ? gltfComponentSize(model_.accessors[size_t(accessor)].componentType) : 0;
+    Status s = view(accessor, what, 3 * (cs ? cs : 4), &d, &stride, &count, &ct, &type);
     if (!s) return s;
-    if (type != TINYGLTF_TYPE_VEC3 || ct != TINYGLTF_COMPONENT_TYPE_FLOAT)
-      return makeError(Code::kMeshUnsupported, what + ": only float VEC3 data is supported (quantised meshes are not)");
-    out3->resize(count * 3);
-    for (size_t i = 0; i < count; ++i) std::memcpy(&(*out3)[3 * i], d + i * stride, 12);
-    return {};
+    if (type != TINYGLTF_TYPE_VEC3) return makeError(Code::kMeshUnsupported, what + ": only VEC3 data is supported");
+    return convertVec3(d, stride, count, ct, model_.accessors[size_t(accessor)].normalized, isNormal, what, out3);
   }
 
   Status readIndices(int accessor, const std::string& what, size_t vertexCount, std::vector<uint32_t>* idx) {
@@ -238,14 +180,16 @@ bool skipImages(tinygltf::Image*, const int, std::string*, std::string*, int, in
 
 }  // namespace
 
-Result<Mesh> loadWithTinyGltf(const std::string& path, bool binary) {
+Result<std::shared_ptr<const tinygltf::Model>> parseGltf(const std::string& path, bool binary) {
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(skipImages, nullptr);
-  tinygltf::Model model;
+  auto model = std::make_shared<tinygltf::Model>();
   std::string err, warn;
   bool ok = false;
+  std::vector<unsigned char> bytes;
+  if (Status pre = prepareGltf(path, binary, &bytes); !pre) return std::move(pre).error();
   try {
-    ok = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, path) : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+    ok = parsePreparedGltf(loader, model.get(), &err, &warn, bytes, path, binary);
   } catch (const std::exception& e) {
     return makeError(Code::kMeshParse, path + ": " + e.what());
   }
@@ -253,22 +197,19 @@ Result<Mesh> loadWithTinyGltf(const std::string& path, bool binary) {
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
     return makeError(Code::kMeshParse, path + ": " + (err.empty() ? std::string("cannot parse glTF") : err));
   }
-  for (const std::string& ext : model.extensionsRequired)
-    return makeError(Code::kMeshUnsupported, path + ": required extension " + ext + " is not supported");
+  if (Status s = decodeMeshoptViews(model.get(), path); !s) return std::move(s).error();
+  if (Status s = decodeDracoPrimitives(model.get(), path); !s) return std::move(s).error();
+  return std::shared_ptr<const tinygltf::Model>(std::move(model));
+}
+
+Result<Mesh> importGltfMeshes(const tinygltf::Model& model, const std::string& path,
+                              const std::vector<GltfMeshRef>& refs) {
   Importer imp(model, path);
-  const Mat4 id = identity();
-  if (!model.scenes.empty()) {
-    const int sceneIndex = model.defaultScene >= 0 ? model.defaultScene : 0;
-    if (size_t(sceneIndex) >= model.scenes.size()) return makeError(Code::kMeshIndex, path + ": default scene out of range");
-    for (int n : model.scenes[size_t(sceneIndex)].nodes) {
-      Status s = imp.node(n, id, 0);
-      if (!s) return std::move(s).error();
-    }
-  } else {
-    for (const auto& m : model.meshes) {
-      Status s = imp.mesh(m, id);
-      if (!s) return std::move(s).error();
-    }
+  for (const GltfMeshRef& r : refs) {
+    if (r.mesh < 0 || size_t(r.mesh) >= model.meshes.size())
+      return makeError(Code::kMeshIndex, path + ": mesh index " + std::to_string(r.mesh) + " out of range");
+    Status s = imp.mesh(model.meshes[size_t(r.mesh)], r.matrix);
+    if (!s) return std::move(s).error();
   }
   if (imp.allNormals_ && imp.normals_.size() == imp.out.positions.size()) imp.out.normals = std::move(imp.normals_);
   return std::move(imp.out);

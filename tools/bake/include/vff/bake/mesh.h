@@ -2,13 +2,16 @@
 //
 // Supported inputs: OBJ, PLY (face lists, or `tristrips` with -1 restarts), OFF, STL (through
 // OpenMesh; polygons are triangulated) and glTF 2.0
-// .gltf/.glb (through tinygltf: every triangle primitive of the default scene, node transforms
-// applied). Content that cannot be baked is an error, never a silently empty mesh:
+// .gltf/.glb (through tinygltf: every triangle primitive of the default scene or a chosen one, node
+// transforms applied; quantized, Draco and meshopt compressed data decoded; vff/bake/gltf.h splits a
+// scene into its meshes or nodes). Content that cannot be baked is an error, never a silently empty
+// mesh:
 //   kIoOpen          the file is missing or unreadable
 //   kMeshFormat      unknown extension
 //   kMeshParse       the importer cannot parse the file
-//   kMeshUnsupported points/lines primitives, required glTF extensions (Draco, meshopt, ...),
-//                    non-float positions, sparse accessors
+//   kMeshUnsupported points/lines primitives, a required glTF extension other than
+//                    KHR_mesh_quantization, KHR_draco_mesh_compression and EXT_meshopt_compression,
+//                    attribute types those do not allow, sparse accessors
 //   kMeshIndex       an index or an accessor outside its buffer
 //   kMeshEmpty       no triangles; kMeshNonFinite a NaN/Inf coordinate (message names the vertex);
 //   kMeshDegenerate  every triangle has zero area
@@ -33,16 +36,34 @@ struct Mesh {
 
 struct MeshInfo {
   std::string format;  // "obj", "ply", "off", "stl", "gltf", "glb"
+  // glTF: the file's scenes (their names, "" when unnamed) and the one loaded (-1 when the file has
+  // no scene and every mesh was loaded untransformed).
+  std::vector<std::string> gltfScenes;
+  int gltfScene = -1;
+};
+
+struct MeshLoadOptions {
+  // glTF: the scene to load; -1: the file's default scene (`scene`), else scene 0. A scene that
+  // does not exist is kInvalidArgument, naming the scenes there are.
+  int gltfScene = -1;
 };
 
 // Loads and checks a mesh (see the error list above). Messages name the file.
-Result<Mesh> loadMesh(const std::string& path, MeshInfo* info = nullptr);
+Result<Mesh> loadMesh(const std::string& path, MeshInfo* info = nullptr, const MeshLoadOptions& options = {});
 
 // Checks a mesh held in memory: finite coordinates, indices in range, drops zero-area triangles,
 // and fails when none remain. `what` names the source in messages.
 Status checkMesh(Mesh* mesh, const std::string& what);
 
-// Content hash (XXH3-64 of the positions and indices) for provenance metadata.
+// Content hash (XXH3-64 of the positions and indices) for provenance metadata: it changes with the
+// vertex order, so the same geometry read from two file formats usually has two.
 uint64_t meshHash(const Mesh& mesh);
+
+// Canonical hash of the triangles (META vff.source.geometryHash, spec/format.md section 9): XXH3-64
+// of the triangles as 9 f32 each (vertex coordinates, -0 written as +0), every triangle rotated so
+// that its lexicographically smallest vertex comes first (the winding kept), the triangles sorted
+// lexicographically. It depends on the geometry only, not on vertex sharing, vertex order, triangle
+// order or file format.
+uint64_t geometryHash(const Mesh& mesh);
 
 }  // namespace vff::bake

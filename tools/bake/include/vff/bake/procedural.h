@@ -28,4 +28,30 @@ const std::vector<std::string>& shapeNames();
 // Writes a mesh as Wavefront OBJ (vertices, normals when present, 1-based faces).
 Status writeObj(const Mesh& mesh, const std::string& path);
 
+// ---- glTF scenes (gltf_write.cpp) ---------------------------------------------------------------
+struct GltfNodeSpec {
+  std::string name;
+  int mesh = -1;                         // index into the meshes, -1: none
+  std::vector<int> children;             // node indices
+  std::vector<double> translation;       // 3 values, or empty
+  std::vector<double> rotation;          // quaternion x, y, z, w, or empty
+  std::vector<double> scale;             // 3 values, or empty
+};
+struct GltfSceneSpec {
+  std::string name;
+  std::vector<int> nodes;  // the scene's root nodes
+};
+struct NamedMesh {
+  std::string name;
+  Mesh mesh;
+};
+// Writes a glTF 2.0 file: float positions, uint32 indices, one buffer embedded as a base64 data URI
+// (.gltf). `defaultScene` is the file's `scene` (-1: none written).
+Status writeGltf(const std::string& path, const std::vector<NamedMesh>& meshes, const std::vector<GltfNodeSpec>& nodes,
+                 const std::vector<GltfSceneSpec>& scenes, int defaultScene = 0);
+// A small scene of several objects for the tests and samples: a box used by two nodes (one rotated
+// and scaled, one under a rotated group node), a torus knot under a non-uniform scale, and a bowl
+// alone in a second scene; scene 0 is the default.
+Status writeSampleGltfScene(const std::string& path);
+
 }  // namespace vff::bake

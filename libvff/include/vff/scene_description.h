@@ -1,0 +1,83 @@
+// vff/scene_description.h - scene descriptions (spec/scene.md): which fields a scene uses and where
+// each copy of them stands.
+//
+// A scene description is a JSON file that lists fields (`.vff` files, by a reference relative to the
+// description) and instances (a field placed by a uniform scale, a rotation and a translation, glTF's
+// T * R * S). `vff-bake --split` writes one for the meshes or nodes of a glTF scene. Reading it
+// checks every rule of spec/scene.md; the fields themselves are opened by the caller (File::open on
+// resolveSceneUri()), so that a tool decides how to load, decode and share them.
+//
+//   auto scene = vff::readSceneDescription("courtyard.vffscene.json");
+//   if (!scene) { fprintf(stderr, "%s\n", scene.error().toString().c_str()); return; }
+//   for (const vff::SceneField& f : scene->fields)
+//     open(vff::resolveSceneUri("courtyard.vffscene.json", f.uri));
+//   for (const vff::SceneInstance& i : scene->instances)
+//     place(i.field, i.rigidTransform());
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "vff/error.h"
+#include "vff/query.h"
+
+namespace vff {
+
+inline constexpr int kSceneDescriptionVersion = 1;
+
+struct SceneField {
+  std::string uri;         // the .vff file, relative to the description's folder or absolute
+  std::string name;        // may be empty
+  std::string sourceJson;  // the `source` object as JSON text, or empty
+};
+
+struct SceneInstance {
+  uint32_t field = 0;                    // index into SceneDescription::fields
+  std::string name;                      // may be empty
+  Vec3 translation;                      // world = translation + rotate(rotation, scale * p)
+  std::array<float, 4> rotation{0, 0, 0, 1};  // unit quaternion x, y, z, w
+  float scale = 1.0f;                    // uniform, > 0
+  std::string extrasJson;                // the instance's `extras` as JSON text, or empty
+
+  // The same placement as libvff's transform (the quaternion as a rotation matrix).
+  RigidTransform rigidTransform() const noexcept;
+};
+
+struct SceneDescription {
+  std::string generator;  // asset.generator, may be empty
+  std::vector<SceneField> fields;
+  std::vector<SceneInstance> instances;
+  std::string extrasJson;  // the top-level `extras` as JSON text, or empty
+};
+
+// Parses a description held in memory; `name` names it in messages. Every rule of spec/scene.md is
+// checked: kSceneJson (not one JSON object), kSceneVersion (not a vff-scene, or not version 1),
+// kSceneValue (a missing or wrong member; the message gives its JSON location, such as
+// "instances[3].rotation"). Rotations are normalised.
+Result<SceneDescription> parseSceneDescription(std::string_view json, const std::string& name);
+
+// Reads and parses a file (kIoOpen, kIoRead; then as above, messages naming the file).
+Result<SceneDescription> readSceneDescription(const std::string& path);
+
+// The description as JSON text: two-space indented, members in a fixed order, floats written with
+// the fewest digits that read back to the same float, so that equal descriptions give equal bytes.
+// Empty names, sources and extras are left out. It fails with kSceneValue on what
+// parseSceneDescription would refuse (a field index out of range, a non-finite number, ...).
+Result<std::string> formatSceneDescription(const SceneDescription& scene);
+
+// Writes formatSceneDescription's text to `path` atomically (a temporary file renamed over it):
+// either the whole new file or the old one (kIoOpen, kIoWrite).
+Status writeSceneDescription(const std::string& path, const SceneDescription& scene);
+
+// The path of a field's `uri` for a description read from `descriptionPath`: absolute URIs as they
+// are, relative ones joined to the description's folder.
+std::string resolveSceneUri(const std::string& descriptionPath, const std::string& uri);
+
+// The rotation part of a transform as a unit quaternion x, y, z, w (w >= 0); `rotation` must be a
+// rotation matrix (orthonormal, determinant +1).
+std::array<float, 4> quaternionFromRotation(const float rotation[3][3]) noexcept;
+
+}  // namespace vff

@@ -1,0 +1,171 @@
+// Scene descriptions (spec/scene.md): the reader's rules, the writer's text, the transforms.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "vff/scene_description.h"
+
+namespace vff {
+namespace {
+
+const char* kExample = R"({
+  "asset": {"format": "vff-scene", "version": 1, "generator": "test"},
+  "fields": [{"uri": "a.vff", "name": "bunny", "source": {"file": "x.glb", "mesh": 0}}, {"uri": "sub/b.vff"}],
+  "instances": [
+    {"field": 0, "name": "left", "translation": [-2, 0, 0.5]},
+    {"field": 1, "rotation": [0, 0.70710678, 0, 0.70710678], "scale": 0.5, "extras": {"k": [1, 2]}}
+  ],
+  "unknownMember": true
+})";
+
+TEST(SceneDescription, ParsesTheSpecExampleShape) {
+  auto s = parseSceneDescription(kExample, "ex.json");
+  ASSERT_TRUE(s) << s.error().toString();
+  EXPECT_EQ(s->generator, "test");
+  ASSERT_EQ(s->fields.size(), 2u);
+  EXPECT_EQ(s->fields[0].uri, "a.vff");
+  EXPECT_EQ(s->fields[0].name, "bunny");
+  EXPECT_EQ(s->fields[0].sourceJson, R"({"file":"x.glb","mesh":0})");
+  ASSERT_EQ(s->instances.size(), 2u);
+  EXPECT_EQ(s->instances[0].translation.z, 0.5f);
+  EXPECT_EQ(s->instances[0].scale, 1.0f);
+  EXPECT_EQ(s->instances[0].rotation[3], 1.0f);
+  EXPECT_EQ(s->instances[1].field, 1u);
+  EXPECT_EQ(s->instances[1].extrasJson, R"({"k":[1,2]})");
+}
+
+// world(p) = translation + rotate(rotation, scale * p), the quaternion as glTF defines it.
+TEST(SceneDescription, TransformIsTranslationRotationScale) {
+  SceneInstance i;
+  i.translation = {1, 2, 3};
+  i.rotation = {0, float(std::sqrt(0.5)), 0, float(std::sqrt(0.5))};  // +90 degrees about y
+  i.scale = 2;
+  const RigidTransform t = i.rigidTransform();
+  const Vec3 w = t.toWorldPoint({1, 0, 0});  // x -> -z under +90 degrees about y
+  EXPECT_NEAR(w.x, 1.0f, 1e-6f);
+  EXPECT_NEAR(w.y, 2.0f, 1e-6f);
+  EXPECT_NEAR(w.z, 3.0f - 2.0f, 1e-6f);
+  const auto q = quaternionFromRotation(t.rotation);
+  for (int k = 0; k < 4; ++k) EXPECT_NEAR(q[size_t(k)], i.rotation[size_t(k)], 1e-6f);
+}
+
+TEST(SceneDescription, QuaternionFromRotationRoundTripsEveryBranch) {
+  // Rotations whose largest diagonal term is each of the four candidates, and w < 0 folded to w > 0.
+  const std::array<float, 4> qs[] = {{0.1f, 0.2f, 0.3f, 0.927362f}, {0.95f, 0.1f, 0.2f, 0.2179f},
+                                     {0.1f, 0.95f, 0.2f, 0.2179f},   {0.1f, 0.2f, 0.95f, 0.2179f},
+                                     {0, 0, 1, 0}};
+  for (auto q : qs) {
+    const double n = std::sqrt(double(q[0]) * q[0] + double(q[1]) * q[1] + double(q[2]) * q[2] + double(q[3]) * q[3]);
+    for (float& c : q) c = float(c / n);
+    SceneInstance i;
+    i.rotation = q;
+    const auto back = quaternionFromRotation(i.rigidTransform().rotation);
+    for (int k = 0; k < 4; ++k) EXPECT_NEAR(back[size_t(k)], q[size_t(k)], 2e-6f) << k;
+  }
+}
+
+TEST(SceneDescription, WriterTextReadsBackToTheSameValues) {
+  auto s = parseSceneDescription(kExample, "ex.json");
+  ASSERT_TRUE(s);
+  s->instances[0].translation.x = 0.1f;  // the shortest text that reads back as the same float
+  auto text = formatSceneDescription(*s);
+  ASSERT_TRUE(text) << text.error().toString();
+  EXPECT_NE(text->find("\"translation\": [0.1, 0, 0.5]"), std::string::npos) << *text;
+  auto back = parseSceneDescription(*text, "back.json");
+  ASSERT_TRUE(back) << back.error().toString();
+  ASSERT_EQ(back->instances.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(back->instances[i].translation.x, s->instances[i].translation.x);
+    EXPECT_EQ(back->instances[i].scale, s->instances[i].scale);
+    for (size_t k = 0; k < 4; ++k) EXPECT_NEAR(back->instances[i].rotation[k], s->instances[i].rotation[k], 1e-7f);
+    EXPECT_EQ(back->instances[i].extrasJson, s->instances[i].extrasJson);
+  }
+  EXPECT_EQ(back->fields[0].sourceJson, s->fields[0].sourceJson);
+  auto again = formatSceneDescription(*back);
+  ASSERT_TRUE(again);
+  EXPECT_EQ(*again, *text);
+}
+
+TEST(SceneDescription, WriterRefusesWhatTheReaderRefuses) {
+  SceneDescription s;
+  s.fields.push_back({"a.vff", "", ""});
+  s.instances.push_back({});
+  s.instances[0].field = 1;
+  auto text = formatSceneDescription(s);
+  ASSERT_FALSE(text);
+  EXPECT_EQ(text.error().code, Code::kSceneValue);
+  EXPECT_NE(text.error().message.find("instances[0].field"), std::string::npos) << text.error().message;
+}
+
+struct Bad {
+  const char* json;
+  Code code;
+  const char* where;  // expected in the message
+};
+
+TEST(SceneDescription, EveryRuleHasItsError) {
+  const std::string head = R"({"asset":{"format":"vff-scene","version":1},"fields":[{"uri":"a.vff"}],"instances":[)";
+  const Bad bad[] = {
+      {"not json", Code::kSceneJson, "not valid JSON"},
+      {"[1]", Code::kSceneJson, "not an object"},
+      {R"({"fields":[],"instances":[]})", Code::kSceneVersion, "asset"},
+      {R"({"asset":{"format":"gltf","version":1},"fields":[],"instances":[]})", Code::kSceneVersion, "\"gltf\""},
+      {R"({"asset":{"format":"vff-scene","version":2},"fields":[],"instances":[]})", Code::kSceneVersion,
+       "asset.version is 2"},
+      {R"({"asset":{"format":"vff-scene","version":1},"instances":[]})", Code::kSceneValue, "fields"},
+      {R"({"asset":{"format":"vff-scene","version":1},"fields":[{"uri":""}],"instances":[]})", Code::kSceneValue,
+       "fields[0].uri"},
+      {R"({"asset":{"format":"vff-scene","version":1},"fields":[{"uri":"https://x/a.vff"}],"instances":[]})",
+       Code::kSceneValue, "URI scheme"},
+      {R"({"asset":{"format":"vff-scene","version":1},"fields":[{"name":"x"}],"instances":[]})", Code::kSceneValue,
+       "fields[0].uri"},
+      {nullptr, Code::kSceneValue, "instances[0].field"},  // {"field":1}
+      {nullptr, Code::kSceneValue, "instances[0].rotation"},
+      {nullptr, Code::kSceneValue, "instances[0].scale"},
+      {nullptr, Code::kSceneValue, "instances[0].translation[2]"},
+      {nullptr, Code::kSceneValue, "instances[0].translation"},
+  };
+  const std::string tails[] = {R"({"field":1}]})", R"({"field":0,"rotation":[0,0,0,2]}]})",
+                               R"({"field":0,"scale":0}]})", R"({"field":0,"translation":[0,0,1e39]}]})",
+                               R"({"field":0,"translation":[0,0]}]})"};
+  size_t tail = 0;
+  for (const Bad& b : bad) {
+    const std::string text = b.json ? std::string(b.json) : head + tails[tail++];
+    auto s = parseSceneDescription(text, "bad.json");
+    ASSERT_FALSE(s) << text;
+    EXPECT_EQ(s.error().code, b.code) << text << ": " << s.error().message;
+    EXPECT_NE(s.error().message.find("bad.json"), std::string::npos) << s.error().message;
+    EXPECT_NE(s.error().message.find(b.where), std::string::npos) << s.error().message;
+  }
+}
+
+TEST(SceneDescription, FilesAndUris) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("vff_scene_desc_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "s.vffscene.json").string();
+  auto s = parseSceneDescription(kExample, "ex.json");
+  ASSERT_TRUE(s);
+  ASSERT_TRUE(writeSceneDescription(path, *s));
+  auto back = readSceneDescription(path);
+  ASSERT_TRUE(back) << back.error().toString();
+  EXPECT_EQ(back->fields.size(), 2u);
+  EXPECT_EQ(resolveSceneUri(path, "sub/b.vff"), (dir / "sub/b.vff").string());
+  EXPECT_EQ(resolveSceneUri(path, "/abs/c.vff"), "/abs/c.vff");
+  EXPECT_EQ(resolveSceneUri("s.json", "b.vff"), "b.vff");
+  auto missing = readSceneDescription((dir / "none.json").string());
+  ASSERT_FALSE(missing);
+  EXPECT_EQ(missing.error().code, Code::kIoOpen);
+  // No temporary is left beside the file.
+  size_t files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) files += e.is_regular_file();
+  EXPECT_EQ(files, 1u);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace vff

@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# web/ tests: each test_NAME is one ctest case web.NAME (tests/CMakeLists.txt, vff_script_tests).
+# Needs node and web/node_modules (scripts/setup.sh runs `npm ci`); the browser cases also need
+# Debian's chromium (VFF_CHROMIUM: another command name). A missing piece prints SKIP and the
+# reason, and exits 77 (ctest: skipped).
+source "$(dirname "$0")/../common/cli_harness.sh"
+WEB="${VFF_SOURCE_DIR:-$(cd "$(dirname "$0")/../.." && pwd)}/web"
+
+skip() { echo "SKIP: $1"; exit 77; }
+need_node() {
+  command -v node >/dev/null || skip "node is not installed (scripts/setup.sh installs nodejs)"
+  [[ -d $WEB/node_modules/fzstd && -d $WEB/node_modules/hash-wasm ]] || skip "no $WEB/node_modules: run scripts/setup.sh (npm ci in web/)"
+}
+need_chromium() {
+  need_node
+  [[ -d $WEB/node_modules/playwright-core ]] || skip "no playwright-core in $WEB/node_modules: run scripts/setup.sh"
+  VFF_CHROMIUM_PATH="$(command -v "${VFF_CHROMIUM:-chromium}")" || skip "no chromium (apt-get install chromium)"
+  export VFF_CHROMIUM_PATH
+}
+node_test() {
+  (cd "$WEB" && node --test "$@") >"$WORK/out" 2>"$WORK/err"
+  RC=$?
+  grep -E '^# (pass|fail)' "$WORK/out"
+  [[ $RC -eq 0 ]] || { show; fail "node --test $* failed"; }
+}
+
+# Every valid conformance vector decodes to its expected.json; every invalid one raises its ID.
+test_node_conformance() { need_node; node_test test/conformance.test.js; }
+
+# Damaged vectors (cut, single bytes changed): read completely or rejected with a 2xxx-8xxx ID.
+test_node_robustness() { need_node; node_test test/robustness.test.js; }
+
+# The page's summary is, line for line, what vff-inspect prints for each valid vector.
+test_node_summary() {
+  need_node
+  [[ -x ${VFF_INSPECT:-} ]] || skip "vff-inspect is not built"
+  node_test test/summary.test.js
+}
+
+# The spec's worked examples: hits-med, BC4, normals, positions, nearest sample, layout.
+test_node_units() { need_node; node_test test/units.test.js; }
+
+# web/src/vff_query_es.js is exactly what web/tools/gen-glsl-es.mjs makes from gpu/glsl/vff_query.glsl.
+test_glsl_es_generated() { need_node; node_test test/glsl.test.js; }
+
+# In headless Chromium: the decoder decodes the conformance vectors as under node.
+test_browser_decoder() { need_chromium; node_test test/browser/decoder.browser.js; }
+
+# In headless Chromium: the page loads a baked bunny, renders it with WebGL2, and its ground
+# matches the C++ reference render (vff_web_reference) of the same view.
+test_browser_render() {
+  need_chromium
+  [[ -x ${VFF_BAKE:-} ]] || skip "vff-bake is not built (needs Embree)"
+  [[ -f /usr/share/glmark2/models/bunny.obj ]] || skip "no /usr/share/glmark2/models/bunny.obj (apt-get install glmark2-data)"
+  VFF_WORK="$WORK" node_test test/browser/render.browser.js
+}
+
+run_test "$1"

@@ -1,0 +1,216 @@
+// gltf_scene.cpp - which meshes of a glTF file are baked and where: the scene walk behind loadMesh
+// (one object) and loadGltfObjects (one object per mesh or node, vff/bake/gltf.h).
+#include <sys/stat.h>
+#include <tiny_gltf.h>
+
+#include <cmath>
+#include <map>
+
+#include "mesh_importers.h"
+#include "vff/bake/gltf.h"
+#include "vff/scene_description.h"
+
+namespace vff::bake {
+namespace detail {
+namespace {
+
+using Mat4 = GltfMatrix;
+
+Mat4 identity() { return {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}; }
+
+Mat4 mul(const Mat4& a, const Mat4& b) {
+  Mat4 r{};
+  for (int c = 0; c < 4; ++c)
+    for (int rr = 0; rr < 4; ++rr) {
+      double s = 0;
+      for (int k = 0; k < 4; ++k) s += a[size_t(k * 4 + rr)] * b[size_t(c * 4 + k)];
+      r[size_t(c * 4 + rr)] = s;
+    }
+  return r;
+}
+
+Mat4 nodeMatrix(const tinygltf::Node& n) {
+  if (n.matrix.size() == 16) {
+    Mat4 m;
+    std::copy(n.matrix.begin(), n.matrix.end(), m.begin());
+    return m;
+  }
+  Mat4 t = identity(), r = identity(), s = identity();
+  if (n.translation.size() == 3) {
+    t[12] = n.translation[0];
+    t[13] = n.translation[1];
+    t[14] = n.translation[2];
+  }
+  if (n.rotation.size() == 4) {
+    const double x = n.rotation[0], y = n.rotation[1], z = n.rotation[2], w = n.rotation[3];
+    r = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w),     2 * (x * z - y * w),     0,
+         2 * (x * y - z * w),     1 - 2 * (x * x + z * z), 2 * (y * z + x * w),     0,
+         2 * (x * z + y * w),     2 * (y * z - x * w),     1 - 2 * (x * x + y * y), 0,
+         0,                       0,                       0,                       1};
+  }
+  if (n.scale.size() == 3) {
+    s[0] = n.scale[0];
+    s[5] = n.scale[1];
+    s[10] = n.scale[2];
+  }
+  return mul(t, mul(r, s));
+}
+
+// A node that has a mesh, with its world matrix.
+struct NodeMesh {
+  int node = -1, mesh = -1;
+  Mat4 world;
+};
+
+// Walks the nodes of scene `sceneIndex` depth first (children in order), collecting those with a
+// mesh. Without scenes (sceneIndex -1), every mesh untransformed.
+Result<std::vector<NodeMesh>> sceneMeshes(const tinygltf::Model& model, const std::string& path, int sceneIndex) {
+  std::vector<NodeMesh> out;
+  if (sceneIndex < 0) {
+    for (size_t m = 0; m < model.meshes.size(); ++m) out.push_back({-1, int(m), identity()});
+    return out;
+  }
+  struct Frame {
+    int node;
+    Mat4 parent;
+    int depth;
+  };
+  std::vector<Frame> stack;
+  const auto& roots = model.scenes[size_t(sceneIndex)].nodes;
+  for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, identity(), 0});
+  while (!stack.empty()) {
+    const Frame f = stack.back();
+    stack.pop_back();
+    if (f.node < 0 || size_t(f.node) >= model.nodes.size())
+      return makeError(Code::kMeshIndex, path + ": node index " + std::to_string(f.node) + " out of range");
+    if (f.depth > 64) return makeError(Code::kMeshParse, path + ": node hierarchy deeper than 64 (a cycle?)");
+    const tinygltf::Node& n = model.nodes[size_t(f.node)];
+    const Mat4 world = mul(f.parent, nodeMatrix(n));
+    if (n.mesh >= 0) {
+      if (size_t(n.mesh) >= model.meshes.size())
+        return makeError(Code::kMeshIndex, path + ": node " + std::to_string(f.node) + " references a missing mesh");
+      out.push_back({f.node, n.mesh, world});
+    }
+    for (auto it = n.children.rbegin(); it != n.children.rend(); ++it) stack.push_back({*it, world, f.depth + 1});
+  }
+  return out;
+}
+
+// Parses the file and picks the scene (`requested` -1: the default one). *info gets the scenes.
+Result<std::shared_ptr<const tinygltf::Model>> parseScene(const std::string& path, bool binary, int requested,
+                                                          int* sceneIndex, MeshInfo* info) {
+  auto model = parseGltf(path, binary);
+  if (!model) return model;
+  const auto& scenes = (*model)->scenes;
+  if (info) {
+    info->gltfScenes.clear();
+    for (const auto& s : scenes) info->gltfScenes.push_back(s.name);
+  }
+  if (requested >= 0 && size_t(requested) >= scenes.size())
+    return makeError(Code::kInvalidArgument, path + ": there is no scene " + std::to_string(requested) + " (the file has " +
+                                                 std::to_string(scenes.size()) + " scene" +
+                                                 (scenes.size() == 1 ? "" : "s") + ")");
+  *sceneIndex = -1;
+  if (!scenes.empty()) {
+    *sceneIndex = requested >= 0 ? requested : (*model)->defaultScene >= 0 ? (*model)->defaultScene : 0;
+    if (size_t(*sceneIndex) >= scenes.size()) return makeError(Code::kMeshIndex, path + ": default scene out of range");
+  }
+  if (info) info->gltfScene = *sceneIndex;
+  return model;
+}
+
+bool isGlb(const std::string& path) {
+  return path.size() >= 4 && (path.compare(path.size() - 4, 4, ".glb") == 0 || path.compare(path.size() - 4, 4, ".GLB") == 0);
+}
+
+// The world matrix as translation * similarity, when its linear part is one: a positive uniform
+// scale times a rotation, within float precision.
+bool similarity(const Mat4& m, GltfPlacement* p) {
+  const double a[3][3] = {{m[0], m[4], m[8]}, {m[1], m[5], m[9]}, {m[2], m[6], m[10]}};
+  const double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+                     a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+  if (!(det > 0)) return false;
+  const double s = std::cbrt(det);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      double dot = 0;  // (A^T A)_ij
+      for (int k = 0; k < 3; ++k) dot += a[k][i] * a[k][j];
+      if (std::fabs(dot - (i == j ? s * s : 0.0)) > 1e-5 * s * s) return false;
+    }
+  float r[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r[i][j] = float(a[i][j] / s);
+  p->rotation = quaternionFromRotation(r);
+  p->scale = float(s);
+  p->translation = {float(m[12]), float(m[13]), float(m[14])};
+  return true;
+}
+
+}  // namespace
+
+Result<Mesh> loadWithTinyGltf(const std::string& path, bool binary, const MeshLoadOptions& options, MeshInfo* info) {
+  int sceneIndex = -1;
+  auto model = parseScene(path, binary, options.gltfScene, &sceneIndex, info);
+  if (!model) return std::move(model).error();
+  auto nodes = sceneMeshes(**model, path, sceneIndex);
+  if (!nodes) return std::move(nodes).error();
+  std::vector<GltfMeshRef> refs;
+  for (const NodeMesh& n : *nodes) refs.push_back({n.mesh, n.world});
+  return importGltfMeshes(**model, path, refs);
+}
+
+}  // namespace detail
+
+Result<std::vector<GltfObject>> loadGltfObjects(const std::string& path, const GltfObjectOptions& options,
+                                                MeshInfo* info) {
+  struct stat st {};
+  if (Status s = detail::checkReadable(path, &st); !s) return std::move(s).error();
+  MeshInfo localInfo;
+  MeshInfo* in = info ? info : &localInfo;
+  int sceneIndex = -1;
+  auto model = detail::parseScene(path, detail::isGlb(path), options.scene, &sceneIndex, in);
+  if (!model) return std::move(model).error();
+  in->format = detail::isGlb(path) ? "glb" : "gltf";
+  auto nodes = detail::sceneMeshes(**model, path, sceneIndex);
+  if (!nodes) return std::move(nodes).error();
+
+  std::vector<GltfObject> objects;
+  std::map<int, size_t> sharedObject;  // mesh -> its object in its own frame (kMesh)
+  for (const detail::NodeMesh& n : *nodes) {
+    GltfPlacement place;
+    place.node = n.node;
+    if (n.node >= 0) place.name = (*model)->nodes[size_t(n.node)].name;
+    const bool similar = detail::similarity(n.world, &place);
+    detail::GltfMatrix bakedMatrix = detail::identity();
+    if (!similar) {  // the linear part goes into the geometry, the translation into the placement
+      bakedMatrix = n.world;
+      bakedMatrix[12] = bakedMatrix[13] = bakedMatrix[14] = 0;
+      place.translation = {float(n.world[12]), float(n.world[13]), float(n.world[14])};
+    }
+    const bool shared = options.split == GltfSplit::kMesh && similar;
+    if (shared && sharedObject.count(n.mesh)) {
+      objects[sharedObject[n.mesh]].placements.push_back(place);
+      continue;
+    }
+    GltfObject obj;
+    obj.mesh = n.mesh;
+    obj.node = shared ? -1 : n.node;
+    obj.name = options.split == GltfSplit::kNode ? place.name : (*model)->meshes[size_t(n.mesh)].name;
+    auto geometry = detail::importGltfMeshes(**model, path, {{n.mesh, bakedMatrix}});
+    if (!geometry) return std::move(geometry).error();
+    const std::string what = path + " mesh " + std::to_string(n.mesh) +
+                             (obj.name.empty() ? std::string() : " '" + obj.name + "'") +
+                             (obj.node >= 0 ? " at node " + std::to_string(obj.node) : std::string());
+    Status s = checkMesh(&*geometry, what);
+    if (!s) return std::move(s).error();
+    obj.geometry = std::move(*geometry);
+    obj.placements.push_back(place);
+    if (shared) sharedObject[n.mesh] = objects.size();
+    objects.push_back(std::move(obj));
+  }
+  if (objects.empty())
+    return makeError(Code::kMeshEmpty, path + ": scene " + std::to_string(sceneIndex) + " has no node with a mesh");
+  return objects;
+}
+
+}  // namespace vff::bake

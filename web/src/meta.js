@@ -1,0 +1,99 @@
+// meta.js - the META rule 8001 checker: exactly one RFC 8259 JSON text in strict UTF-8, surrogate
+// escapes in pairs, at most 64 levels deep, numbers checked as text (spec/format.md section 9).
+
+/** Returns null when the bytes are one JSON text, else {offset, message} of the first problem. */
+export function checkJsonText(b) {
+  let p = 0, depth = 0;
+  const n = b.length;
+  const fail = (m) => { throw { offset: p, message: m }; };
+  const ws = () => { while (p < n && (b[p] === 0x20 || b[p] === 0x09 || b[p] === 0x0a || b[p] === 0x0d)) ++p; };
+  const lit = (s) => {
+    for (let i = 0; i < s.length; ++i) if (b[p + i] !== s.charCodeAt(i)) fail(`expected ${s}`);
+    p += s.length;
+  };
+  const hex4 = () => {
+    let v = 0;
+    for (let i = 0; i < 4; ++i) {
+      const c = b[p++];
+      const d = c >= 0x30 && c <= 0x39 ? c - 0x30 : c >= 0x41 && c <= 0x46 ? c - 55 : c >= 0x61 && c <= 0x66 ? c - 87 : -1;
+      if (d < 0) fail('bad \\u escape');
+      v = v * 16 + d;
+    }
+    return v;
+  };
+  const string = () => {
+    ++p;
+    for (;;) {
+      if (p >= n) fail('unterminated string');
+      const c = b[p];
+      if (c === 0x22) { ++p; return; }
+      if (c < 0x20) fail('unescaped control character');
+      if (c === 0x5c) {
+        const e = b[p + 1];
+        p += 2;
+        if (e === 0x75) {
+          const u = hex4();
+          if (u >= 0xdc00 && u <= 0xdfff) fail('lone low surrogate escape');
+          if (u >= 0xd800 && u <= 0xdbff) {
+            if (b[p] !== 0x5c || b[p + 1] !== 0x75) fail('lone high surrogate escape');
+            p += 2;
+            const l = hex4();
+            if (l < 0xdc00 || l > 0xdfff) fail('high surrogate escape without a low one');
+          }
+        } else if (![0x22, 0x5c, 0x2f, 0x62, 0x66, 0x6e, 0x72, 0x74].includes(e)) fail('bad escape');
+        continue;
+      }
+      if (c < 0x80) { ++p; continue; }
+      // UTF-8, RFC 3629: shortest form, no surrogates, nothing above U+10FFFF.
+      let len, lo = 0x80, hi = 0xbf;
+      if (c >= 0xc2 && c <= 0xdf) len = 2;
+      else if (c >= 0xe0 && c <= 0xef) { len = 3; if (c === 0xe0) lo = 0xa0; if (c === 0xed) hi = 0x9f; }
+      else if (c >= 0xf0 && c <= 0xf4) { len = 4; if (c === 0xf0) lo = 0x90; if (c === 0xf4) hi = 0x8f; }
+      else fail('invalid UTF-8');
+      for (let i = 1; i < len; ++i) {
+        const t = b[p + i];
+        if (t === undefined || t < (i === 1 ? lo : 0x80) || t > (i === 1 ? hi : 0xbf)) fail('invalid UTF-8');
+      }
+      p += len;
+    }
+  };
+  const digits = () => { const s = p; while (p < n && b[p] >= 0x30 && b[p] <= 0x39) ++p; if (p === s) fail('digit expected'); };
+  const number = () => {
+    if (b[p] === 0x2d) ++p;
+    if (b[p] === 0x30) ++p; else digits();
+    if (b[p] === 0x2e) { ++p; digits(); }
+    if (b[p] === 0x65 || b[p] === 0x45) { ++p; if (b[p] === 0x2b || b[p] === 0x2d) ++p; digits(); }
+  };
+  const value = () => {
+    ws();
+    const c = b[p];
+    if (c === 0x7b || c === 0x5b) {
+      if (++depth > 64) fail('nested deeper than 64 levels');
+      const close = c === 0x7b ? 0x7d : 0x5d;
+      ++p; ws();
+      if (b[p] === close) { ++p; --depth; return; }
+      for (;;) {
+        if (close === 0x7d) { ws(); if (b[p] !== 0x22) fail('key expected'); string(); ws(); if (b[p] !== 0x3a) fail(': expected'); ++p; }
+        value(); ws();
+        if (b[p] === 0x2c) { ++p; continue; }
+        if (b[p] === close) { ++p; --depth; return; }
+        fail(', or closing bracket expected');
+      }
+    }
+    if (c === 0x22) return string();
+    if (c === 0x74) return lit('true');
+    if (c === 0x66) return lit('false');
+    if (c === 0x6e) return lit('null');
+    if (c === 0x2d || (c >= 0x30 && c <= 0x39)) return number();
+    fail(p >= n ? 'value expected' : 'unexpected byte');
+  };
+  try {
+    value();
+    ws();
+    if (p !== n) fail('bytes after the JSON value');
+  } catch (e) {
+    if (e instanceof Error) throw e;
+    return e;
+  }
+  return null;
+}
