@@ -12,6 +12,7 @@ packages=(
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
   clang libclang-rt-14-dev
   glmark2-data zstd xz-utils python3
+  python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-matplotlib
   chromium nodejs
 )
 # npm ships inside some nodejs builds; Debian packages it apart.

@@ -224,6 +224,7 @@ BakeStats runAll(const Scene::Impl& s, const Plan& plan, const BakeOptions& o, u
   auto work = [&] {
     uint64_t h = 0;
     for (uint32_t i; (i = next.fetch_add(1, std::memory_order_relaxed)) < maps;) {
+      if (o.cancel && o.cancel->load(std::memory_order_relaxed)) break;
       h += traceMap<kKeep>(s, plan, i, kKeep ? dist + i * plan.distBytes : nullptr,
                            kKeep && norm ? norm + i * plan.normBytes : nullptr);
       const uint64_t d = done.fetch_add(1, std::memory_order_relaxed) + 1;
@@ -261,6 +262,7 @@ Result<BakedField> bakeField(const Scene& scene, const BakeOptions& o) {
                                              " bytes");
   }
   out.stats = runAll<true>(*scene.impl_, *plan, o, out.distance.data(), o.normals ? out.normals.data() : nullptr);
+  if (o.cancel && o.cancel->load()) return makeError(Code::kBadState, "the bake was cancelled");
   return out;
 }
 

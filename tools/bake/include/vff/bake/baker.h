@@ -7,6 +7,7 @@
 // goes into the normal field. Hits are two-sided. The output does not depend on the thread count.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -29,6 +30,10 @@ struct BakeOptions {
   std::optional<Sphere> sphere;  // default: the minimal enclosing sphere of the mesh's vertices
   // Called from the baking threads with (maps done, maps total); keep it cheap and thread-safe.
   std::function<void(uint64_t, uint64_t)> progress;
+  // When set, read by the baking threads before each map: once it holds true they take no more
+  // maps and bakeField fails with kBadState ("cancelled"). For callers that stop a bake from
+  // another thread (a Ctrl-C in the Python module).
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 struct BakeStats {

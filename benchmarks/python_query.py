@@ -1,0 +1,99 @@
+#!/usr/bin/env python3
+"""The Python batch and vff-query against libvff's C++ batch, on the same rays, in one run.
+
+    PYTHONPATH=build/python python3 benchmarks/python_query.py --field out/bunny.vff \\
+        --query build/tools/vff-query/vff-query [--rays 1000000] [--repeat 5]
+
+Makes `--rays` ambient-occlusion rays about the field (origins on a disc around its foot, up to
+2R, cosine-weighted; as vff-experiments bench's "ao" set) and writes them as an (N, 6) float32
+.npy. Then, best of --repeat each, alternating:
+  C++ batch    vff-query --timing: the batch calls alone on warm memory (FieldQuery::intersect in
+               chunks over its threads, the answers dropped)
+  vff-query    the same command end to end: reading the .npy, querying, writing the answers .npy
+  Python       FieldQuery.intersect(origins, directions) on numpy arrays (threads as vff-query's),
+               and FieldQuery.occluded for reference
+and prints each in Mrays/s with its ratio to the C++ batch, naming the CPU.
+"""
+import argparse
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+import vff
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from report import cpu_name  # noqa: E402
+
+
+def ao_rays(field, n, seed=7):
+    rng = np.random.default_rng(seed)
+    c = np.array(field.center, np.float64)
+    r = field.radius
+    rad = 2 * r * np.sqrt(rng.random(n))
+    phi = 2 * np.pi * rng.random(n)
+    o = np.stack([c[0] + rad * np.cos(phi), np.full(n, c[1] - r + 1e-4 * r), c[2] + rad * np.sin(phi)], -1)
+    u1, u2 = rng.random(n), rng.random(n)
+    s = np.sqrt(u1)
+    d = np.stack([s * np.cos(2 * np.pi * u2), np.sqrt(1 - u1), s * np.sin(2 * np.pi * u2)], -1)
+    return o.astype(np.float32), d.astype(np.float32)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--field", required=True)
+    ap.add_argument("--query", required=True, help="the vff-query executable")
+    ap.add_argument("--rays", type=int, default=1000000)
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--threads", type=int, default=os.cpu_count())
+    ap.add_argument("--interpolated", action="store_true")
+    a = ap.parse_args()
+    f = vff.open(a.field)
+    q = vff.FieldQuery(f)
+    o, d = ao_rays(f, a.rays)
+    extra = ["--interpolated"] if a.interpolated else []
+    best = {"cpp": 0.0, "cli": 0.0, "py": 0.0, "reuse": 0.0, "occ": 0.0}
+    reuse = q.intersect(o, d, interpolated=a.interpolated, threads=a.threads)
+    with tempfile.TemporaryDirectory() as tmp:
+        rays = os.path.join(tmp, "rays.npy")
+        out = os.path.join(tmp, "hits.npy")
+        np.save(rays, np.hstack([o, d]))
+        cmd = [a.query, a.field, "-i", rays, "-o", out, "-j", str(a.threads), *extra]
+        for _ in range(a.repeat):
+            r = subprocess.run(cmd + ["--timing"], capture_output=True, text=True, check=True)
+            m = re.search(r"batch alone, warm: [0-9.]+ s \(([0-9.]+) Mrays/s\)", r.stderr)
+            best["cpp"] = max(best["cpp"], float(m.group(1)))
+            t0 = time.perf_counter()
+            subprocess.run(cmd, check=True)
+            best["cli"] = max(best["cli"], a.rays / 1e6 / (time.perf_counter() - t0))
+            t0 = time.perf_counter()
+            h = q.intersect(o, d, interpolated=a.interpolated, threads=a.threads)
+            best["py"] = max(best["py"], a.rays / 1e6 / (time.perf_counter() - t0))
+            t0 = time.perf_counter()
+            q.intersect(o, d, interpolated=a.interpolated, threads=a.threads, out=reuse)
+            best["reuse"] = max(best["reuse"], a.rays / 1e6 / (time.perf_counter() - t0))
+            t0 = time.perf_counter()
+            q.occluded(o, d, interpolated=a.interpolated, threads=a.threads)
+            best["occ"] = max(best["occ"], a.rays / 1e6 / (time.perf_counter() - t0))
+        got = np.load(out)
+        assert np.array_equal(got[:, 1], h.t), "vff-query and the Python batch disagree"
+    print("cpu: %s, %d threads, batch kernel %s" % (cpu_name(), a.threads, vff.batch_kernel()))
+    print("field: %s (%d maps of %dx%d), %d ao rays, %s, best of %d" % (
+        os.path.basename(a.field), f.map_count, f.map_resolution, f.map_resolution, a.rays,
+        "interpolated" if a.interpolated else "nearest", a.repeat))
+    print("| path | Mrays/s | x C++ batch |")
+    print("|---|---:|---:|")
+    print("| C++ batch (FieldQuery::intersect, warm, vff-query --timing) | %.1f | 1.00 |" % best["cpp"])
+    print("| vff-query, .npy in and out, end to end | %.1f | %.2f |" % (best["cli"], best["cli"] / best["cpp"]))
+    print("| Python FieldQuery.intersect, numpy in and out | %.1f | %.2f |" % (best["py"], best["py"] / best["cpp"]))
+    print("| Python FieldQuery.intersect, out= (arrays reused) | %.1f | %.2f |" % (best["reuse"], best["reuse"] / best["cpp"]))
+    print("| Python FieldQuery.occluded (a byte per ray out; no C++ baseline here) | %.1f | - |" % best["occ"])
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,123 @@
+# Type stubs of the vff package (the extension vff._vff and vff._errors).
+from typing import Any, Callable, Iterator, NamedTuple, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+format_version: Tuple[int, int]
+
+class Error(Exception):
+    code: int
+    name: str
+    section: Optional[str]
+    offset: Optional[int]
+    message: str
+    @property
+    def validation_id(self) -> Optional[int]: ...
+
+class IoError(Error, OSError): ...
+class InvalidFileError(Error): ...
+class MeshError(Error): ...
+class InvalidArgumentError(Error, ValueError): ...
+class UnsupportedError(Error): ...
+class OperationError(Error, RuntimeError): ...
+
+class Problem(NamedTuple):
+    id: int
+    name: str
+    severity: str
+    section: Optional[str]
+    offset: Optional[int]
+    message: str
+
+Vec3 = Union[Sequence[float], npt.NDArray[np.float32]]
+Bound = Union[None, float, npt.NDArray[np.float32]]
+
+def batch_kernel() -> str: ...
+
+class File:
+    path: str
+    version: Tuple[int, int]
+    file_size: int
+    center: Tuple[float, float, float]
+    radius: float
+    position_scheme: str
+    position_param: int
+    map_count: int
+    direction_scheme: str
+    map_resolution: int
+    frame: str
+    distance_encoding: str
+    miss_code: int
+    normal_encoding: str
+    has_normals: bool
+    layout: dict[str, Any]
+    sections: list[dict[str, Any]]
+    metadata: dict[str, Any]
+    metadata_text: str
+    def describe(self) -> dict[str, Any]: ...
+    def validate(self, decode_blocks: bool = True) -> list[Problem]: ...
+    def map(self, index: int, plane: str = "distance") -> np.ndarray: ...
+    def maps(self, plane: str = "distance") -> np.ndarray: ...
+    def distances(self, index: int) -> npt.NDArray[np.float32]: ...
+    def normals(self, index: int) -> npt.NDArray[np.float32]: ...
+    def slice(self, index: int, plane: str = "distance") -> npt.NDArray[np.uint8]: ...
+
+def open(path: str, checksums: str = "all") -> File: ...
+def inspect(path: str) -> dict[str, Any]: ...
+
+class Hits:
+    hit: npt.NDArray[np.bool_]
+    t: npt.NDArray[np.float32]
+    point: npt.NDArray[np.float32]
+    normal: npt.NDArray[np.float32]
+    inside: npt.NDArray[np.bool_]
+    def __len__(self) -> int: ...
+    def __iter__(self) -> Iterator[np.ndarray]: ...
+
+HitTuple = Tuple[bool, float, Tuple[float, float, float], Tuple[float, float, float], bool]
+
+class _Queries:
+    def intersect(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
+                  tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0,
+                  threads: int = 0, out: Optional[Hits] = None) -> Hits: ...
+    def occluded(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
+                 tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0,
+                 threads: int = 0) -> npt.NDArray[np.bool_]: ...
+    def visibility(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
+                   tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0,
+                   threads: int = 0) -> npt.NDArray[np.float32]: ...
+    def intersect_ray(self, origin: Vec3, direction: Vec3, tmin: float = 0.0, tmax: float = ..., *,
+                      interpolated: bool = False, intra_bias: float = -1.0) -> HitTuple: ...
+    def occluded_ray(self, origin: Vec3, direction: Vec3, tmin: float = 0.0, tmax: float = ..., *,
+                     interpolated: bool = False, intra_bias: float = -1.0) -> bool: ...
+    def visibility_ray(self, origin: Vec3, direction: Vec3, tmin: float = 0.0, tmax: float = ..., *,
+                       interpolated: bool = False, intra_bias: float = -1.0) -> float: ...
+
+class FieldQuery(_Queries):
+    def __init__(self, file: File) -> None: ...
+    file: File
+    payload_bytes: int
+    has_normals: bool
+
+class Instance(_Queries):
+    def __init__(self, field: FieldQuery, rotation: Optional[npt.ArrayLike] = None, translation: Vec3 = (0, 0, 0),
+                 scale: float = 1.0) -> None: ...
+    @staticmethod
+    def from_axis_angle(field: FieldQuery, axis: Vec3, radians: float, translation: Vec3 = (0, 0, 0),
+                        scale: float = 1.0) -> "Instance": ...
+    field: FieldQuery
+    rotation: npt.NDArray[np.float32]
+    translation: Tuple[float, float, float]
+    scale: float
+    world_sphere: Tuple[Tuple[float, float, float], float]
+
+def bake(vertices: npt.ArrayLike, faces: npt.ArrayLike, out: Optional[str] = None, *,
+         progress: Optional[Callable[[int, int], Any]] = None, **options: Any) -> File: ...
+def bake_file(path: str, out: str, *, progress: Optional[Callable[[int, int], Any]] = None, **options: Any) -> File: ...
+def compress(src: str, dst: str, level: int = 19, filter: str = "auto", maps_per_block: int = 0) -> File: ...
+def decompress(src: str, dst: str) -> File: ...
+def convert(src: str, dst: str, *, codec: str = "stored", zstd_level: int = 19, maps_per_block: int = 0,
+            target: Optional[str] = None, max_texture_size: Optional[int] = None, max_layers: Optional[int] = None,
+            gutter: Optional[int] = None) -> File: ...

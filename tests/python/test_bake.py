@@ -1,0 +1,131 @@
+"""vff.bake, vff.bake_file, compress/decompress/convert: fields baked from numpy meshes."""
+import _thread
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import vff
+
+
+def uv_sphere(radius=1.0, rings=24, segments=48, center=(0.0, 0.0, 0.0)):
+    """A closed UV sphere: (V, 3) float32 vertices and (F, 3) int32 faces."""
+    theta = np.linspace(0, np.pi, rings + 1)
+    phi = np.linspace(0, 2 * np.pi, segments, endpoint=False)
+    t, p = np.meshgrid(theta, phi, indexing="ij")
+    v = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], -1).reshape(-1, 3) * radius
+    v = (v + np.asarray(center)).astype(np.float32)
+    faces = []
+    for r in range(rings):
+        for s in range(segments):
+            a, b = r * segments + s, r * segments + (s + 1) % segments
+            c, d = a + segments, b + segments
+            if r > 0:
+                faces.append((a, c, b))
+            if r < rings - 1:
+                faces.append((b, c, d))
+    return v, np.array(faces, np.int32)
+
+
+def ray_sphere(o, d, center, radius):
+    """The first t >= 0 where unit-direction rays o + t d cross a sphere (inf for a miss)."""
+    oc = o - np.asarray(center)
+    b = np.sum(oc * d, axis=1)
+    disc = b * b - (np.sum(oc * oc, axis=1) - radius * radius)
+    t = -b - np.sqrt(np.maximum(disc, 0))
+    return np.where((disc >= 0) & (t >= 0), t, np.inf)
+
+
+def test_bake_answers_the_spheres():
+    # A ball and a small moon: the bounding sphere is larger than the ball, so distances are real.
+    ball, moon = ((0.5, -0.25, 2.0), 0.6), ((1.6, -0.25, 2.0), 0.1)
+    v1, f1 = uv_sphere(ball[1], center=ball[0])
+    v2, f2 = uv_sphere(moon[1], 8, 16, center=moon[0])
+    v, f = np.vstack([v1, v2]), np.vstack([f1, f2 + len(v1)])
+    calls = []
+    field = vff.bake(v, f, count=12, map_size=32, normals=True, progress=lambda d, t: calls.append((d, t)))
+    assert field.map_count == 2 * (2 * 144 + 24 + 1) and field.map_resolution == 32 and field.has_normals
+    assert calls and calls[-1] == (field.map_count, field.map_count)
+    assert field.validate() == []
+    q = vff.FieldQuery(field)
+    rng = np.random.default_rng(9)
+    n = 2000
+    dirs = rng.normal(size=(n, 3))
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    origins = (np.array(field.center) + 3.0 * field.radius * dirs).astype(np.float32)
+    d = (np.array(ball[0]) + rng.uniform(-0.3, 0.3, (n, 3)) - origins).astype(np.float32)
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    exact = np.minimum(ray_sphere(origins, d, *ball), ray_sphere(origins, d, *moon))
+    step = 2 * field.radius / 254  # one unorm8-diameter code
+    for interpolated, median, p95 in ((False, 3 * step, 12 * step), (True, 2 * step, 8 * step)):
+        h = q.intersect(origins, d, interpolated=interpolated)
+        agree = h.hit == np.isfinite(exact)
+        assert agree.mean() > 0.99
+        both = h.hit & np.isfinite(exact)
+        err = np.abs(h.t[both] - exact[both])
+        assert np.median(err) < median and np.percentile(err, 95) < p95, (interpolated, np.median(err) / step)
+    # Normals point away from the ball's centre where the ball was hit.
+    h = q.intersect(origins, d)
+    on_ball = h.hit & (ray_sphere(origins, d, *ball) <= ray_sphere(origins, d, *moon))
+    radial = h.point[on_ball] - np.array(ball[0])
+    radial /= np.linalg.norm(radial, axis=1, keepdims=True)
+    assert np.median(np.sum(radial * h.normal[on_ball], axis=1)) > 0.95
+
+
+def test_bake_file_and_rewrites(tmp_path):
+    v, f = uv_sphere(rings=8, segments=16)
+    obj = tmp_path / "ball.obj"
+    with open(obj, "w") as out:
+        out.writelines("v %.9g %.9g %.9g\n" % tuple(p) for p in v)
+        out.writelines("f %d %d %d\n" % tuple(t + 1) for t in f)
+    baked = vff.bake_file(str(obj), str(tmp_path / "ball.vff"), count=2, map_size=8, threads=1)
+    assert baked.path == str(tmp_path / "ball.vff") and baked.metadata["vff.source"]["name"] == "ball.obj"
+    again = vff.bake(v, f, str(tmp_path / "mem.vff"), count=2, map_size=8, threads=2)
+    assert np.array_equal(again.maps(), baked.maps())  # the thread count does not change the field
+    small = vff.compress(str(tmp_path / "ball.vff"), str(tmp_path / "small.vff"))
+    assert set(small.describe()["planes"]["distance"]["block_codecs"]) == {"zstd"}
+    plain = vff.decompress(str(tmp_path / "small.vff"), str(tmp_path / "plain.vff"))
+    assert np.array_equal(plain.maps(), baked.maps()) and plain.metadata == baked.metadata
+    packed = vff.convert(str(tmp_path / "ball.vff"), str(tmp_path / "packed.vff"), max_texture_size=16, target="3d")
+    assert packed.layout["target"] == "3d" and packed.layout["slice_width"] <= 16
+    assert np.array_equal(packed.maps(), baked.maps()) and packed.validate() == []
+
+
+def test_bake_errors():
+    v, f = uv_sphere(rings=4, segments=8)
+    with pytest.raises(vff.MeshError) as e:
+        vff.bake(v, f + 1000)
+    assert e.value.code == 10007
+    bad = v.copy()
+    bad[0, 0] = np.nan
+    with pytest.raises(vff.MeshError) as e:
+        vff.bake(bad, f)
+    assert e.value.name == "mesh-non-finite"
+    with pytest.raises(ValueError, match="encoding: expected one of unorm8-diameter"):
+        vff.bake(v, f, encoding="unorm9")
+    with pytest.raises(TypeError, match="unexpected keyword argument 'mapsize'"):
+        vff.bake(v, f, mapsize=8)
+    with pytest.raises(ValueError, match=r"vertices: expected shape \(V, 3\)"):
+        vff.bake(v[:, :2], f)
+    with pytest.raises(TypeError, match="faces: expected an integer array"):
+        vff.bake(v, f.astype(np.float32))
+    with pytest.raises(vff.IoError):
+        vff.bake_file("/nonexistent/mesh.obj", "/nonexistent/out.vff")
+
+
+def test_bake_stops_on_ctrl_c_and_on_callback_errors():
+    v, f = uv_sphere(rings=48, segments=96)
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    start = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        vff.bake(v, f, count=48, map_size=64)
+    timer.join()
+    assert time.monotonic() - start < 10
+
+    def stop(done, total):
+        raise RuntimeError("enough after %d of %d" % (done, total))
+
+    with pytest.raises(RuntimeError, match="enough after"):
+        vff.bake(v, f, count=48, map_size=64, progress=stop)

@@ -1,0 +1,179 @@
+#!/usr/bin/env bash
+# query_tool_tests.sh - vff-query against libvff's one-ray answers (vff_query_reference), and its
+# diagnostics. Every function named test_* is one ctest case (tests/query-tool/CMakeLists.txt).
+#   VFF_QUERY   the vff-query executable
+#   REFERENCE   vff_query_reference (reference.cpp): rays, and the one-ray answers as vff-query's CSV
+#   VECTORS     spec/conformance/valid
+#   WORK        a scratch folder of this test (emptied first)
+set -euo pipefail
+: "${VFF_QUERY:?}" "${REFERENCE:?}" "${VECTORS:?}" "${WORK:?}"
+
+source "$(dirname "${BASH_SOURCE[0]}")/../common/cli_harness.sh"
+query() { run "$VFF_QUERY" "$@"; }
+# Fields of every distance encoding, with and without normals.
+FIELDS=(u8d-zstd-normals-meta u8c-stored-normals-3d-gutter1 u16d-zstd-normals-gutter2 bit1-stored bc4-zstd-normals-slices)
+# same A B: files A and B are identical.
+same() { cmp -s "$1" "$2" || { diff "$1" "$2" | head -20 >&2; fail "$1 and $2 differ"; }; }
+# has_numpy: python3 with numpy is there (scripts/setup.sh installs it).
+has_numpy() { /usr/bin/python3 -c 'import numpy' 2>/dev/null; }
+
+test_help() {
+  query --help
+  expect_rc 0
+  for opt in --ray --input --output --format --interpolated --visibility --tmin --tmax --rotate --translate --scale \
+    --threads "Exit codes:" "3  invalid input file"; do expect_out "$opt"; done
+}
+
+# Nearest answers, split over threads in batches, equal the one-ray calls on every encoding.
+test_nearest_equals_one_ray() {
+  for f in "${FIELDS[@]}"; do
+    "$REFERENCE" rays "$VECTORS/$f.vff" 600 7 >"$WORK/rays.csv"
+    "$REFERENCE" answer "$VECTORS/$f.vff" "$WORK/rays.csv" --visibility >"$WORK/want.csv"
+    query "$VECTORS/$f.vff" -i "$WORK/rays.csv" -o "$WORK/got.csv" --visibility -j 3
+    expect_rc 0
+    same "$WORK/want.csv" "$WORK/got.csv"
+    grep -q '^1,' "$WORK/got.csv" || fail "$f: no ray hit"
+    grep -q '^0,' "$WORK/got.csv" || fail "$f: every ray hit"
+  done
+}
+
+test_interpolated_equals_one_ray() {
+  for f in "${FIELDS[@]}"; do
+    "$REFERENCE" rays "$VECTORS/$f.vff" 400 11 >"$WORK/rays.csv"
+    "$REFERENCE" answer "$VECTORS/$f.vff" "$WORK/rays.csv" --interpolated --visibility >"$WORK/want.csv"
+    query "$VECTORS/$f.vff" -i "$WORK/rays.csv" --interpolated --visibility -j 2
+    expect_rc 0
+    same "$WORK/want.csv" "$WORK/out"
+  done
+}
+
+# An instance transform: rays in world space, answered as Instance's one-ray calls.
+test_instance_equals_one_ray() {
+  local f="$VECTORS/u8d-zstd-normals-meta.vff" place=(--rotate 0 1 0.5 0.7 --translate 2 -1 0.5 --scale 1.5)
+  # Rays about the moved sphere: made around the field's own sphere, then moved by the same transform
+  # by vff-query itself would be circular; the reference's rays are near enough to the moved sphere.
+  "$REFERENCE" rays "$f" 500 3 >"$WORK/rays.csv"
+  "$REFERENCE" answer "$f" "$WORK/rays.csv" "${place[@]}" >"$WORK/want.csv"
+  query "$f" -i "$WORK/rays.csv" "${place[@]}"
+  expect_rc 0
+  same "$WORK/want.csv" "$WORK/out"
+  grep -q '^1,' "$WORK/out" || fail "no ray hit the moved field"
+}
+
+# The same rays as --ray, CSV, JSON lines and .npy give the same answers.
+test_input_spellings_agree() {
+  local f="$VECTORS/u8d-zstd-normals-meta.vff"
+  query "$f" --ray 0.5 -1 5 0 0 -1 --ray 0.5 -1 5 0 0.5 -1 --ray 9 9 9 1 0 0
+  expect_rc 0
+  cp "$WORK/out" "$WORK/want.csv"
+  [[ $(sed -n 2p "$WORK/want.csv") == 1,2.31* ]] || { show; fail "the first ray does not hit at t 2.31"; }
+  printf 'ox,oy,oz,dx,dy,dz\n# a comment\n0.5 -1 5 0 0 -1\n\n0.5,-1,5,0,0.5,-1\n+9,9,9,1,0,0\n' >"$WORK/rays.csv"
+  query "$f" <"$WORK/rays.csv"
+  expect_rc 0
+  same "$WORK/want.csv" "$WORK/out"
+  printf '{"origin":[0.5,-1,5],"direction":[0,0,-1]}\n[0.5,-1,5,0,0.5,-1,0,1e30]\n{"origin":[9,9,9],"direction":[1,0,0],"tmax":3}\n' \
+    >"$WORK/rays.jsonl"
+  query "$f" -i "$WORK/rays.jsonl"
+  expect_rc 0
+  same "$WORK/want.csv" "$WORK/out"
+  query "$f" -i "$WORK/rays.jsonl" --format jsonl
+  expect_rc 0
+  expect_out '{"hit":true,"t":2.31000018,"point":[0.5,-1,2.68999982],"normal":['
+  expect_out '{"hit":false,"t":null,"point":null,"normal":null,"inside":false}'
+  # tmax before the surface: a miss.
+  query "$f" --ray 0.5 -1 5 0 0 -1 --tmax 2
+  expect_rc 0
+  [[ $(sed -n 2p "$WORK/out") == 0,inf* ]] || { show; fail "--tmax 2 still hits"; }
+}
+
+test_npy_in_and_out() {
+  has_numpy || { echo "SKIP: python3 with numpy is not installed (scripts/setup.sh installs python3-numpy)"; return 0; }
+  local f="$VECTORS/u16d-zstd-normals-gutter2.vff"
+  "$REFERENCE" rays "$f" 300 5 >"$WORK/rays.csv"
+  /usr/bin/python3 -c "import numpy as np; np.save('$WORK/rays.npy', np.loadtxt('$WORK/rays.csv', delimiter=',', dtype=np.float32))"
+  query "$f" -i "$WORK/rays.csv" --visibility
+  expect_rc 0
+  cp "$WORK/out" "$WORK/want.csv"
+  query "$f" -i "$WORK/rays.npy" -o "$WORK/hits.npy" --visibility
+  expect_rc 0
+  expect_no_out
+  /usr/bin/python3 - "$WORK/hits.npy" "$WORK/want.csv" <<'PY' || fail ".npy answers differ from the CSV ones"
+import sys, numpy as np
+got = np.load(sys.argv[1])
+want = np.genfromtxt(sys.argv[2], delimiter=',', names=True)
+assert got.dtype == np.float32 and got.shape == (300, 10), (got.dtype, got.shape)
+for i, name in enumerate(want.dtype.names):
+    assert np.array_equal(got[:, i], want[name].astype(np.float32), equal_nan=True), name
+PY
+  # Standard input takes .npy too.
+  query "$f" --format npy --visibility <"$WORK/rays.npy"
+  expect_rc 0
+  cmp -s "$WORK/out" "$WORK/hits.npy" || fail ".npy from standard input differs"
+}
+
+test_bad_lines_name_line_and_column() {
+  local f="$VECTORS/u8d-zstd-normals-meta.vff"
+  printf '0.5,-1,5,0,0,-1\n# note\n9,9,9,1,0,0\n0.5,-1,5,0,zero,-1\n0.5,-1,5,0,0,-1\n' >"$WORK/in"
+  query "$f" <"$WORK/in"
+  expect_rc 3
+  expect_err "vff-query: error: <stdin>:4:12: expected a number, found \"zero\""
+  [[ $(wc -l <"$WORK/out") -eq 3 ]] || { show; fail "the two rays before the bad line are not answered"; }
+  printf '1,2,3,4,5\n' >"$WORK/short.csv"
+  query "$f" -i "$WORK/short.csv"
+  expect_rc 3
+  expect_err "$WORK/short.csv:1:10: found 5 numbers: a ray has 6"
+  printf '1,2,3,0,0,0\n' >"$WORK/in"
+  query "$f" <"$WORK/in"
+  expect_rc 3
+  expect_err "<stdin>:1:7: the direction is zero"
+  printf '0,0,9,0,0,-1\n{"origin":[1,2],"direction":[0,0,1]}\n' >"$WORK/in"
+  query "$f" <"$WORK/in"
+  expect_rc 3
+  expect_err "<stdin>:2:1: origin must be an array of 3 numbers"
+  printf '{"origin":[1,2,3],\n' >"$WORK/in"
+  query "$f" <"$WORK/in"
+  expect_rc 3
+  expect_err_re '<stdin>:1:[0-9]+: invalid JSON'
+}
+
+test_bad_npy_names_expected() {
+  has_numpy || { echo "SKIP: python3 with numpy is not installed"; return 0; }
+  local f="$VECTORS/u8d-zstd-normals-meta.vff"
+  /usr/bin/python3 -c "import numpy as np; np.save('$WORK/f8.npy', np.zeros((4, 6))); np.save('$WORK/n5.npy', np.zeros((4, 5), np.float32)); np.save('$WORK/f.npy', np.zeros((4, 6), np.float32)); np.save('$WORK/fo.npy', np.asfortranarray(np.ones((4, 6), np.float32)))"
+  query "$f" -i "$WORK/f8.npy"
+  expect_rc 3
+  expect_err "vff-query: error: $WORK/f8.npy: expected dtype float32 ('<f4'), found '<f8'"
+  query "$f" -i "$WORK/n5.npy"
+  expect_rc 3
+  expect_err "expected shape (N, 6) or (N, 8), found (4, 5)"
+  query "$f" -i "$WORK/f.npy"
+  expect_rc 3
+  expect_err "row 0, column 3: the direction is zero"
+  query "$f" -i "$WORK/fo.npy"
+  expect_rc 3
+  expect_err "expected a C-order array"
+}
+
+test_errors_and_exit_codes() {
+  query "$WORK/none.vff" --ray 0 0 5 0 0 -1
+  expect_rc 2
+  expect_err "vff-query: error: $WORK/none.vff"
+  printf 'not a field' >"$WORK/bad.vff"
+  query "$WORK/bad.vff" --ray 0 0 5 0 0 -1
+  expect_rc 3
+  expect_err "vff-query: error: $WORK/bad.vff"
+  query "$VECTORS/bit1-stored.vff" --ray 0 0 5 0 0
+  expect_rc 1
+  query "$VECTORS/bit1-stored.vff" --ray 0 0 5 0 0 0
+  expect_rc 1
+  expect_err "--ray number 1: the direction is zero"
+  query "$VECTORS/bit1-stored.vff" --ray 0 0 5 0 0 -1 -i "$WORK/x.csv"
+  expect_rc 1
+  query "$VECTORS/bit1-stored.vff" -i "$WORK/none.csv"
+  expect_rc 2
+  expect_err "$WORK/none.csv"
+  query "$VECTORS/bit1-stored.vff" --ray 0 0 5 0 0 -1 -o "$WORK/no/such/dir/out.csv"
+  expect_rc 2
+}
+
+run_test "$1"

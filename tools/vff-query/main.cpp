@@ -1,0 +1,337 @@
+// vff-query: answers rays with a visibility field, from the shell.
+//
+//   vff-query bunny.vff --ray 0 0 5 0 0 -1                    one ray (repeatable); CSV on stdout
+//   vff-query bunny.vff < rays.csv --format jsonl            CSV or JSON lines on stdin
+//   vff-query bunny.vff -i rays.npy -o hits.npy              (N, 6) or (N, 8) float32 in, (N, 9) out
+//   vff-query bunny.vff -i rays.csv --interpolated --visibility --rotate 0 1 0 0.5 --translate 2 0 0
+//
+// Every answer is the C++ batch query's (FieldQuery or Instance), split over threads in chunks;
+// the answers do not depend on the thread count.
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <new>
+#include <thread>
+#include <utility>
+
+#include "cli.h"
+#include "npy.h"
+#include "rays.h"
+#include "vff/vff.h"
+
+namespace {
+
+using namespace vff;
+using namespace vff::query_tool;
+
+constexpr const char* kProg = "vff-query";
+constexpr size_t kChunk = 16384;  // rays per batch call on one thread
+
+struct Options {
+  std::string field;
+  std::vector<std::vector<float>> rays;
+  std::string input;
+  std::string output = "-";
+  std::string format;
+  bool interpolated = false;
+  bool visibility = false;
+  float tmin = 0.0f;
+  float tmax = std::numeric_limits<float>::infinity();
+  float intraBias = -1.0f;
+  std::vector<float> rotate, translate;
+  float scale = 1.0f;
+  unsigned threads = 0;
+  bool timing = false;
+};
+
+int run(int argc, char** argv);
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::bad_alloc&) {
+    return cli::reportError(kProg, "", makeError(Code::kOutOfMemory, "out of memory"));
+  } catch (const std::exception& e) {
+    return cli::reportError(kProg, "", makeError(Code::kBadState, std::string("internal error: ") + e.what()));
+  }
+}
+
+namespace {
+
+void addOptions(CLI::App& app, Options& o) {
+  cli::addVersionFlag(app, kProg);
+  app.add_option("field", o.field, "the .vff field to query")->required();
+  app.add_option("--ray", o.rays, "a ray: origin x y z, direction x y z (repeatable)")
+      ->expected(6)
+      ->allow_extra_args(false)
+      ->option_text("OX OY OZ DX DY DZ");
+  app.add_option("-i,--input", o.input,
+                 "rays from a file: a .npy float32 array (N, 6) or (N, 8) (ox oy oz dx dy dz [tmin tmax]), or text "
+                 "lines, CSV or JSON (- or nothing: standard input, when no --ray is given)");
+  app.add_option("-o,--output", o.output, "where the answers go (- : standard output; a file is written atomically)")
+      ->capture_default_str();
+  app.add_option("--format", o.format, "answers as csv, jsonl or npy (default: npy for an output named *.npy, else csv)")
+      ->check(CLI::IsMember({"csv", "jsonl", "npy"}));
+  app.add_flag("--interpolated", o.interpolated, "interpolated reconstruction (default: the paper's nearest)");
+  app.add_flag("--visibility", o.visibility, "add a column: the ray's visibility (0..1; 0 or 1 with nearest)");
+  app.add_option("--tmin", o.tmin, "the rays' tmin, unless a ray gives its own")->capture_default_str();
+  app.add_option("--tmax", o.tmax, "the rays' tmax, unless a ray gives its own (default: inf)");
+  app.add_option("--intra-bias", o.intraBias, "bias of rays from inside the sphere, a fraction of R (default: the field's)");
+  app.add_option("--rotate", o.rotate, "place the field: rotation about axis x y z by an angle in radians")
+      ->expected(4)
+      ->option_text("AX AY AZ RADIANS");
+  app.add_option("--translate", o.translate, "place the field: translation x y z (after rotation and scale)")
+      ->expected(3)
+      ->option_text("X Y Z");
+  app.add_option("--scale", o.scale, "place the field: uniform scale (> 0)")->check(CLI::PositiveNumber);
+  app.add_option("-j,--threads", o.threads, "threads (0: all cores); the answers do not depend on it")
+      ->capture_default_str();
+  app.add_flag("--timing", o.timing,
+               "print to stderr the seconds spent reading, querying and writing, and the rays per second of the "
+               "whole and of the batch calls alone on warm memory (run 3 more times; for benchmarks)");
+}
+
+// The bytes of an input: a regular file is mapped read-only (no copy), standard input ("-") and
+// other files are read whole.
+class Input {
+ public:
+  static Result<Input> open(const std::string& path) {
+    Input in;
+    if (path == "-") {
+      auto bytes = cli::readStdin();
+      if (!bytes) return std::move(bytes).error();
+      in.owned_ = std::move(*bytes);
+      return in;
+    }
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return makeError(Code::kIoOpen, "cannot open " + path + ": " + std::strerror(errno));
+    struct stat st {};
+    if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
+      void* p = ::mmap(nullptr, size_t(st.st_size), PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+      if (p != MAP_FAILED) {
+        ::close(fd);
+        in.map_ = static_cast<const uint8_t*>(p);
+        in.mapSize_ = size_t(st.st_size);
+        return in;
+      }
+    }
+    uint8_t buf[1 << 16];
+    ssize_t n;
+    while ((n = ::read(fd, buf, sizeof buf)) > 0) in.owned_.insert(in.owned_.end(), buf, buf + n);
+    const int err = errno;
+    ::close(fd);
+    if (n < 0) return makeError(Code::kIoRead, "cannot read " + path + ": " + std::strerror(err));
+    return in;
+  }
+  Input() = default;
+  Input(Input&& o) noexcept : owned_(std::move(o.owned_)), map_(std::exchange(o.map_, nullptr)), mapSize_(o.mapSize_) {}
+  Input& operator=(Input&&) = delete;
+  ~Input() {
+    if (map_) ::munmap(const_cast<uint8_t*>(map_), mapSize_);
+  }
+  std::span<const uint8_t> bytes() const { return map_ ? std::span(map_, mapSize_) : std::span<const uint8_t>(owned_); }
+
+ private:
+  std::vector<uint8_t> owned_;
+  const uint8_t* map_ = nullptr;
+  size_t mapSize_ = 0;
+};
+
+// The rays of a .npy matrix; a problem is an invalid-input message.
+std::optional<std::string> npyRays(std::span<const uint8_t> bytes, const Options& o, std::vector<Ray>* rays) {
+  NpyMatrix m;
+  if (auto e = readNpyMatrix(bytes, &m)) return *e;
+  if (m.cols != 6 && m.cols != 8)
+    return "expected shape (N, 6) or (N, 8), found (" + std::to_string(m.rows) + ", " + std::to_string(m.cols) + ")";
+  rays->resize(m.rows);
+  const float* v = reinterpret_cast<const float*>(m.data.data());
+  for (uint64_t i = 0; i < m.rows; ++i) {
+    float r[8];
+    std::memcpy(r, v + i * m.cols, m.cols * sizeof(float));
+    Ray& ray = (*rays)[i];
+    ray = Ray{{r[0], r[1], r[2]}, {r[3], r[4], r[5]}, o.tmin, o.tmax};
+    if (m.cols == 8) ray.tmin = r[6], ray.tmax = r[7];
+    if (auto bad = checkRay(ray))
+      return "row " + std::to_string(i) + ", column " + std::to_string(bad->second) + ": " + bad->first;
+  }
+  return std::nullopt;
+}
+
+// Answers the rays in chunks over `threads` threads; each chunk's answers go to store(first, hits,
+// visibility) (visibility empty unless asked for), from the thread that made them.
+template <class Store>
+void answer(const FieldQuery& q, const std::optional<Instance>& inst, std::span<const Ray> rays, const QueryOptions& qo,
+            bool visibility, unsigned threads, Store store) {
+  const size_t chunks = (rays.size() + kChunk - 1) / kChunk;
+  std::atomic<size_t> next{0};
+  auto work = [&] {
+    std::vector<QueryHit> hits(kChunk);
+    std::vector<float> vis(visibility ? kChunk : 0);
+    for (size_t c; (c = next.fetch_add(1)) < chunks;) {
+      const size_t b = c * kChunk, n = std::min(kChunk, rays.size() - b);
+      auto in = rays.subspan(b, n);
+      std::span<QueryHit> out(hits.data(), n);
+      if (inst) inst->intersect(in, out, qo); else q.intersect(in, out, qo);
+      std::span<float> v(vis.data(), visibility ? n : 0);
+      if (visibility) {
+        if (inst) inst->visibility(in, v, qo); else q.visibility(in, v, qo);
+      }
+      store(b, std::span<const QueryHit>(out), std::span<const float>(v));
+    }
+  };
+  const unsigned n = std::max(1u, std::min<unsigned>(threads, unsigned(chunks)));
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < n; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+}
+
+int run(int argc, char** argv) {
+  Options o;
+  CLI::App app{
+      "Answers rays with a visibility field: hit, t, point, normal and whether the origin was inside the\n"
+      "bounding sphere, one line (or .npy row) per ray, in the order given. Rays come from --ray, from\n"
+      "a .npy file, or as text lines (CSV: ox,oy,oz,dx,dy,dz[,tmin,tmax]; JSON: {\"origin\":[..],\n"
+      "\"direction\":[..],\"tmin\":..,\"tmax\":..} or [6 or 8 numbers]) from a file or standard input.\n"
+      "A bad line is reported as FILE:LINE:COLUMN (exit 3) after the rays before it are answered.\n"
+      "Output columns: hit,t,x,y,z,nx,ny,nz,inside[,visibility] (a miss: t inf, point nan; no normal: nan).\n\n"
+      "  vff-query field.vff --ray 0 0 5 0 0 -1\n"
+      "  vff-query field.vff -i rays.npy -o hits.npy --interpolated\n",
+      kProg};
+  app.footer(cli::exitCodeHelp());
+  addOptions(app, o);
+  if (auto rc = cli::parse(app, kProg, argc, argv)) return *rc;
+  if (!o.rays.empty() && !o.input.empty()) {
+    cli::usageError(kProg, "--ray and --input exclude each other");
+    return cli::kExitUsage;
+  }
+  if (o.tmin > o.tmax) {
+    cli::usageError(kProg, "--tmin is greater than --tmax");
+    return cli::kExitUsage;
+  }
+  const bool toNpyName = o.output.size() > 4 && o.output.compare(o.output.size() - 4, 4, ".npy") == 0;
+  const OutputFormat format = o.format == "npy" ? OutputFormat::kNpy
+                              : o.format == "jsonl" ? OutputFormat::kJsonLines
+                              : o.format == "csv"   ? OutputFormat::kCsv
+                              : toNpyName           ? OutputFormat::kNpy
+                                                    : OutputFormat::kCsv;
+
+  // The field first: a field that cannot be read answers nothing.
+  auto file = File::open(o.field);
+  if (!file) return cli::reportError(kProg, o.field, file.error());
+  auto q = FieldQuery::fromFile(*file);
+  if (!q) return cli::reportError(kProg, o.field, q.error());
+  std::optional<Instance> inst;
+  if (!o.rotate.empty() || !o.translate.empty() || o.scale != 1.0f) {
+    const Vec3 axis = o.rotate.empty() ? Vec3{0, 0, 1} : Vec3{o.rotate[0], o.rotate[1], o.rotate[2]};
+    if (axis.x == 0 && axis.y == 0 && axis.z == 0) {
+      cli::usageError(kProg, "--rotate needs a non-zero axis");
+      return cli::kExitUsage;
+    }
+    const Vec3 t = o.translate.empty() ? Vec3{} : Vec3{o.translate[0], o.translate[1], o.translate[2]};
+    inst = Instance{&*q, RigidTransform::fromAxisAngle(axis, o.rotate.empty() ? 0.0f : o.rotate[3], t, o.scale)};
+  }
+
+  // The rays.
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<Ray> rays;
+  std::optional<std::string> badInput;  // the diagnostic of a bad line or array, printed after the answers
+  if (!o.rays.empty()) {
+    for (size_t i = 0; i < o.rays.size(); ++i) {
+      const auto& r = o.rays[i];
+      if (r.size() != 6) {
+        cli::usageError(kProg, "--ray number " + std::to_string(i + 1) + " has " + std::to_string(r.size()) +
+                                   " numbers: it takes 6 (ox oy oz dx dy dz)");
+        return cli::kExitUsage;
+      }
+      Ray ray{{r[0], r[1], r[2]}, {r[3], r[4], r[5]}, o.tmin, o.tmax};
+      if (auto bad = checkRay(ray)) {
+        cli::usageError(kProg, "--ray number " + std::to_string(i + 1) + ": " + bad->first);
+        return cli::kExitUsage;
+      }
+      rays.push_back(ray);
+    }
+  } else {
+    const std::string path = o.input.empty() ? "-" : o.input;
+    const std::string label = path == "-" ? "<stdin>" : path;
+    auto input = Input::open(path);
+    if (!input) return cli::reportError(kProg, label, input.error());
+    const std::span<const uint8_t> bytes = input->bytes();
+    if (bytes.size() >= 6 && std::memcmp(bytes.data(), "\x93NUMPY", 6) == 0) {
+      if (auto e = npyRays(bytes, o, &rays)) {
+        cli::printError(kProg, label + ": " + *e);
+        return cli::kExitInvalidFile;
+      }
+    } else {
+      ParsedRays parsed = parseRayLines({reinterpret_cast<const char*>(bytes.data()), bytes.size()}, o.tmin, o.tmax);
+      rays = std::move(parsed.rays);
+      if (parsed.error)
+        badInput = label + ":" + std::to_string(parsed.error->line) + ":" + std::to_string(parsed.error->column) +
+                   ": " + parsed.error->message;
+    }
+  }
+
+  QueryOptions qo;
+  qo.reconstruction = o.interpolated ? Reconstruction::kInterpolated : Reconstruction::kNearest;
+  qo.intraBias = o.intraBias;
+  const unsigned threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
+  // .npy answers go straight into the output's rows; text ones are formatted after.
+  const auto t1 = std::chrono::steady_clock::now();
+  std::vector<uint8_t> out;
+  std::vector<QueryHit> hits;
+  std::vector<float> vis;
+  if (format == OutputFormat::kNpy) {
+    const size_t cols = kColumnCount + (o.visibility ? 1 : 0);
+    out = npyMatrixHeader(rays.size(), cols);
+    const size_t head = out.size();
+    out.resize(head + rays.size() * cols * sizeof(float));
+    float* rows = reinterpret_cast<float*>(out.data() + head);  // head is a multiple of 64
+    answer(*q, inst, rays, qo, o.visibility, threads,
+           [&](size_t first, std::span<const QueryHit> h, std::span<const float> v) { answerRows(h, v, rows + first * cols); });
+  } else {
+    hits.resize(rays.size());
+    if (o.visibility) vis.resize(rays.size());
+    answer(*q, inst, rays, qo, o.visibility, threads, [&](size_t first, std::span<const QueryHit> h, std::span<const float> v) {
+      std::copy(h.begin(), h.end(), hits.begin() + ptrdiff_t(first));
+      std::copy(v.begin(), v.end(), vis.begin() + ptrdiff_t(first));
+    });
+  }
+  const auto t2 = std::chrono::steady_clock::now();
+  if (format != OutputFormat::kNpy) out = formatAnswers(hits, vis, format);
+  if (auto st = cli::writeFileAtomic(o.output, out); !st) return cli::reportError(kProg, "", st.error());
+  if (o.timing) {
+    const auto t3 = std::chrono::steady_clock::now();
+    auto sec = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
+    const double n = double(rays.size()) / 1e6;
+    // The batch calls alone on warm memory, as a library caller makes them: the baseline the
+    // end-to-end rate compares with (best of 3; the answers are dropped).
+    double batch = 1e30;
+    for (int r = 0; r < 3; ++r) {
+      const auto b0 = std::chrono::steady_clock::now();
+      answer(*q, inst, rays, qo, o.visibility, threads, [](size_t, std::span<const QueryHit>, std::span<const float>) {});
+      batch = std::min(batch, sec(b0, std::chrono::steady_clock::now()));
+    }
+    std::fprintf(stderr,
+                 "vff-query: timing: %zu rays, %u threads, %s: read %.4f s, query %.4f s (%.1f Mrays/s), "
+                 "write %.4f s, total %.4f s (%.1f Mrays/s); batch alone, warm: %.4f s (%.1f Mrays/s)\n",
+                 rays.size(), threads, o.interpolated ? "interpolated" : "nearest", sec(t0, t1), sec(t1, t2),
+                 n / std::max(1e-9, sec(t1, t2)), sec(t2, t3), sec(t0, t3), n / std::max(1e-9, sec(t0, t3)), batch, n / std::max(1e-9, batch));
+  }
+  if (badInput) {
+    cli::printError(kProg, *badInput);
+    return cli::kExitInvalidFile;
+  }
+  return cli::kExitSuccess;
+}
+
+}  // namespace

@@ -1,0 +1,244 @@
+// rays.cpp - parsing the text lines of rays and formatting the answers (rays.h).
+#include "rays.h"
+
+#include <nlohmann/json.hpp>
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+
+#include "npy.h"
+
+namespace vff::query_tool {
+
+namespace {
+
+bool isBlank(char c) { return c == ' ' || c == '\t'; }
+
+// The 6 or 8 numbers of a ray into `ray`.
+void assign(Ray* ray, const float* v, size_t n) {
+  ray->origin = {v[0], v[1], v[2]};
+  ray->direction = {v[3], v[4], v[5]};
+  if (n == 8) {
+    ray->tmin = v[6];
+    ray->tmax = v[7];
+  }
+}
+
+// A CSV line. columns[i]: the 1-based column where number i starts.
+std::optional<LineError> parseCsv(std::string_view line, Ray* ray) {
+  float v[8];
+  uint64_t columns[9] = {};
+  size_t n = 0, i = 0;
+  while (true) {
+    while (i < line.size() && isBlank(line[i])) ++i;
+    if (i == line.size()) break;
+    if (n == 8) return LineError{0, i + 1, "too many numbers: a ray has 6 (ox,oy,oz,dx,dy,dz) or 8 (and tmin,tmax)"};
+    const char* first = line.data() + i;
+    const char* last = line.data() + line.size();
+    if (*first == '+') ++first;  // from_chars takes no '+'
+    auto [ptr, ec] = std::from_chars(first, last, v[n]);
+    size_t end = size_t(ptr - line.data());
+    if (ec == std::errc::result_out_of_range) return LineError{0, i + 1, "number out of float range"};
+    if (ec != std::errc() || (end < line.size() && !isBlank(line[end]) && line[end] != ',')) {
+      size_t e = i;
+      while (e < line.size() && !isBlank(line[e]) && line[e] != ',') ++e;
+      return LineError{0, i + 1, "expected a number, found \"" + std::string(line.substr(i, e - i)) + "\""};
+    }
+    columns[n++] = i + 1;
+    i = end;
+    while (i < line.size() && isBlank(line[i])) ++i;
+    if (i < line.size() && line[i] == ',') {
+      ++i;
+      while (i < line.size() && isBlank(line[i])) ++i;
+      if (i == line.size()) return LineError{0, i + 1, "expected a number after ','"};
+    }
+  }
+  if (n != 6 && n != 8)
+    return LineError{0, line.size() + 1,
+                     "found " + std::to_string(n) + " numbers: a ray has 6 (ox,oy,oz,dx,dy,dz) or 8 (and tmin,tmax)"};
+  assign(ray, v, n);
+  if (auto bad = checkRay(*ray)) return LineError{0, columns[bad->second], bad->first};
+  return std::nullopt;
+}
+
+// A JSON line: an object with origin/direction (and tmin/tmax), or an array of 6 or 8 numbers.
+std::optional<LineError> parseJson(std::string_view line, Ray* ray) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(line);
+  } catch (const nlohmann::json::parse_error& e) {
+    std::string what = e.what();
+    const size_t colon = what.find("syntax error");
+    return LineError{0, e.byte ? e.byte : 1, "invalid JSON: " + (colon == std::string::npos ? what : what.substr(colon))};
+  }
+  auto numbers = [](const nlohmann::json& a, size_t count, const char* name, float* v) -> std::optional<std::string> {
+    if (!a.is_array() || a.size() != count) return std::string(name) + " must be an array of " + std::to_string(count) + " numbers";
+    for (size_t k = 0; k < count; ++k) {
+      if (!a[k].is_number()) return std::string(name) + "[" + std::to_string(k) + "] is not a number";
+      v[k] = a[k].get<float>();
+    }
+    return std::nullopt;
+  };
+  float v[8];
+  if (j.is_array()) {
+    const size_t n = j.size();
+    if (n != 6 && n != 8) return LineError{0, 1, "a ray array holds 6 or 8 numbers, found " + std::to_string(n)};
+    if (auto e = numbers(j, n, "the ray", v)) return LineError{0, 1, *e};
+    assign(ray, v, n);
+  } else if (j.is_object()) {
+    if (!j.contains("origin") || !j.contains("direction"))
+      return LineError{0, 1, "a ray object needs \"origin\" and \"direction\""};
+    if (auto e = numbers(j["origin"], 3, "origin", v)) return LineError{0, 1, *e};
+    if (auto e = numbers(j["direction"], 3, "direction", v + 3)) return LineError{0, 1, *e};
+    assign(ray, v, 6);
+    for (const char* key : {"tmin", "tmax"}) {
+      if (!j.contains(key)) continue;
+      if (!j[key].is_number()) return LineError{0, 1, std::string(key) + " is not a number"};
+      (key[1] == 'm' && key[2] == 'i' ? ray->tmin : ray->tmax) = j[key].get<float>();
+    }
+  } else {
+    return LineError{0, 1, "expected a JSON object or array"};
+  }
+  if (auto bad = checkRay(*ray)) return LineError{0, 1, bad->first};
+  return std::nullopt;
+}
+
+bool isColumnNames(std::string_view line) {
+  std::string compact;
+  for (char c : line)
+    if (!isBlank(c)) compact.push_back(c);
+  return compact == "ox,oy,oz,dx,dy,dz" || compact == "ox,oy,oz,dx,dy,dz,tmin,tmax";
+}
+
+void appendNumber(std::string& out, float v) {
+  char buf[32];
+  const int n = std::snprintf(buf, sizeof buf, "%.9g", double(v));
+  out.append(buf, size_t(n));
+}
+
+}  // namespace
+
+std::optional<std::pair<std::string, int>> checkRay(const Ray& ray) {
+  const float v[6] = {ray.origin.x, ray.origin.y, ray.origin.z, ray.direction.x, ray.direction.y, ray.direction.z};
+  for (int k = 0; k < 6; ++k)
+    if (!std::isfinite(v[k])) return std::pair{std::string(k < 3 ? "the origin" : "the direction") + " is not finite", k};
+  if (v[3] == 0 && v[4] == 0 && v[5] == 0) return std::pair{std::string("the direction is zero"), 3};
+  if (std::isnan(ray.tmin) || std::isnan(ray.tmax)) return std::pair{std::string("tmin or tmax is NaN"), 6};
+  if (ray.tmin > ray.tmax) return std::pair{std::string("tmin is greater than tmax"), 6};
+  return std::nullopt;
+}
+
+ParsedRays parseRayLines(std::string_view text, float tmin, float tmax) {
+  ParsedRays out;
+  uint64_t lineNo = 0;
+  bool firstContent = true;
+  size_t pos = 0;
+  while (pos < text.size()) {
+    size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view line = text.substr(pos, end - pos);
+    pos = end + 1;
+    ++lineNo;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    size_t s = 0;
+    while (s < line.size() && isBlank(line[s])) ++s;
+    if (s == line.size() || line[s] == '#') continue;
+    if (firstContent && isColumnNames(line)) {
+      firstContent = false;
+      continue;
+    }
+    firstContent = false;
+    Ray ray{{}, {}, tmin, tmax};
+    std::optional<LineError> e = (line[s] == '{' || line[s] == '[') ? parseJson(line, &ray) : parseCsv(line, &ray);
+    if (e) {
+      e->line = lineNo;
+      out.error = std::move(e);
+      return out;
+    }
+    out.rays.push_back(ray);
+  }
+  return out;
+}
+
+void answerRows(std::span<const QueryHit> hits, std::span<const float> visibility, float* rows) {
+  const bool vis = !visibility.empty();
+  const size_t cols = kColumnCount + (vis ? 1 : 0);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (size_t i = 0; i < hits.size(); ++i) {
+    const QueryHit& h = hits[i];
+    float* r = rows + i * cols;
+    r[0] = h.hit ? 1.0f : 0.0f;
+    r[1] = h.t;
+    r[2] = h.hit ? h.point.x : nan;
+    r[3] = h.hit ? h.point.y : nan;
+    r[4] = h.hit ? h.point.z : nan;
+    r[5] = h.hasNormal ? h.normal.x : nan;
+    r[6] = h.hasNormal ? h.normal.y : nan;
+    r[7] = h.hasNormal ? h.normal.z : nan;
+    r[8] = h.inside ? 1.0f : 0.0f;
+    if (vis) r[9] = visibility[i];
+  }
+}
+
+std::vector<uint8_t> formatAnswers(std::span<const QueryHit> hits, std::span<const float> visibility,
+                                   OutputFormat format) {
+  const bool vis = !visibility.empty();
+  if (format == OutputFormat::kNpy) {
+    const uint64_t cols = kColumnCount + (vis ? 1 : 0);
+    std::vector<float> m(hits.size() * cols);
+    answerRows(hits, visibility, m.data());
+    return npyMatrixBytes(m, hits.size(), cols);
+  }
+  std::string out;
+  out.reserve(hits.size() * 64 + 64);
+  if (format == OutputFormat::kCsv) {
+    out = "hit,t,x,y,z,nx,ny,nz,inside";
+    out += vis ? ",visibility\n" : "\n";
+  }
+  for (size_t i = 0; i < hits.size(); ++i) {
+    const QueryHit& h = hits[i];
+    if (format == OutputFormat::kCsv) {
+      out += h.hit ? "1," : "0,";
+      if (h.hit) {
+        appendNumber(out, h.t);
+        for (float v : {h.point.x, h.point.y, h.point.z}) out += ',', appendNumber(out, v);
+      } else {
+        out += "inf,nan,nan,nan";
+      }
+      if (h.hasNormal)
+        for (float v : {h.normal.x, h.normal.y, h.normal.z}) out += ',', appendNumber(out, v);
+      else
+        out += ",nan,nan,nan";
+      out += h.inside ? ",1" : ",0";
+    } else {
+      out += h.hit ? "{\"hit\":true,\"t\":" : "{\"hit\":false,\"t\":null";
+      if (h.hit) {
+        appendNumber(out, h.t);
+        out += ",\"point\":[";
+        appendNumber(out, h.point.x), out += ',', appendNumber(out, h.point.y), out += ',', appendNumber(out, h.point.z);
+        out += ']';
+      } else {
+        out += ",\"point\":null";
+      }
+      if (h.hasNormal) {
+        out += ",\"normal\":[";
+        appendNumber(out, h.normal.x), out += ',', appendNumber(out, h.normal.y), out += ',', appendNumber(out, h.normal.z);
+        out += ']';
+      } else {
+        out += ",\"normal\":null";
+      }
+      out += h.inside ? ",\"inside\":true" : ",\"inside\":false";
+    }
+    if (vis) {
+      out += format == OutputFormat::kCsv ? "," : ",\"visibility\":";
+      appendNumber(out, visibility[i]);
+    }
+    out += format == OutputFormat::kCsv ? "\n" : "}\n";
+  }
+  return {out.begin(), out.end()};
+}
+
+}  // namespace vff::query_tool
