@@ -1,6 +1,6 @@
-// progress.h - the progress line the tools print on stderr while they work: "tool: DONE/TOTAL maps,
-// RATE Mrays/s, ETA SECONDS s", redrawn at most 10 times a second, only when enabled (on a terminal,
-// not with --quiet or --json). Safe to update from several threads.
+// progress.h - the progress line the tools print on stderr while they work: the maps done of the
+// total, the ray rate for bakes and the time left, redrawn at most 10 times a second, only when
+// enabled (on a terminal, not with --quiet or --json). Safe to update from several threads.
 #pragma once
 
 #include <chrono>
