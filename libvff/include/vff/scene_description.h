@@ -4,8 +4,9 @@
 // A scene description is a JSON file that lists fields (`.vff` files, by a reference relative to the
 // description) and instances (a field placed by a uniform scale, a rotation and a translation, glTF's
 // T * R * S). `vff-bake --split` writes one for the meshes or nodes of a glTF scene. Reading it
-// checks every rule of spec/scene.md; the fields themselves are opened by the caller (File::open on
-// resolveSceneUri()), so that a tool decides how to load, decode and share them.
+// checks every rule of spec/scene.md. loadScene() then opens every field and places the instances
+// in a vff::Scene; a tool that loads, decodes or shares fields its own way opens them itself
+// (File::open on resolveSceneUri()):
 //
 //   auto scene = vff::readSceneDescription("courtyard.vffscene.json");
 //   if (!scene) { fprintf(stderr, "%s\n", scene.error().toString().c_str()); return; }
@@ -17,12 +18,15 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "vff/error.h"
 #include "vff/query.h"
+#include "vff/reader.h"
+#include "vff/scene.h"
 
 namespace vff {
 
@@ -75,6 +79,22 @@ Status writeSceneDescription(const std::string& path, const SceneDescription& sc
 // The path of a field's `uri` for a description read from `descriptionPath`: absolute URIs as they
 // are, relative ones joined to the description's folder.
 std::string resolveSceneUri(const std::string& descriptionPath, const std::string& uri);
+
+// A scene description with its fields open and its instances placed in a committed vff::Scene:
+// instance i of the scene is description.instances[i]. It owns everything the scene borrows; it
+// does not move (held by unique_ptr), so the scene's pointers to its fields stay valid.
+struct LoadedScene {
+  SceneDescription description;
+  std::vector<std::unique_ptr<File>> files;         // one per description field, kept open
+  std::vector<std::unique_ptr<FieldQuery>> fields;  // their queries (every block decoded once)
+  Scene scene;                                      // committed
+};
+
+// Reads the description at `path`, opens every field it lists (resolveSceneUri) with `options`,
+// and places the instances. Errors: those of readSceneDescription; those of File::open and
+// FieldQuery::fromFile, the message naming the field's uri and the description; those of
+// Scene::add for an instance (a transform checkTransform refuses), naming the instance.
+Result<std::unique_ptr<LoadedScene>> loadScene(const std::string& path, const ReadOptions& options = {});
 
 // The rotation part of a transform as a unit quaternion x, y, z, w (w >= 0); `rotation` must be a
 // rotation matrix (orthonormal, determinant +1).
