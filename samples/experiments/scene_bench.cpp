@@ -25,6 +25,7 @@
 
 #include "cli.h"
 #include "common.h"
+#include "embree_instances.h"
 #include "vff/embree.h"
 #include "vff/scene.h"
 
@@ -52,27 +53,6 @@ struct Side {
   double commit = 0, rays = 0;  // seconds, summed over frames
 };
 
-void setEmbreeTransform(RTCGeometry g, const vff::RigidTransform& x) {
-  // Embree's RTC_FORMAT_FLOAT3X4_ROW_MAJOR: the 3 x 4 matrix [R | t] row by row.
-  float m[12];
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) m[4 * r + c] = x.rotation[r][c] * x.scale;
-  }
-  m[3] = x.translation.x, m[7] = x.translation.y, m[11] = x.translation.z;
-  rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, m);
-  rtcCommitGeometry(g);
-}
-
-bool occluded1(RTCScene scene, const vff::Ray& r) {
-  RTCRay ray{};
-  ray.org_x = r.origin.x, ray.org_y = r.origin.y, ray.org_z = r.origin.z;
-  ray.dir_x = r.direction.x, ray.dir_y = r.direction.y, ray.dir_z = r.direction.z;
-  ray.tnear = r.tmin, ray.tfar = r.tmax, ray.mask = ~0u;
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  rtcOccluded1(scene, &ctx, &ray);
-  return ray.tfar < 0;
-}
 
 }  // namespace
 

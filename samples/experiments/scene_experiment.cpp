@@ -24,6 +24,7 @@
 
 #include "cli.h"
 #include "common.h"
+#include "embree_instances.h"
 #include "vff/bake/procedural.h"
 #include "vff/bake/sphere.h"
 #include "vff/scene.h"
@@ -83,26 +84,6 @@ vff::RigidTransform placement(const Object& ob, uint32_t k, uint32_t count, int 
   const Vec3 centre{2.3f * std::cos(phase), floats ? 1.6f + 0.3f * std::sin(float(frame)) : 1.0f, 2.3f * std::sin(phase)};
   x.translation = centre - x.toWorldVector(toVec(ob.sphere.center));
   return x;
-}
-
-void setInstance(RTCGeometry g, const vff::RigidTransform& x) {
-  float m[12];
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) m[4 * r + c] = x.rotation[r][c] * x.scale;
-  m[3] = x.translation.x, m[7] = x.translation.y, m[11] = x.translation.z;
-  rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, m);
-  rtcCommitGeometry(g);
-}
-
-bool occluded1(RTCScene scene, const vff::Ray& r) {
-  RTCRay ray{};
-  ray.org_x = r.origin.x, ray.org_y = r.origin.y, ray.org_z = r.origin.z;
-  ray.dir_x = r.direction.x, ray.dir_y = r.direction.y, ray.dir_z = r.direction.z;
-  ray.tnear = r.tmin, ray.tfar = r.tmax, ray.mask = ~0u;
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  rtcOccluded1(scene, &ctx, &ray);
-  return ray.tfar < 0;
 }
 
 double seconds() {
@@ -202,7 +183,7 @@ int runScene(const Options& o) {
     std::vector<vff::RigidTransform> xs(count);
     for (uint32_t k = 0; k < count; ++k) {
       xs[k] = placement(*objects[k], k, count, frame);
-      setInstance(inst[k], xs[k]);
+      setEmbreeTransform(inst[k], xs[k]);
     }
     rtcCommitScene(exact);
     const double exactRebuild = seconds() - t0;
