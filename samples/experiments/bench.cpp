@@ -100,14 +100,9 @@ std::string cpuName() {
   return family.empty() ? name : name + " (family " + family + ", model " + model + ")";
 }
 
-
 int runBench(const Options& o) {
   FieldConfig config;
-  const std::string configName = o.configs.empty() ? "4226x64x64" : o.configs.front();
-  if (!parseFieldConfig(configName, &config)) {
-    vff::cli::usageError(kProg, "--config " + configName + ": expected MAPSxMxM with an octa-hemi2 map count");
-    return vff::cli::kExitUsage;
-  }
+  if (auto rc = singleConfig(o, "4226x64x64", &config)) return *rc;
   const unsigned threads = resolveThreads(o.threads);
   auto setup = makeSetup(o, threads);
   if (!setup) return vff::cli::reportError(kProg, o.mesh, setup.error());

@@ -174,6 +174,10 @@ vff::Result<std::unique_ptr<BakedQuery>> bakeQuery(const World& world, const vff
 vff::Result<std::unique_ptr<BakedQuery>> loadQuery(const World& world, const std::string& path, bool normals);
 // Parses "4226x64x64" (or "n32m64"): maps must be an octa-hemi2 count.
 bool parseFieldConfig(const std::string& text, FieldConfig* out);
+struct Options;
+// The one field configuration of a benchmark or the scene experiment: the first --config, else
+// `fallback`; a usage error (printed, its exit code returned) when it does not parse.
+std::optional<int> singleConfig(const Options& o, const std::string& fallback, FieldConfig* out);
 
 // ---- Primary visibility (G-buffer) --------------------------------------------------------------
 enum class PixelKind : uint8_t { kBackground, kPlane, kObject };

@@ -31,6 +31,13 @@ bool parseFieldConfig(const std::string& text, FieldConfig* out) {
   return false;
 }
 
+std::optional<int> singleConfig(const Options& o, const std::string& fallback, FieldConfig* out) {
+  const std::string text = o.configs.empty() ? fallback : o.configs.front();
+  if (parseFieldConfig(text, out)) return std::nullopt;
+  vff::cli::usageError(kProg, "--config " + text + ": expected MAPSxMxM with an octa-hemi2 map count");
+  return vff::cli::kExitUsage;
+}
+
 vff::Result<std::unique_ptr<BakedQuery>> bakeQuery(const World& world, const vff::bake::Scene& scene,
                                                    const FieldConfig& config, bool normals, unsigned threads) {
   vff::bake::BakeOptions bo;

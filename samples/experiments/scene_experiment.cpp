@@ -95,11 +95,7 @@ double seconds() {
 int runScene(const Options& o) {
   const unsigned threads = resolveThreads(o.threads);
   FieldConfig config;
-  const std::string configName = o.configs.empty() ? "4226x32x32" : o.configs.front();
-  if (!parseFieldConfig(configName, &config)) {
-    vff::cli::usageError(kProg, "--config " + configName + ": expected MAPSxMxM with an octa-hemi2 map count");
-    return vff::cli::kExitUsage;
-  }
+  if (auto rc = singleConfig(o, "4226x32x32", &config)) return *rc;
   std::vector<std::unique_ptr<Object>> objects;
   auto addObject = [&](const std::string& name, vff::bake::Mesh mesh) -> int {
     auto ob = std::make_unique<Object>();

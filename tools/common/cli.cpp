@@ -1,6 +1,9 @@
 // cli.cpp - the shared command-line helpers (see cli.h).
 #include "cli.h"
 
+#include <new>
+#include <stdexcept>
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -64,6 +67,16 @@ int reportError(std::string_view prog, std::string_view file, const Error& error
   (void)std::fprintf(stderr, "%s\n", formatDiagnostic(prog, "error", file, error).c_str());
   const int rc = exitCodeFor(error.code);
   return rc == kExitSuccess ? kExitRuntime : rc;  // an Error with kOk is still a failure
+}
+
+int runGuarded(std::string_view prog, int (*body)(int, char**), int argc, char** argv) {
+  try {
+    return body(argc, argv);
+  } catch (const std::bad_alloc&) {
+    return reportError(prog, "", makeError(Code::kOutOfMemory, "out of memory"));
+  } catch (const std::exception& e) {
+    return reportError(prog, "", makeError(Code::kBadState, std::string("internal error: ") + e.what()));
+  }
 }
 
 void reportWarning(std::string_view prog, std::string_view file, const Error& error) {

@@ -60,6 +60,10 @@ std::string formatDiagnostic(std::string_view prog, std::string_view severity, s
 // Prints formatDiagnostic(prog, "error", file, error) to stderr and returns exitCodeFor(error.code).
 int reportError(std::string_view prog, std::string_view file, const Error& error);
 
+// Runs a tool's body; everything it throws (an allocation, the JSON library) ends as a runtime error
+// naming `prog` (out-of-memory, or an internal error with the exception's text), not an abort.
+int runGuarded(std::string_view prog, int (*body)(int, char**), int argc, char** argv);
+
 // Prints "PROG: warning: ..." for an Error that does not stop the command.
 void reportWarning(std::string_view prog, std::string_view file, const Error& error);
 

@@ -51,16 +51,7 @@ int run(int argc, char** argv);
 
 }  // namespace
 
-// Everything that throws (an allocation, the JSON library) ends as a runtime error, not an abort.
-int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::bad_alloc&) {
-    return cli::reportError(kProg, "", makeError(Code::kOutOfMemory, "out of memory"));
-  } catch (const std::exception& e) {
-    return cli::reportError(kProg, "", makeError(Code::kBadState, std::string("internal error: ") + e.what()));
-  }
-}
+int main(int argc, char** argv) { return cli::runGuarded(kProg, run, argc, argv); }
 
 namespace {
 
