@@ -22,6 +22,7 @@
 #include <cmath>
 #include <cstdint>
 #include <random>
+#include <span>
 #include <thread>
 #include <vector>
 
@@ -88,10 +89,10 @@ inline Ray aoRay(const AoScene& s, uint32_t p, int i) {
   return Ray{o, d, 0.0f, s.tmax};
 }
 
-// The CPU image: AO per pixel with FieldQuery's batch calls (one per pixel), on `threads` threads
-// (rows interleaved).
-inline std::vector<float> cpuAo(const FieldQuery& q, const AoScene& s, int rays, Reconstruction r,
-                                unsigned threads = 1) {
+// The CPU image: AO per pixel with the batch visibility call of `q` (a FieldQuery, or a
+// vff::Scene: one call per pixel), on `threads` threads (rows interleaved).
+template <class Query>
+std::vector<float> cpuAo(const Query& q, const AoScene& s, int rays, Reconstruction r, unsigned threads = 1) {
   std::vector<float> out(size_t(s.size) * s.size);
   const QueryOptions qo{.reconstruction = r, .intraBias = 0.0f};
   auto work = [&](unsigned t0) {
@@ -101,7 +102,7 @@ inline std::vector<float> cpuAo(const FieldQuery& q, const AoScene& s, int rays,
       for (int x = 0; x < s.size; ++x) {
         const uint32_t p = uint32_t(y * s.size + x);
         for (int i = 0; i < rays; ++i) batch[size_t(i)] = aoRay(s, p, i);
-        q.visibility(batch, vis, qo);
+        (void)q.visibility(std::span<const Ray>(batch), std::span<float>(vis), qo);
         float open = 0;
         for (float v : vis) open += v;
         out[p] = open / float(rays);
@@ -117,7 +118,13 @@ inline std::vector<float> cpuAo(const FieldQuery& q, const AoScene& s, int rays,
 
 // The compute shader after `#version 430` and vff_query.glsl: one invocation per pixel, 8 x 8
 // groups. Uniforms: location 0 size, 1 rays, 2 interpolated (0/1), 3 eps, 4 tmax, 5 first row.
+// AO_VISIBILITY and AO_OCCLUDED are the queries it makes; a scene (vff_scene.glsl) defines them
+// as vffSceneVisibility and vffSceneOccluded before this text.
 inline constexpr const char* kAoShader = R"(
+#ifndef AO_VISIBILITY
+#define AO_VISIBILITY(o, d) vffVisibility(o, d, 0.0, aoTmax, 0.0)
+#define AO_OCCLUDED(o, d) vffOccluded(o, d, 0.0, aoTmax, 0.0)
+#endif
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std430, binding = 5) readonly buffer AoGBuffer { vec4 aoGBuffer[]; };
 layout(std430, binding = 6) readonly buffer AoDirections { vec4 aoDirections[]; };
@@ -147,8 +154,8 @@ void main() {
     vec3 l = aoDirections[(base + uint(i)) % 8192u].xyz;
     precise vec3 d = vec3(F[0].x * l.x + F[1].x * l.y + F[2].x * l.z, F[0].y * l.x + F[1].y * l.y + F[2].y * l.z,
                           F[0].z * l.x + F[1].z * l.y + F[2].z * l.z);
-    if (aoInterpolated != 0) open += vffVisibility(o, d, 0.0, aoTmax, 0.0);
-    else open += vffOccluded(o, d, 0.0, aoTmax, 0.0) ? 0.0 : 1.0;
+    if (aoInterpolated != 0) open += AO_VISIBILITY(o, d);
+    else open += AO_OCCLUDED(o, d) ? 0.0 : 1.0;
   }
   aoImage[p] = open / float(aoRays);
 }

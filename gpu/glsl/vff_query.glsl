@@ -34,6 +34,13 @@
 //   float vffVisibility(...)  kInterpolated FieldQuery::visibility: the unoccluded share in [0, 1].
 //   VffHit vffQuery(..., bool interpolated, out float visibility)  the core of all four.
 // A hit carries the object-space normal (hasNormal) when the field has a normal plane.
+//
+// Several fields at once (a scene: gpu/glsl/vff_scene.glsl). Every lookup step reads its field
+// through VFF_FIELD (default: the uniform block vffField, declared only when VFF_FIELD is not
+// defined) and finds the field's data at VFF_POSITIONS_BASE (vec4 index in vffPositions),
+// VFF_MAPS_LAYER and VFF_NORMALS_LAYER (first slice in vffMaps, vffNormals); all default to the
+// single field's 0. vff_scene.glsl defines the four to read the field of the instance being
+// queried from its field table, so the scene and the single field share every function below.
 // Building blocks (names as in spec/geometry.md 5.4 and spec/positions.md 6): vffFrame, vffToLocal,
 // vffHemisphereToSquare, vffSquareToHemisphere, vffSquareToTexel, vffTexelCenter, vffNearestSample,
 // vffFetchCode, vffDecode.
@@ -63,6 +70,7 @@
 // Field and layout: the FDSC and LAYT fields (spec/format.md sections 5 and 6) plus the values the
 // loader derives exactly as the CPU does. Must match vff::gl::FieldBlock (112 bytes; member order,
 // types and std140 offsets are checked by tests/gpu/test_glsl_layout.cpp).
+#ifndef VFF_FIELD
 layout(std140, binding = VFF_FIELD_BINDING) uniform VffFieldBlock {
   vec3 sphereCenter;        // sphere.center
   float sphereRadius;       // sphere.radius
@@ -91,6 +99,20 @@ layout(std140, binding = VFF_FIELD_BINDING) uniform VffFieldBlock {
   uint reserved0;
   uint reserved1;
 } vffField;
+#define VFF_FIELD vffField
+#endif
+// Where the field's data lie in the resources below: the vec4 index of its sample positions in
+// vffPositions, and its first slice in vffMaps and in vffNormals. 0 for a single field; a scene
+// (vff_scene.glsl) defines them, with VFF_FIELD, to select the field of the instance it queries.
+#ifndef VFF_POSITIONS_BASE
+#define VFF_POSITIONS_BASE 0u
+#endif
+#ifndef VFF_MAPS_LAYER
+#define VFF_MAPS_LAYER 0u
+#endif
+#ifndef VFF_NORMALS_LAYER
+#define VFF_NORMALS_LAYER 0u
+#endif
 
 #if defined(VFF_MAPS_BC4)
 // bc4-diameter: the texture unit decodes the BC4 blocks (spec/format.md 7.4); 2D arrays only.
@@ -114,7 +136,7 @@ layout(binding = VFF_NORMALS_BINDING) uniform highp isampler2DArray vffNormals;
 // For unorm8-chord it continues with the decode scale of every texel of a map, 2R cos(alpha) / 254
 // with cos(alpha) of the texel centre, computed by the CPU exactly as the CPU query does: texel
 // t = j M + i is component t % 4 of vffPositions[mapCount + t / 4]. From vec4 index
-// vffField.neighbourOffset: the neighbour lists of kInterpolated, VFF_NEIGHBOURS sample indices per
+// VFF_FIELD.neighbourOffset: the neighbour lists of kInterpolated, VFF_NEIGHBOURS sample indices per
 // map (VFF_NEIGHBOURS / 4 vec4, as floats; -1 pads), the lists the CPU query builds.
 layout(std430, binding = VFF_POSITIONS_BINDING) readonly buffer VffPositionsBlock {
   vec4 vffPositions[];
@@ -244,7 +266,7 @@ vec2 vffTexelCenter(ivec2 ij, int M) {
 }
 
 // ---- Nearest positional sample (spec/positions.md section 6, positions read from the buffer) -------
-vec3 vffPosition(int k) { return vffPositions[k].xyz; }
+vec3 vffPosition(int k) { return vffPositions[VFF_POSITIONS_BASE + uint(k)].xyz; }
 
 int vffOctaHemi2Index(int n, int h, int p, int q) {
   int t = n + q;
@@ -333,33 +355,33 @@ int vffNearestFibonacci(vec3 d, int n) {
 // The sample nearest to direction d (need not be unit length).
 int vffNearestSample(vec3 d) {
   vec3 u = normalize(d);
-  int n = int(vffField.positionParam);
-  if (vffField.positionScheme == VFF_POSITION_OCTA_HEMI2) return vffNearestOctaHemi2(u, n);
-  if (vffField.positionScheme == VFF_POSITION_EA_OCTA_GRID) return vffNearestEaOctaGrid(u, n);
+  int n = int(VFF_FIELD.positionParam);
+  if (VFF_FIELD.positionScheme == VFF_POSITION_OCTA_HEMI2) return vffNearestOctaHemi2(u, n);
+  if (VFF_FIELD.positionScheme == VFF_POSITION_EA_OCTA_GRID) return vffNearestEaOctaGrid(u, n);
   return vffNearestFibonacci(u, n);
 }
 
 // ---- Fetch and decode (spec/format.md "Packed slice layout", "Value encodings") ----------------------
 // Where texel (i, j) of map k lies in the packed slices (placeMap): x, y, slice.
 uvec3 vffPlace(uint k, uvec2 ij) {
-  uint perSlice = vffField.tilesPerRow * vffField.tilesPerColumn;
+  uint perSlice = VFF_FIELD.tilesPerRow * VFF_FIELD.tilesPerColumn;
   uint slice = k / perSlice;
   uint r = k - slice * perSlice;
-  uint x = (r % vffField.tilesPerRow) * vffField.tileSize + vffField.gutter + ij.x;
-  uint y = (r / vffField.tilesPerRow) * vffField.tileSize + vffField.gutter + ij.y;
+  uint x = (r % VFF_FIELD.tilesPerRow) * VFF_FIELD.tileSize + VFF_FIELD.gutter + ij.x;
+  uint y = (r / VFF_FIELD.tilesPerRow) * VFF_FIELD.tileSize + VFF_FIELD.gutter + ij.y;
   return uvec3(x, y, slice);
 }
 
 // The stored code of texel (i, j) of map k: placeMap, then texelFetch in the packed slices.
 uint vffFetchCode(uint k, uvec2 ij) {
-  uvec3 p = vffPlace(k, ij);
+  uvec3 p = vffPlace(k, ij) + uvec3(0u, 0u, VFF_MAPS_LAYER);
 #ifdef VFF_MAPS_BC4
   // The palette entry as a normalised value: its code is round(value * 255). Texture units may round
   // the interpolated entries differently from the CPU's integer rule (by under one code); 0 and 255
   // (a miss) are exact.
   return uint(round(texelFetch(vffMaps, ivec3(p), 0).r * 255.0));
 #else
-  if (vffField.distanceEncoding == VFF_ENCODING_BIT1)
+  if (VFF_FIELD.distanceEncoding == VFF_ENCODING_BIT1)
     return (texelFetch(vffMaps, ivec3(int(p.x >> 3u), int(p.y), int(p.z)), 0).r >> (p.x & 7u)) & 1u;
   return texelFetch(vffMaps, ivec3(p), 0).r;
 #endif
@@ -388,7 +410,7 @@ vec3 vffFetchNormal(uint k, uvec2 ij) {
 #ifdef VFF_NO_NORMALS
   return vec3(0.0);
 #else
-  return vffDecodeNormal(texelFetch(vffNormals, ivec3(vffPlace(k, ij)), 0).rg);
+  return vffDecodeNormal(texelFetch(vffNormals, ivec3(vffPlace(k, ij) + uvec3(0u, 0u, VFF_NORMALS_LAYER)), 0).rg);
 #endif
 }
 
@@ -400,23 +422,23 @@ struct VffTexel {
 
 VffTexel vffDecode(uint code, uvec2 ij) {
   VffTexel o;
-  uint e = vffField.distanceEncoding;
+  uint e = VFF_FIELD.distanceEncoding;
   if (e == VFF_ENCODING_BIT1) {
     o.hit = code != 0u;
     o.distance = 0.0;
     return o;
   }
-  o.hit = code != vffField.missCode;
+  o.hit = code != VFF_FIELD.missCode;
   if (e == VFF_ENCODING_UNORM8_CHORD) {
     // The texel's scale 2R cos(alpha) / 254 from the table after the positions (see the buffer).
     // Computing it here with vffSquareToCosAlpha is within an ulp, but not bit-exact on drivers
     // that fuse a * b + c despite `precise` (llvmpipe does).
-    uint t = ij.y * vffField.mapResolution + ij.x;
-    float scale = vffPositions[vffField.mapCount + t / 4u][t % 4u];
+    uint t = ij.y * VFF_FIELD.mapResolution + ij.x;
+    float scale = vffPositions[VFF_POSITIONS_BASE + VFF_FIELD.mapCount + t / 4u][t % 4u];
     precise float d = float(code) * scale;
     o.distance = d;
   } else {
-    precise float d = float(code) * vffField.distanceScale;
+    precise float d = float(code) * VFF_FIELD.distanceScale;
     o.distance = d;
   }
   return o;
@@ -442,7 +464,7 @@ struct VffHit {
 // The kInterpolated kernel weight of sample k for the unit entry point eu (as the CPU).
 float vffKernel(vec3 eu, uint k) {
   precise vec3 d = eu - vffPosition(int(k));
-  precise float x = 1.0 - vffDivide(vffDot(d, d), vffField.kernelRadius2);
+  precise float x = 1.0 - vffDivide(vffDot(d, d), VFF_FIELD.kernelRadius2);
   precise float w = x * x;
   return x > 0.0 ? w : 0.0;
 }
@@ -471,8 +493,8 @@ VffHit vffQuery(vec3 origin, vec3 direction, float tmin, float tmax, float intra
   precise float lo = tmin * len;
   precise float hi = tmax * len;
   // 1. The sphere.
-  vec3 c = vffField.sphereCenter;
-  float R = vffField.sphereRadius;
+  vec3 c = VFF_FIELD.sphereCenter;
+  float R = VFF_FIELD.sphereRadius;
   precise vec3 delta = origin - c;
   precise float beta = vffDot(delta, w);
   precise float gamma = vffDot(delta, delta) - R * R;
@@ -487,26 +509,26 @@ VffHit vffQuery(vec3 origin, vec3 direction, float tmin, float tmax, float intra
   precise vec3 e = origin + w * t0;
   vec3 v = inside ? -w : w;
   if (inside) {
-    if (vffField.distanceEncoding == VFF_ENCODING_BIT1) return o;  // no distances: cannot tell
-    precise float bias = (intraBias >= 0.0 ? intraBias : vffField.intraBias) * R;
+    if (VFF_FIELD.distanceEncoding == VFF_ENCODING_BIT1) return o;  // no distances: cannot tell
+    precise float bias = (intraBias >= 0.0 ? intraBias : VFF_FIELD.intraBias) * R;
     lo = max(lo, bias);
   }
 #ifdef VFF_NO_NORMALS
   bool normals = false;
 #else
-  bool normals = vffField.normalEncoding != VFF_NORMAL_NONE;
+  bool normals = VFF_FIELD.normalEncoding != VFF_NORMAL_NONE;
 #endif
   // 2. The nearest sample, 3. the texel, 4. the decode.
-  precise vec3 eu = (e - c) * vffField.invRadius;
+  precise vec3 eu = (e - c) * VFF_FIELD.invRadius;
   int k = vffNearestSample(eu);
-  int M = int(vffField.mapResolution);
+  int M = int(VFF_FIELD.mapResolution);
   o.looked = true;
   o.sampleIndex = uint(k);
   if (!interpolated || inside) {
     vec3 ek = vffPosition(k);
     mat3 F = vffFrame(-ek);
     vec3 l = vffToLocal(F, v);
-    vec2 uv = vffHemisphereToSquare(vffField.directionScheme, l);
+    vec2 uv = vffHemisphereToSquare(VFF_FIELD.directionScheme, l);
     uvec2 ij = uvec2(vffSquareToTexel(uv, M));
     uint code = vffFetchCode(uint(k), ij);
     VffTexel s = vffDecode(code, ij);
@@ -538,9 +560,9 @@ VffHit vffQuery(vec3 origin, vec3 direction, float tmin, float tmax, float intra
   uint kc = 1u;
   ks[0] = uint(k);
   kw[0] = max(vffKernel(eu, uint(k)), 1e-6);  // the nearest sample always contributes
-  uint nbase = vffField.neighbourOffset + (VFF_NEIGHBOURS / 4u) * uint(k);
+  uint nbase = VFF_FIELD.neighbourOffset + (VFF_NEIGHBOURS / 4u) * uint(k);
   for (uint q = 0u; q < VFF_NEIGHBOURS; ++q) {
-    float f = vffPositions[nbase + q / 4u][q % 4u];
+    float f = vffPositions[VFF_POSITIONS_BASE + nbase + q / 4u][q % 4u];
     if (f < 0.0) break;
     uint nk = uint(f);
     float wk = vffKernel(eu, nk);
@@ -558,7 +580,7 @@ VffHit vffQuery(vec3 origin, vec3 direction, float tmin, float tmax, float intra
     precise vec3 p = c + uk * R;
     vec3 l = vffToLocal(vffFrame(-uk), v);
     if (l.z <= 0.0) continue;  // the sample does not see this direction
-    vec2 uv = vffHemisphereToSquare(vffField.directionScheme, l);
+    vec2 uv = vffHemisphereToSquare(VFF_FIELD.directionScheme, l);
     precise float x = (uv.x + 1.0) * 0.5 * float(M) - 0.5;
     precise float y = (uv.y + 1.0) * 0.5 * float(M) - 0.5;
     precise float fx0 = floor(x), fy0 = floor(y);

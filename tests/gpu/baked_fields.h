@@ -34,8 +34,9 @@ inline std::string caseName(const FieldCase& c) {
   return s;
 }
 
-inline Result<File> bakeFile(const FieldCase& c, bool normals) {
-  static const bake::Mesh mesh = bake::makeShape("torus-knot");
+// `shape`: one of bake::makeShape's (the scene tests use several).
+inline Result<File> bakeFile(const FieldCase& c, bool normals, const std::string& shape = "torus-knot") {
+  const bake::Mesh mesh = bake::makeShape(shape);
   auto scene = bake::Scene::create(mesh);
   if (!scene) return scene.error();
   bake::BakeOptions o;

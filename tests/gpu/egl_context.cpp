@@ -94,11 +94,18 @@ const HeadlessGl& headlessGl() {
   return gl;
 }
 
-unsigned buildQueryProgram(const std::string& defines, const std::string& body, std::string* log) {
-  std::ifstream include(std::string(VFF_GLSL_DIR) + "/vff_query.glsl");
+std::string readGlsl(const std::string& name) {
+  std::ifstream include(std::string(VFF_GLSL_DIR) + "/" + name);
   std::stringstream text;
   text << include.rdbuf();
-  const std::string src = "#version 430\n" + defines + text.str() + body;
+  return text.str();
+}
+
+unsigned buildQueryProgram(const std::string& defines, const std::string& body, std::string* log) {
+  return buildProgram("#version 430\n" + defines + readGlsl("vff_query.glsl") + body, log);
+}
+
+unsigned buildProgram(const std::string& src, std::string* log) {
   const char* p = src.c_str();
   const GLuint sh = glCreateShader(GL_COMPUTE_SHADER);
   glShaderSource(sh, 1, &p, nullptr);

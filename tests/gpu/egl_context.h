@@ -19,4 +19,10 @@ const HeadlessGl& headlessGl();
 // and `body` (GL has no #include). Returns the program, or 0 with the compile or link log in *log.
 unsigned buildQueryProgram(const std::string& defines, const std::string& body, std::string* log);
 
+// Compiles and links a compute program from its whole text. Returns 0 with the log on failure.
+unsigned buildProgram(const std::string& source, std::string* log);
+
+// The text of gpu/glsl/NAME.
+std::string readGlsl(const std::string& name);
+
 }  // namespace vff::test

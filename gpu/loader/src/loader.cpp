@@ -4,6 +4,8 @@
 
 #include <GL/glcorearb.h>
 
+#include "gl_upload.h"
+
 #include <string>
 #include <utility>
 #include <vector>
@@ -22,6 +24,10 @@ std::string glErrorName(GLenum e) {
   }
 }
 
+}  // namespace
+
+namespace detail {
+
 // The first pending GL error as a vff::Error, after draining the queue.
 Status checkGl(const char* what) {
   GLenum first = glGetError();
@@ -38,12 +44,7 @@ uint32_t getInt(GLenum name) {
   return v > 0 ? uint32_t(v) : 0;
 }
 
-// Restores the GL state loadField touches.
-struct SavedState {
-  GLint unpackAlignment = 4, unpackBuffer = 0, unpackRowLength = 0, unpackImageHeight = 0;
-  GLint unpackSkipPixels = 0, unpackSkipRows = 0, unpackSkipImages = 0;
-  GLint texture2DArray = 0, texture3D = 0, uniformBuffer = 0, storageBuffer = 0;
-  SavedState() {
+SavedState::SavedState() {
     glGetIntegerv(GL_UNPACK_ALIGNMENT, &unpackAlignment);
     glGetIntegerv(GL_PIXEL_UNPACK_BUFFER_BINDING, &unpackBuffer);
     glGetIntegerv(GL_UNPACK_ROW_LENGTH, &unpackRowLength);
@@ -55,8 +56,9 @@ struct SavedState {
     glGetIntegerv(GL_TEXTURE_BINDING_3D, &texture3D);
     glGetIntegerv(GL_UNIFORM_BUFFER_BINDING, &uniformBuffer);
     glGetIntegerv(GL_SHADER_STORAGE_BUFFER_BINDING, &storageBuffer);
-  }
-  ~SavedState() {
+}
+
+SavedState::~SavedState() {
     glPixelStorei(GL_UNPACK_ALIGNMENT, unpackAlignment);
     glBindBuffer(GL_PIXEL_UNPACK_BUFFER, GLuint(unpackBuffer));
     glPixelStorei(GL_UNPACK_ROW_LENGTH, unpackRowLength);
@@ -68,8 +70,9 @@ struct SavedState {
     glBindTexture(GL_TEXTURE_3D, GLuint(texture3D));
     glBindBuffer(GL_UNIFORM_BUFFER, GLuint(uniformBuffer));
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, GLuint(storageBuffer));
-  }
-};
+}
+
+namespace {
 
 // The message names the limit, what the file's layout needs, and a layout that fits the context
 // (with the vff-convert options that repack the file into it), or says that none does.
@@ -91,6 +94,9 @@ Error limitError(const char* limit, uint32_t value, const std::string& need, con
   }
   return makeError(Code::kUnsupported, msg);
 }
+
+}  // namespace
+
 // The context: GL 4.3 for compute shaders, storage buffers and texelFetch on integer arrays.
 Status checkVersion() {
   glGetError();  // a caller's stale error is not ours
@@ -125,12 +131,6 @@ Status checkLimits(const FieldDesc& field, const LayoutDesc& layout, const LoadO
   return {};
 }
 
-// The distance texture's format, checked against the file's slices.
-struct MapsFormat {
-  GLenum internalFormat = GL_R8UI, type = GL_UNSIGNED_BYTE;
-  uint32_t width = 0;        // texels (bit1: bytes) per slice row
-  uint64_t sliceBytes = 0;   // File::sliceBytes(Plane::kDistance)
-};
 
 Result<MapsFormat> mapsFormat(const File& file, uint32_t width) {
   const FieldDesc& field = file.field();
@@ -156,15 +156,15 @@ Result<MapsFormat> mapsFormat(const File& file, uint32_t width) {
 }
 
 // A texture of one level, nearest filtering (integer textures allow nothing else), immutable storage.
-Status makeTexture(GLenum target, GLenum internalFormat, uint32_t width, const LayoutDesc& layout, GLuint* texture,
-                   const char* what) {
+Status makeTexture(GLenum target, GLenum internalFormat, uint32_t width, uint32_t height, uint32_t layers,
+                   GLuint* texture, const char* what) {
   glGenTextures(1, texture);
   glBindTexture(target, *texture);
   glTexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
   glTexParameteri(target, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
   glTexParameteri(target, GL_TEXTURE_BASE_LEVEL, 0);
   glTexParameteri(target, GL_TEXTURE_MAX_LEVEL, 0);
-  glTexStorage3D(target, 1, internalFormat, GLsizei(width), GLsizei(layout.sliceHeight), GLsizei(layout.sliceCount));
+  glTexStorage3D(target, 1, internalFormat, GLsizei(width), GLsizei(height), GLsizei(layers));
   return checkGl(what);
 }
 
@@ -180,7 +180,7 @@ void setUnpackDefaults() {
 }
 
 // The distance plane into the bound texture; adds the bytes uploaded to *bytes.
-Status uploadDistance(const File& file, GLenum target, const MapsFormat& f, uint64_t* bytes) {
+Status uploadDistance(const File& file, GLenum target, const MapsFormat& f, uint32_t firstLayer, uint64_t* bytes) {
   const FieldDesc& field = file.field();
   const LayoutDesc& layout = file.layout();
   const GLsizei m = GLsizei(field.mapResolution);
@@ -191,7 +191,7 @@ Status uploadDistance(const File& file, GLenum target, const MapsFormat& f, uint
       auto map = file.mapData(Plane::kDistance, k);
       if (!map) return map.error();
       const TilePlacement at = placeMap(layout, k);
-      glCompressedTexSubImage3D(target, 0, GLint(at.x), GLint(at.y), GLint(at.slice), m, m, 1,
+      glCompressedTexSubImage3D(target, 0, GLint(at.x), GLint(at.y), GLint(firstLayer + at.slice), m, m, 1,
                                 GL_COMPRESSED_RED_RGTC1, GLsizei(map->size()), map->data());
     }
     if (Status st = checkGl("glCompressedTexSubImage3D (maps)"); !st) return st.error();
@@ -204,7 +204,7 @@ Status uploadDistance(const File& file, GLenum target, const MapsFormat& f, uint
       auto map = file.mapData(Plane::kDistance, k);
       if (!map) return map.error();
       const TilePlacement at = placeMap(layout, k);
-      glTexSubImage3D(target, 0, GLint(at.x), GLint(at.y), GLint(at.slice), m, m, 1, GL_RED_INTEGER, f.type,
+      glTexSubImage3D(target, 0, GLint(at.x), GLint(at.y), GLint(firstLayer + at.slice), m, m, 1, GL_RED_INTEGER, f.type,
                       map->data());
     }
     if (Status st = checkGl("glTexSubImage3D (maps)"); !st) return st.error();
@@ -213,7 +213,7 @@ Status uploadDistance(const File& file, GLenum target, const MapsFormat& f, uint
     std::vector<uint8_t> slice(f.sliceBytes);
     for (uint32_t s = 0; s < layout.sliceCount; ++s) {
       if (Status st = file.readSlice(Plane::kDistance, s, slice); !st) return st.error();
-      glTexSubImage3D(target, 0, 0, 0, GLint(s), GLsizei(f.width), GLsizei(layout.sliceHeight), 1, GL_RED_INTEGER,
+      glTexSubImage3D(target, 0, 0, 0, GLint(firstLayer + s), GLsizei(f.width), GLsizei(layout.sliceHeight), 1, GL_RED_INTEGER,
                       f.type, slice.data());
       if (Status st = checkGl("glTexSubImage3D"); !st) return st.error();
       *bytes += f.sliceBytes;
@@ -222,9 +222,7 @@ Status uploadDistance(const File& file, GLenum target, const MapsFormat& f, uint
   return {};
 }
 
-// The normal plane: the same layout, two snorm16 per texel as GL_RG16I, into a new texture
-// *texture; adds the bytes uploaded to *bytes.
-Status uploadNormals(const File& file, GLenum target, GLuint* texture, uint64_t* bytes) {
+Status checkNormals(const File& file) {
   const FieldDesc& field = file.field();
   const LayoutDesc& layout = file.layout();
   if (field.normalEncoding != NormalEncoding::kOctSnorm16)
@@ -232,15 +230,21 @@ Status uploadNormals(const File& file, GLenum target, GLuint* texture, uint64_t*
   const uint64_t normalBytes = file.sliceBytes(Plane::kNormal);
   if (normalBytes != uint64_t(layout.sliceWidth) * layout.sliceHeight * 4)
     return makeError(Code::kUnsupported, "unexpected normal slice size " + std::to_string(normalBytes) + " bytes");
-  if (Status s = makeTexture(target, GL_RG16I, layout.sliceWidth, layout, texture, "glTexStorage3D (normals)"); !s)
-    return s.error();
+  return {};
+}
+
+Status uploadNormals(const File& file, GLenum target, uint32_t firstLayer, uint64_t* bytes) {
+  const FieldDesc& field = file.field();
+  const LayoutDesc& layout = file.layout();
+  if (Status s = checkNormals(file); !s) return s;
+  const uint64_t normalBytes = file.sliceBytes(Plane::kNormal);
   if (layout.gutter == 0) {
     const GLsizei m = GLsizei(field.mapResolution);
     for (uint32_t k = 0; k < field.mapCount; ++k) {  // straight from the file, as the distances
       auto map = file.mapData(Plane::kNormal, k);
       if (!map) return map.error();
       const TilePlacement at = placeMap(layout, k);
-      glTexSubImage3D(target, 0, GLint(at.x), GLint(at.y), GLint(at.slice), m, m, 1, GL_RG_INTEGER, GL_SHORT,
+      glTexSubImage3D(target, 0, GLint(at.x), GLint(at.y), GLint(firstLayer + at.slice), m, m, 1, GL_RG_INTEGER, GL_SHORT,
                       map->data());
     }
     if (Status st = checkGl("glTexSubImage3D (normal maps)"); !st) return st.error();
@@ -250,7 +254,7 @@ Status uploadNormals(const File& file, GLenum target, GLuint* texture, uint64_t*
   std::vector<uint8_t> nslice(normalBytes);
   for (uint32_t s = 0; s < layout.sliceCount; ++s) {
     if (Status st = file.readSlice(Plane::kNormal, s, nslice); !st) return st.error();
-    glTexSubImage3D(target, 0, 0, 0, GLint(s), GLsizei(layout.sliceWidth), GLsizei(layout.sliceHeight), 1,
+    glTexSubImage3D(target, 0, 0, 0, GLint(firstLayer + s), GLsizei(layout.sliceWidth), GLsizei(layout.sliceHeight), 1,
                     GL_RG_INTEGER, GL_SHORT, nslice.data());
     if (Status st = checkGl("glTexSubImage3D (normals)"); !st) return st.error();
     *bytes += normalBytes;
@@ -266,7 +270,9 @@ Status makeBuffer(GLenum target, const void* data, size_t size, GLuint* buffer, 
   return checkGl(what);
 }
 
-}  // namespace
+}  // namespace detail
+
+using namespace detail;
 
 GpuField::GpuField(GpuField&& o) noexcept
     : block_(o.block_),
@@ -329,15 +335,19 @@ Result<GpuField> loadField(const File& file, const LoadOptions& options) {
   GpuField out;
   out.block_ = *block;
   out.mapsTarget_ = layout.target == LayoutTarget::kTexture3D ? GL_TEXTURE_3D : GL_TEXTURE_2D_ARRAY;
-  if (Status s = makeTexture(out.mapsTarget_, format->internalFormat, width, layout, &out.mapsTexture_,
-                             "glTexStorage3D");
+  if (Status s = makeTexture(out.mapsTarget_, format->internalFormat, width, layout.sliceHeight, layout.sliceCount,
+                             &out.mapsTexture_, "glTexStorage3D");
       !s)
     return s.error();
   setUnpackDefaults();
-  if (Status s = uploadDistance(file, out.mapsTarget_, *format, &out.textureBytes_); !s) return s.error();
+  if (Status s = uploadDistance(file, out.mapsTarget_, *format, 0, &out.textureBytes_); !s) return s.error();
   if (file.hasNormals()) {
-    if (Status s = uploadNormals(file, out.mapsTarget_, &out.normalsTexture_, &out.textureBytes_); !s)
+    if (Status s = checkNormals(file); !s) return s.error();
+    if (Status s = makeTexture(out.mapsTarget_, GL_RG16I, layout.sliceWidth, layout.sliceHeight, layout.sliceCount,
+                               &out.normalsTexture_, "glTexStorage3D (normals)");
+        !s)
       return s.error();
+    if (Status s = uploadNormals(file, out.mapsTarget_, 0, &out.textureBytes_); !s) return s.error();
   }
   // The field block (with where the neighbour lists start in the positions buffer).
   if (Status s = makeBuffer(GL_UNIFORM_BUFFER, &out.block_, sizeof(FieldBlock), &out.fieldBuffer_,

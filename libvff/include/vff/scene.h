@@ -57,6 +57,7 @@
 
 #include "vff/error.h"
 #include "vff/query.h"
+#include "vff/scene_hierarchy.h"
 
 namespace vff {
 
@@ -103,6 +104,10 @@ class Scene {
   // The instance ids whose enlarged world spheres the ray's [tmin, tmax] segment reaches, in
   // ascending order (what the queries consider). Errors: kBadState when not committed.
   Result<std::vector<uint32_t>> candidates(const Ray& ray) const;
+
+  // The committed top-level hierarchy, copied into a flat layout (vff/scene_hierarchy.h) for a
+  // walker outside libvff, such as the GLSL scene query. Errors: kBadState when not committed.
+  Result<SceneHierarchy> hierarchy() const;
 
   struct Impl;  // opaque
 

@@ -1,0 +1,185 @@
+// scene_loader.cpp - the GL calls of the scene loader (vff/gl/scene_loader.h): loadScene uploads
+// the fields once into shared textures and buffers (laid out by planScene), GpuScene::update the
+// instances and the hierarchy per frame.
+#include <GL/glcorearb.h>
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "gl_upload.h"
+#include "vff/gl/scene_loader.h"
+
+namespace vff::gl {
+
+using namespace detail;
+
+namespace {
+
+// Replaces the contents of *buffer (bound to GL_SHADER_STORAGE_BUFFER), growing it when needed.
+Status fillBuffer(uint32_t* buffer, uint64_t* allocated, const void* data, size_t size, const char* what) {
+  if (!*buffer) glGenBuffers(1, buffer);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, *buffer);
+  const size_t want = std::max<size_t>(size, 16);
+  if (want > *allocated) {
+    glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(want), nullptr, GL_DYNAMIC_DRAW);
+    *allocated = want;
+  }
+  if (size) glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(size), data);
+  return checkGl(what);
+}
+
+}  // namespace
+
+GpuScene::GpuScene(GpuScene&& o) noexcept { *this = std::move(o); }
+
+GpuScene& GpuScene::operator=(GpuScene&& o) noexcept {
+  if (this != &o) {
+    release();
+    plan_ = std::move(o.plan_);
+    queries_ = std::move(o.queries_);
+    maps_ = std::exchange(o.maps_, 0);
+    normals_ = std::exchange(o.normals_, 0);
+    positions_ = std::exchange(o.positions_, 0);
+    fields_ = std::exchange(o.fields_, 0);
+    instances_ = std::exchange(o.instances_, 0);
+    nodes_ = std::exchange(o.nodes_, 0);
+    instancesSize_ = std::exchange(o.instancesSize_, 0);
+    nodesSize_ = std::exchange(o.nodesSize_, 0);
+    instanceCount_ = std::exchange(o.instanceCount_, 0);
+    textureBytes_ = std::exchange(o.textureBytes_, 0);
+  }
+  return *this;
+}
+
+GpuScene::~GpuScene() { release(); }
+
+void GpuScene::release() noexcept {
+  if (maps_) glDeleteTextures(1, &maps_);
+  if (normals_) glDeleteTextures(1, &normals_);
+  for (uint32_t* b : {&positions_, &fields_, &instances_, &nodes_})
+    if (*b) glDeleteBuffers(1, b);
+  maps_ = normals_ = positions_ = fields_ = instances_ = nodes_ = 0;
+  instancesSize_ = nodesSize_ = 0;
+  instanceCount_ = 0;
+  textureBytes_ = 0;
+}
+
+void GpuScene::bind(const SceneBindings& b) const noexcept {
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b.positions, positions_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b.fields, fields_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b.instances, instances_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b.nodes, nodes_);
+  if (normals_) {
+    glActiveTexture(GL_TEXTURE0 + b.normals);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, normals_);
+  }
+  glActiveTexture(GL_TEXTURE0 + b.maps);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, maps_);
+}
+
+Status GpuScene::update(const Scene& scene) {
+  auto h = scene.hierarchy();
+  if (!h) return std::move(h).error();
+  if (3 * h->depth + 1 > kSceneStack)
+    return makeError(Code::kUnsupported, "scene: the hierarchy has " + std::to_string(h->depth) +
+                                             " levels; the shader's stack (VFF_SCENE_STACK " +
+                                             std::to_string(kSceneStack) + ") holds " +
+                                             std::to_string((kSceneStack - 1) / 3));
+  auto inst = makeSceneInstances(scene, *h, queries_);
+  if (!inst) return std::move(inst).error();
+  std::vector<uint8_t> nodes(sizeof(SceneNodesHeader) + h->nodes.size() * sizeof(SceneNode));
+  SceneNodesHeader head;
+  head.nodeCount = uint32_t(h->nodes.size());
+  head.maxRadius = h->maxRadius;
+  head.instanceCount = uint32_t(inst->size());
+  std::memcpy(nodes.data(), &head, sizeof head);
+  if (!h->nodes.empty())
+    std::memcpy(nodes.data() + sizeof head, h->nodes.data(), h->nodes.size() * sizeof(SceneNode));
+  glGetError();  // a caller's stale error is not ours
+  GLint saved = 0;
+  glGetIntegerv(GL_SHADER_STORAGE_BUFFER_BINDING, &saved);
+  Status s = fillBuffer(&instances_, &instancesSize_, inst->data(), inst->size() * sizeof(SceneInstanceBlock),
+                        "uploading the scene's instances");
+  if (s) s = fillBuffer(&nodes_, &nodesSize_, nodes.data(), nodes.size(), "uploading the scene's hierarchy");
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, GLuint(saved));
+  if (s) instanceCount_ = uint32_t(inst->size());
+  return s;
+}
+
+Result<GpuScene> loadScene(std::span<const SceneField> fields, const LoadOptions& options) {
+  if (fields.empty()) return makeError(Code::kInvalidArgument, "scene: no fields");
+  std::vector<FieldDesc> descs;
+  std::vector<LayoutDesc> layouts;
+  GpuScene out;
+  for (size_t f = 0; f < fields.size(); ++f) {
+    if (!fields[f].file || !fields[f].query)
+      return makeError(Code::kInvalidArgument, "scene field " + std::to_string(f) + ": null file or query");
+    for (size_t g = 0; g < f; ++g)
+      if (fields[g].query == fields[f].query)
+        return makeError(Code::kInvalidArgument, "scene field " + std::to_string(f) + ": the same query as field " +
+                                                     std::to_string(g));
+    descs.push_back(fields[f].file->field());
+    layouts.push_back(fields[f].file->layout());
+    out.queries_.push_back(fields[f].query);
+  }
+  auto plan = planScene(descs, layouts);
+  if (!plan) return plan.error();
+  if (Status s = checkVersion(); !s) return s.error();
+  // Each field against the context's limits, then the shared texture's layer count.
+  for (size_t f = 0; f < fields.size(); ++f) {
+    const uint32_t width = descs[f].distanceEncoding == DistanceEncoding::kBit1 ? layouts[f].sliceWidth / 8
+                                                                                : layouts[f].sliceWidth;
+    if (Status s = checkLimits(descs[f], layouts[f], options, width); !s) return s.error();
+  }
+  uint32_t maxLayers = getInt(GL_MAX_ARRAY_TEXTURE_LAYERS);
+  if (options.maxLayers && options.maxLayers < maxLayers) maxLayers = options.maxLayers;
+  if (plan->mapsLayers > maxLayers)
+    return makeError(Code::kUnsupported, "the scene's fields need " + std::to_string(plan->mapsLayers) +
+                                             " slices in one texture; GL_MAX_ARRAY_TEXTURE_LAYERS is " +
+                                             std::to_string(maxLayers));
+  out.plan_ = std::move(*plan);
+  const ScenePlan& p = out.plan_;
+
+  SavedState saved;
+  if (Status s = makeTexture(GL_TEXTURE_2D_ARRAY, p.wideTexels ? GL_R16UI : GL_R8UI, p.mapsWidth, p.mapsHeight,
+                             p.mapsLayers, &out.maps_, "glTexStorage3D (scene maps)");
+      !s)
+    return s.error();
+  setUnpackDefaults();
+  for (size_t f = 0; f < fields.size(); ++f) {
+    const uint32_t width = descs[f].distanceEncoding == DistanceEncoding::kBit1 ? layouts[f].sliceWidth / 8
+                                                                                : layouts[f].sliceWidth;
+    auto format = mapsFormat(*fields[f].file, width);
+    if (!format) return format.error();
+    if (Status s = uploadDistance(*fields[f].file, GL_TEXTURE_2D_ARRAY, *format, p.fields[f].mapsLayer,
+                                  &out.textureBytes_);
+        !s)
+      return s.error();
+  }
+  if (p.normalsLayers > 0) {
+    if (Status s = makeTexture(GL_TEXTURE_2D_ARRAY, GL_RG16I, p.normalsWidth, p.normalsHeight, p.normalsLayers,
+                               &out.normals_, "glTexStorage3D (scene normals)");
+        !s)
+      return s.error();
+    for (size_t f = 0; f < fields.size(); ++f) {
+      if (!fields[f].file->hasNormals()) continue;
+      if (Status s = uploadNormals(*fields[f].file, GL_TEXTURE_2D_ARRAY, p.fields[f].normalsLayer, &out.textureBytes_);
+          !s)
+        return s.error();
+    }
+  }
+  if (Status s = makeBuffer(GL_SHADER_STORAGE_BUFFER, p.positions.data(), p.positions.size() * sizeof(float),
+                            &out.positions_, "uploading the scene's sample positions");
+      !s)
+    return s.error();
+  if (Status s = makeBuffer(GL_SHADER_STORAGE_BUFFER, p.fields.data(), p.fields.size() * sizeof(SceneFieldBlock),
+                            &out.fields_, "uploading the scene's field table");
+      !s)
+    return s.error();
+  return out;
+}
+
+}  // namespace vff::gl
