@@ -26,22 +26,23 @@
 
 #include "vff/encoding.h"
 #include "vff/gl/loader.h"
+#include "vff/gl/scene_loader.h"
 #include "vff/vff.h"
 
 namespace vff {
 namespace {
 
-std::string readGlsl() {
-  std::ifstream in(std::string(VFF_GLSL_DIR) + "/vff_query.glsl");
+std::string readGlsl(const std::string& file = "vff_query.glsl") {
+  std::ifstream in(std::string(VFF_GLSL_DIR) + "/" + file);
   std::stringstream text;
   text << in.rdbuf();
   return text.str();
 }
 
 // The include's lines, with `//` comments and trailing blanks removed.
-std::vector<std::string> glslLines() {
+std::vector<std::string> glslLines(const std::string& file = "vff_query.glsl") {
   std::vector<std::string> lines;
-  std::istringstream in(readGlsl());
+  std::istringstream in(readGlsl(file));
   for (std::string line; std::getline(in, line);) {
     if (const size_t c = line.find("//"); c != std::string::npos) line.erase(c);
     while (!line.empty() && (line.back() == ' ' || line.back() == '\r')) line.pop_back();
@@ -181,10 +182,11 @@ struct Member {
 };
 
 // The members of the block that begins with the line `header`, up to the line `footer`.
-std::vector<Member> glslBlock(const std::string& header, const std::string& footer) {
+std::vector<Member> glslBlock(const std::string& header, const std::string& footer,
+                              const std::string& file = "vff_query.glsl") {
   static const std::regex member(R"(^  (float|int|uint|vec[234]|ivec[234]|uvec[234]) ([A-Za-z_][A-Za-z0-9_]*)(\[\])?;$)");
   std::vector<Member> out;
-  const std::vector<std::string> lines = glslLines();
+  const std::vector<std::string> lines = glslLines(file);
   size_t i = 0;
   while (i < lines.size() && lines[i] != header) ++i;
   if (i == lines.size()) {
@@ -284,6 +286,113 @@ TEST(GlslLayout, PositionsBlockIsOneVec4Array) {
   ASSERT_EQ(glsl.size(), 1u);
   EXPECT_EQ(glsl[0].type, "vec4[]");
   EXPECT_EQ(glsl[0].name, "vffPositions");
+}
+
+// ---- The scene's structures (gpu/glsl/vff_scene.glsl) ---------------------------------------------
+// Its storage blocks hold arrays of these structs (std430); with only scalars, vec3 followed by a
+// scalar, and vec4 members, std430 offsets equal the std140 ones computed here, and the structs'
+// sizes are multiples of 16 (their array stride).
+
+void expectSameMembers(const std::vector<Member>& glsl, const std::vector<Member>& cpp, size_t cppSize,
+                       const std::string& what) {
+  size_t end = 0;
+  for (const Member& m : cpp) {
+    EXPECT_EQ(m.offset, end) << what << ": the C++ member " << m.name << " does not follow the one before it";
+    end = m.offset + m.size;
+  }
+  EXPECT_EQ(end, cppSize) << what << ": the C++ struct has members this test does not list";
+  ASSERT_EQ(glsl.size(), cpp.size()) << what;
+  for (size_t i = 0; i < glsl.size(); ++i) {
+    EXPECT_EQ(glsl[i].name, cpp[i].name) << what << " member " << i;
+    EXPECT_EQ(glsl[i].type, cpp[i].type) << what << "." << glsl[i].name;
+    EXPECT_EQ(glsl[i].offset, cpp[i].offset) << what << "." << glsl[i].name;
+    EXPECT_EQ(glsl[i].size, cpp[i].size) << what << "." << glsl[i].name;
+  }
+  EXPECT_EQ(cppSize % 16, 0u) << what << ": an array stride is a multiple of 16";
+}
+
+#define VFF_MEMBER_AT(glslType, glslName, type, member, extra, bytes) \
+  Member { glslType, glslName, offsetof(type, member) + (extra), bytes }
+
+TEST(GlslSceneLayout, SceneFieldIsTheFieldBlockThenItsPlace) {
+  std::vector<Member> glsl = glslBlock("struct VffSceneField {", "};", "vff_scene.glsl");
+  layoutStd140(glsl);
+  std::vector<Member> cpp = cppFieldBlock();
+  static_assert(offsetof(gl::SceneFieldBlock, field) == 0);
+  cpp.push_back(VFF_MEMBER_AT("uint", "mapsLayer", gl::SceneFieldBlock, mapsLayer, 0, 4));
+  cpp.push_back(VFF_MEMBER_AT("uint", "normalsLayer", gl::SceneFieldBlock, normalsLayer, 0, 4));
+  cpp.push_back(VFF_MEMBER_AT("uint", "positionsBase", gl::SceneFieldBlock, positionsBase, 0, 4));
+  cpp.push_back(VFF_MEMBER_AT("uint", "reserved2", gl::SceneFieldBlock, reserved2, 0, 4));
+  expectSameMembers(glsl, cpp, sizeof(gl::SceneFieldBlock), "VffSceneField");
+}
+
+TEST(GlslSceneLayout, SceneInstanceMatchesTheLoaderStruct) {
+  std::vector<Member> glsl = glslBlock("struct VffSceneInstance {", "};", "vff_scene.glsl");
+  layoutStd140(glsl);
+  using I = gl::SceneInstanceBlock;
+  const std::vector<Member> cpp = {
+      VFF_MEMBER_AT("vec4", "rotation0", I, rotation, 0, 16), VFF_MEMBER_AT("vec4", "rotation1", I, rotation, 16, 16),
+      VFF_MEMBER_AT("vec4", "rotation2", I, rotation, 32, 16), VFF_MEMBER_AT("vec3", "translation", I, translation, 0, 12),
+      VFF_MEMBER_AT("float", "invScale", I, invScale, 0, 4),   VFF_MEMBER_AT("vec4", "sphere", I, sphere, 0, 16),
+      VFF_MEMBER_AT("uint", "id", I, id, 0, 4),                VFF_MEMBER_AT("uint", "field", I, field, 0, 4),
+      VFF_MEMBER_AT("float", "scale", I, scale, 0, 4),         VFF_MEMBER_AT("uint", "reserved", I, reserved, 0, 4)};
+  expectSameMembers(glsl, cpp, sizeof(I), "VffSceneInstance");
+}
+
+TEST(GlslSceneLayout, SceneNodeMatchesTheExportedNode) {
+  std::vector<Member> glsl = glslBlock("struct VffSceneNode {", "};", "vff_scene.glsl");
+  layoutStd140(glsl);
+  using N = SceneNode;
+  const std::vector<Member> cpp = {
+      VFF_MEMBER_AT("vec4", "loX", N, lo, 0, 16),     VFF_MEMBER_AT("vec4", "loY", N, lo, 16, 16),
+      VFF_MEMBER_AT("vec4", "loZ", N, lo, 32, 16),    VFF_MEMBER_AT("vec4", "hiX", N, hi, 0, 16),
+      VFF_MEMBER_AT("vec4", "hiY", N, hi, 16, 16),    VFF_MEMBER_AT("vec4", "hiZ", N, hi, 32, 16),
+      VFF_MEMBER_AT("uvec4", "child", N, child, 0, 16), VFF_MEMBER_AT("uvec4", "count", N, count, 0, 16),
+      VFF_MEMBER_AT("uvec4", "valid", N, valid, 0, 16)};  // valid, then the three reserved words
+  expectSameMembers(glsl, cpp, sizeof(N), "VffSceneNode");
+}
+
+TEST(GlslSceneLayout, NodesHeaderMatchesTheLoaderStruct) {
+  // The block's scalars up to the node array.
+  std::vector<Member> glsl = glslBlock(
+      "layout(std430, binding = VFF_SCENE_NODES_BINDING) readonly buffer VffSceneNodesBlock {",
+      "  VffSceneNode vffSceneNodes[];", "vff_scene.glsl");
+  layoutStd140(glsl);
+  using H = gl::SceneNodesHeader;
+  const std::vector<Member> cpp = {VFF_MEMBER_AT("uint", "vffSceneNodeCount", H, nodeCount, 0, 4),
+                                   VFF_MEMBER_AT("float", "vffSceneMaxRadius", H, maxRadius, 0, 4),
+                                   VFF_MEMBER_AT("uint", "vffSceneInstanceCount", H, instanceCount, 0, 4),
+                                   VFF_MEMBER_AT("uint", "vffSceneReserved", H, reserved, 0, 4)};
+  expectSameMembers(glsl, cpp, sizeof(H), "VffSceneNodesBlock's header");
+}
+
+TEST(GlslSceneLayout, DefaultBindingsAndStackMatchTheLoader) {
+  static const std::regex def(R"(^#define (VFF_SCENE_[A-Z_]+) ([0-9]+)$)");
+  std::map<std::string, uint32_t> found;
+  for (const std::string& line : glslLines("vff_scene.glsl")) {
+    std::smatch m;
+    if (std::regex_match(line, m, def)) found[m[1]] = uint32_t(std::stoul(m[2]));
+  }
+  const gl::SceneBindings b;
+  const gl::Bindings single;
+  const std::map<std::string, uint32_t> expected = {{"VFF_SCENE_FIELDS_BINDING", b.fields},
+                                                    {"VFF_SCENE_INSTANCES_BINDING", b.instances},
+                                                    {"VFF_SCENE_NODES_BINDING", b.nodes},
+                                                    {"VFF_SCENE_STACK", gl::kSceneStack}};
+  EXPECT_EQ(found, expected);
+  // The fields' resources are vff_query.glsl's, at its default bindings.
+  EXPECT_EQ(b.maps, single.maps);
+  EXPECT_EQ(b.positions, single.positions);
+  EXPECT_EQ(b.normals, single.normals);
+}
+
+TEST(GlslSceneLayout, ShaderSourceReplacesTheIncludeLine) {
+  const std::string scene = readGlsl("vff_scene.glsl"), query = readGlsl("vff_query.glsl");
+  const std::string src = gl::sceneShaderSource(scene, query);
+  EXPECT_EQ(src.find("#include \"vff_query.glsl\""), std::string::npos);
+  EXPECT_EQ(src.size(), scene.size() - std::string("#include \"vff_query.glsl\"").size() + query.size());
+  // The macros that select the field come before the include's text.
+  EXPECT_LT(src.find("#define VFF_FIELD vffSceneFields"), src.find("#ifndef VFF_QUERY_GLSL"));
 }
 
 // ---- What the loader fills in, against libvff ------------------------------------------------------
