@@ -2,7 +2,10 @@
 // gpu/bench/ao_scene.h) on the GPU through gpu/glsl/vff_query.glsl, with the CPU FieldQuery on the
 // same rays in the same run as the baseline.
 //
-//   vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size 512] [--spp 256] [--threads N]
+//   vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size 512] [--spp 256] [--threads N] [--scene N]
+//
+// --scene N adds the scene benchmark (scene_bench.h): the ground AO under N instances of the field
+// through gpu/glsl/vff_scene.glsl against the CPU vff::Scene, and a frame's instance update.
 //
 // Without --field it bakes MESH (default /usr/share/glmark2/models/bunny.obj, else the procedural
 // torus knot) as samples/experiments does: octa-hemi2 n = 32 (4226 maps), 64 x 64, unorm8-diameter.
@@ -27,11 +30,43 @@
 
 #include "../../tests/gpu/egl_context.h"
 #include "ao_scene.h"
+#include "scene_bench.h"
 #include "vff/bake/baker.h"
 #include "vff/bake/mesh.h"
 #include "vff/bake/procedural.h"
 #include "vff/gl/loader.h"
 #include "vff/vff.h"
+
+namespace vff::gpubench {
+
+// (scene_bench.h)
+double renderGpuAo(const AoScene& s, int spp, int interp, unsigned imageBuffer, std::vector<float>* image) {
+  const int size = s.size;
+  glUniform1i(0, size);
+  glUniform1i(1, spp);
+  glUniform1i(2, interp);
+  glUniform1f(3, s.eps);
+  glUniform1f(4, s.tmax);
+  // A warm-up dispatch (drivers such as llvmpipe compile the shader at its first use), then
+  // bands of 64 rows per dispatch (keeps single dispatches short on slow drivers).
+  glUniform1i(5, 0);
+  glDispatchCompute(1, 1, 1);
+  glFinish();
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int row = 0; row < size; row += 64) {
+    glUniform1i(5, row);
+    glDispatchCompute(GLuint(size / 8), GLuint(std::min(64, size - row) / 8), 1);
+  }
+  glFinish();
+  const double gpuS = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  image->assign(size_t(size) * size, 0.0f);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, imageBuffer);
+  glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(image->size() * 4), image->data());
+  return gpuS;
+}
+
+}  // namespace vff::gpubench
 
 namespace {
 
@@ -71,7 +106,7 @@ void parallel(unsigned threads, size_t count, Fn&& fn) {
 }
 
 int usage() {
-  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--threads N]\n");
+  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--threads N] [--scene N]\n");
   return 1;
 }
 
@@ -80,6 +115,7 @@ int usage() {
 struct BenchOptions {
   std::string fieldPath, meshPath = "/usr/share/glmark2/models/bunny.obj";
   int size = 512, spp = 256;
+  int sceneInstances = 0;  // --scene N: also the scene benchmark with N instances
   unsigned threads = std::max(1u, std::thread::hardware_concurrency());
 };
 
@@ -100,11 +136,17 @@ int parseOptions(int argc, char** argv, BenchOptions* o) {
       o->size = std::atoi(v);
     } else if (a == "--spp" && (v = next())) {
       o->spp = std::atoi(v);
+    } else if (a == "--scene" && (v = next())) {
+      o->sceneInstances = std::atoi(v);
     } else if (a == "--threads" && (v = next())) {
       o->threads = unsigned(std::max(1, std::atoi(v)));
     } else {
       return usage();
     }
+  }
+  if (o->sceneInstances < 0) {
+    std::fprintf(stderr, "vff-gpu-bench: --scene takes a number of instances\n");
+    return 1;
   }
   if (o->size < 8 || o->size % 8 != 0 || o->spp < 1) {
     std::fprintf(stderr, "vff-gpu-bench: --size must be a positive multiple of 8 and --spp positive\n");
@@ -273,33 +315,6 @@ void benchQueries(const vff::FieldDesc& f, const vff::gl::GpuField& gpu, const v
 
 // ---- AO render -----------------------------------------------------------------------------------
 
-// The GPU's AO image (buffers bound at 5, 6, 7; the program in use), in *image; returns seconds.
-double renderGpuAo(const vff::gpubench::AoScene& s, int spp, int interp, GLuint imageBuffer, std::vector<float>* image) {
-  const int size = s.size;
-  glUniform1i(0, size);
-  glUniform1i(1, spp);
-  glUniform1i(2, interp);
-  glUniform1f(3, s.eps);
-  glUniform1f(4, s.tmax);
-  // A warm-up dispatch (drivers such as llvmpipe compile the shader at its first use), then
-  // bands of 64 rows per dispatch (keeps single dispatches short on slow drivers).
-  glUniform1i(5, 0);
-  glDispatchCompute(1, 1, 1);
-  glFinish();
-  const auto t0 = Clock::now();
-  for (int row = 0; row < size; row += 64) {
-    glUniform1i(5, row);
-    glDispatchCompute(GLuint(size / 8), GLuint(std::min(64, size - row) / 8), 1);
-  }
-  glFinish();
-  const double gpuS = seconds(t0, Clock::now());
-  image->assign(size_t(size) * size, 0.0f);
-  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, imageBuffer);
-  glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(image->size() * 4), image->data());
-  return gpuS;
-}
-
 void benchAo(const vff::FieldDesc& f, float groundY, const vff::gl::GpuField& gpu, const vff::FieldQuery& cpu,
              GLuint aoProg, const BenchOptions& o) {
   using namespace vff;
@@ -321,7 +336,7 @@ void benchAo(const vff::FieldDesc& f, float groundY, const vff::gl::GpuField& gp
   std::printf("| query | GPU s | CPU s | GPU/CPU | max | RMS |\n|---|---|---|---|---|---|\n");
   for (int interp = 0; interp < 2; ++interp) {
     std::vector<float> g;
-    const double gpuS = renderGpuAo(s, spp, interp, bufs[2], &g);
+    const double gpuS = gpubench::renderGpuAo(s, spp, interp, bufs[2], &g);
     const auto c0 = Clock::now();
     const std::vector<float> cimg =
         gpubench::cpuAo(cpu, s, spp, interp ? Reconstruction::kInterpolated : Reconstruction::kNearest, o.threads);
@@ -372,6 +387,10 @@ int main(int argc, char** argv) {
 
   benchQueries(f, *gpu, *cpu, rayProg, o.threads);
   benchAo(f, groundY, *gpu, *cpu, aoProg, o);
+  if (o.sceneInstances > 0) {
+    const gpubench::SceneBenchOptions so{.instances = o.sceneInstances, .size = o.size, .spp = o.spp, .threads = o.threads};
+    if (const int code = gpubench::benchScene(*file, *cpu, groundY, so); code != 0) return code;
+  }
   glDeleteProgram(rayProg);
   glDeleteProgram(aoProg);
   if (glGetError() != GL_NO_ERROR) {
