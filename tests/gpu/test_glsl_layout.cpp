@@ -464,3 +464,79 @@ TEST(GlslLayout, PositionsBufferHoldsLibvffValues) {
 
 }  // namespace
 }  // namespace vff
+
+namespace vff {
+namespace {
+
+// ---- What the scene loader plans (planScene), without GL ----------------------------------------
+
+LayoutDesc layoutOf(const FieldDesc& f, uint32_t maxSize, uint32_t gutter,
+                    LayoutTarget target = LayoutTarget::kTexture2DArray) {
+  LayoutLimits l;
+  l.target = target;
+  l.maxTextureSize = maxSize;
+  l.gutter = gutter;
+  return computeLayout(f, l).value();
+}
+
+TEST(GlslSceneLayout, PlanAppendsEachFieldsSlicesAndPositions) {
+  const FieldDesc a = makeField(PositionScheme::kOctaHemi2, 4, DirectionScheme::kConcentricEqualArea,
+                                DistanceEncoding::kUnorm8Diameter, 32, 1.0f);
+  FieldDesc b = makeField(PositionScheme::kEqualAreaOctaGrid, 9, DirectionScheme::kHemiOctahedral,
+                          DistanceEncoding::kUnorm8Chord, 16, 2.0f);
+  b.normalEncoding = NormalEncoding::kOctSnorm16;
+  const FieldDesc c = makeField(PositionScheme::kSphericalFibonacci, 100, DirectionScheme::kConcentricEqualArea,
+                                DistanceEncoding::kBit1, 32, 0.5f);
+  const FieldDesc fields[] = {a, b, c};
+  const LayoutDesc layouts[] = {layoutOf(a, 256, 1), layoutOf(b, 128, 0), layoutOf(c, 512, 0)};
+  auto plan = gl::planScene(fields, layouts);
+  ASSERT_TRUE(plan.ok()) << plan.error().toString();
+  ASSERT_EQ(plan->fields.size(), 3u);
+  uint32_t layer = 0, base = 0, width = 0, height = 0;
+  for (int f = 0; f < 3; ++f) {
+    const gl::SceneFieldBlock& s = plan->fields[f];
+    EXPECT_EQ(s.mapsLayer, layer) << "field " << f;
+    EXPECT_EQ(s.positionsBase, base) << "field " << f;
+    // The block is the single field's (neighbourOffset stays relative to the field's base).
+    const gl::FieldBlock single = gl::makeFieldBlock(fields[f], layouts[f]).value();
+    EXPECT_EQ(std::memcmp(&s.field, &single, sizeof single), 0) << "field " << f;
+    const std::vector<float> positions = gl::makePositionsBuffer(fields[f]).value();
+    for (size_t i = 0; i < positions.size(); ++i)
+      ASSERT_TRUE(sameBits(plan->positions[size_t(base) * 4 + i], positions[i])) << "field " << f << " float " << i;
+    layer += layouts[f].sliceCount;
+    base += uint32_t((positions.size() + 3) / 4);
+    width = std::max(width, fields[f].distanceEncoding == DistanceEncoding::kBit1 ? layouts[f].sliceWidth / 8
+                                                                                  : layouts[f].sliceWidth);
+    height = std::max(height, layouts[f].sliceHeight);
+  }
+  EXPECT_EQ(plan->mapsLayers, layer);
+  EXPECT_EQ(plan->mapsWidth, width);
+  EXPECT_EQ(plan->mapsHeight, height);
+  EXPECT_EQ(plan->positions.size(), size_t(base) * 4);
+  EXPECT_FALSE(plan->wideTexels);
+  // Only b has normals: its slices alone, from layer 0.
+  EXPECT_EQ(plan->fields[1].normalsLayer, 0u);
+  EXPECT_EQ(plan->normalsLayers, layouts[1].sliceCount);
+  EXPECT_EQ(plan->normalsWidth, layouts[1].sliceWidth);
+}
+
+TEST(GlslSceneLayout, PlanRefusesWhatOneTextureCannotHold) {
+  const FieldDesc u8 = makeField(PositionScheme::kOctaHemi2, 4, DirectionScheme::kConcentricEqualArea,
+                                 DistanceEncoding::kUnorm8Diameter, 32, 1.0f);
+  const FieldDesc u16 = makeField(PositionScheme::kOctaHemi2, 4, DirectionScheme::kConcentricEqualArea,
+                                  DistanceEncoding::kUnorm16Diameter, 32, 1.0f);
+  const FieldDesc bc4 = makeField(PositionScheme::kOctaHemi2, 4, DirectionScheme::kConcentricEqualArea,
+                                  DistanceEncoding::kBc4Diameter, 32, 1.0f);
+  auto code = [](std::initializer_list<FieldDesc> f, std::initializer_list<LayoutDesc> l) {
+    auto p = gl::planScene(std::vector<FieldDesc>(f), std::vector<LayoutDesc>(l));
+    return p.ok() ? Code::kOk : p.error().code;
+  };
+  EXPECT_EQ(code({u16, u16}, {layoutOf(u16, 256, 0), layoutOf(u16, 512, 1)}), Code::kOk);
+  EXPECT_EQ(code({u8, u16}, {layoutOf(u8, 256, 0), layoutOf(u16, 256, 0)}), Code::kUnsupported);
+  EXPECT_EQ(code({u8, bc4}, {layoutOf(u8, 256, 0), layoutOf(bc4, 256, 0)}), Code::kUnsupported);
+  EXPECT_EQ(code({u8}, {layoutOf(u8, 256, 0, LayoutTarget::kTexture3D)}), Code::kUnsupported);
+  EXPECT_EQ(code({}, {}), Code::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace vff

@@ -44,6 +44,7 @@ namespace {
 constexpr double kNearestT = 1e-5;  // fraction of the instance's world radius
 constexpr double kInterpT = 1e-4;
 constexpr double kVisEps = 1e-4;
+constexpr double kNormalEps = 1e-5;  // world normals, per component (the single-field bound)
 constexpr double kMaxDifferingShare = 0.005;
 
 // One ray per invocation: the four scene queries.
@@ -51,7 +52,8 @@ const char* kMain = R"(
 layout(local_size_x = 64) in;
 struct TestRay { vec4 origin; vec4 direction; vec4 range; };  // range: tmin, tmax, intraBias
 struct TestOut { uint nearestHit; float nearestT; uint nearestInstance; uint occluded;
-                 uint interpHit; float interpT; uint interpInstance; float visibility; };
+                 uint interpHit; float interpT; uint interpInstance; float visibility;
+                 vec4 normal; };  // normal: the kNearest hit's world normal, w = hasNormal
 layout(std430, binding = 8) readonly buffer TestRays { TestRay rays[]; };
 layout(std430, binding = 9) writeonly buffer TestOuts { TestOut outs[]; };
 void main() {
@@ -69,6 +71,7 @@ void main() {
   o.interpT = b.t;
   o.interpInstance = b.instance;
   o.visibility = vffSceneVisibility(r.origin.xyz, r.direction.xyz, r.range.x, r.range.y, r.range.z, true);
+  o.normal = vec4(a.normal, a.hasNormal ? 1.0 : 0.0);
   outs[id] = o;
 }
 )";
@@ -83,8 +86,9 @@ struct GpuOut {
   float interpT;
   uint32_t interpInstance;
   float visibility;
+  float normal[4];
 };
-static_assert(sizeof(GpuRay) == 48 && sizeof(GpuOut) == 32);
+static_assert(sizeof(GpuRay) == 48 && sizeof(GpuOut) == 48);
 
 std::string sceneSource(const std::string& defines, const std::string& body) {
   return "#version 430\n" + defines +
@@ -234,6 +238,7 @@ bool sameHit(const Scene& scene, const Ray& ray, uint32_t gpuHit, float gpuT, ui
 uint32_t compareWithScene(const Scene& scene, const std::vector<GpuRay>& rays, const std::vector<GpuOut>& g,
                           const char* label) {
   uint32_t nearestDiff = 0, occludedDiff = 0, interpDiff = 0, visDiff = 0, differing = 0, hits = 0, interpHits = 0;
+  uint32_t normals = 0, normalDiff = 0;
   double maxVis = 0;
   for (size_t r = 0; r < rays.size(); ++r) {
     const Ray ray = toRay(rays[r]);
@@ -246,6 +251,17 @@ uint32_t compareWithScene(const Scene& scene, const std::vector<GpuRay>& rays, c
     hits += a.hit;
     interpHits += b.hit;
     const bool dn = !sameHit(scene, ray, g[r].nearestHit, g[r].nearestT, g[r].nearestInstance, a, kNearestT);
+    // The world normal of the same hit (instances of the field with a normal plane).
+    if (!dn && a.hit) {
+      EXPECT_EQ(g[r].normal[3] != 0, a.hasNormal) << label << " ray " << r;
+      if (a.hasNormal) {
+        ++normals;
+        const double e = std::max({std::fabs(double(g[r].normal[0]) - a.normal.x),
+                                   std::fabs(double(g[r].normal[1]) - a.normal.y),
+                                   std::fabs(double(g[r].normal[2]) - a.normal.z)});
+        normalDiff += !(e <= kNormalEps);
+      }
+    }
     const bool doc = (g[r].occluded != 0) != occ;
     const bool di = !sameHit(scene, ray, g[r].interpHit, g[r].interpT, g[r].interpInstance, b, kInterpT);
     const double dv = std::fabs(double(g[r].visibility) - double(vis));
@@ -268,6 +284,10 @@ uint32_t compareWithScene(const Scene& scene, const std::vector<GpuRay>& rays, c
   std::printf("[ gpu ] %s: %zu rays (%u kNearest hits, %u kInterpolated hits); differ from the CPU Scene: "
               "intersect %u, occluded %u, interpolated intersect %u, visibility %u (beyond %.0e; max %.3g)\n",
               label, rays.size(), hits, interpHits, nearestDiff, occludedDiff, interpDiff, visDiff, kVisEps, maxVis);
+  std::printf("[ gpu ] %s: %u kNearest hits with a normal; world normals beyond %.0e of the CPU's: %u\n", label,
+              normals, kNormalEps, normalDiff);
+  EXPECT_GT(normals, 0u);
+  EXPECT_EQ(normalDiff, 0u) << label;
   // The rays must exercise the scene: hits of several instances, and misses.
   EXPECT_GT(hits, rays.size() / 8);
   EXPECT_LT(hits, rays.size());
@@ -358,6 +378,13 @@ TEST(GpuScene, UpdateRefusesForeignFieldsAndUncommittedScenes) {
   s = gpu->update(scene);
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.error().code, Code::kInvalidArgument);  // field 2 was not uploaded
+  // The fields fit the context one by one, but not together in one texture.
+  gl::LoadOptions few;
+  few.maxLayers = f.files[0].layout().sliceCount + f.files[1].layout().sliceCount - 1;
+  auto tooMany = gl::loadScene(two, few);
+  ASSERT_FALSE(tooMany.ok());
+  EXPECT_EQ(tooMany.error().code, Code::kUnsupported);
+  EXPECT_NE(tooMany.error().message.find("GL_MAX_ARRAY_TEXTURE_LAYERS"), std::string::npos) << tooMany.error().message;
   std::vector<gl::SceneField> twice = {two[0], two[0]};
   auto dup = gl::loadScene(twice);
   ASSERT_FALSE(dup.ok());
