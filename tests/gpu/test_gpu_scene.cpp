@@ -391,6 +391,37 @@ TEST(GpuScene, UpdateRefusesForeignFieldsAndUncommittedScenes) {
   EXPECT_EQ(dup.error().code, Code::kInvalidArgument);
 }
 
+TEST(GpuScene, EmptySceneMissesEverything) {
+  VFF_REQUIRE_GL();
+  const Fields f = bakeFields();
+  ASSERT_EQ(f.queries.size(), 3u);
+  Scene full;
+  std::mt19937 rng(7u);
+  place(&full, f, rng, true);
+  auto gpu = gl::loadScene(sceneFields(f));
+  ASSERT_TRUE(gpu.ok()) << gpu.error().toString();
+  const Scene empty;  // never touched: committed, no instances
+  ASSERT_TRUE(gpu->update(empty).ok());
+  EXPECT_EQ(gpu->instanceCount(), 0u);
+  const GLuint prog = buildSceneProgram("", kMain);
+  ASSERT_NE(prog, 0u);
+  // Rays that hit the full scene's instances miss the empty one.
+  const std::vector<GpuRay> rays = makeRays(full, 256, 13);
+  const std::vector<GpuOut> g = runRays(*gpu, prog, rays);
+  uint32_t answered = 0;
+  for (const GpuOut& o : g)
+    answered += o.nearestHit != 0 || o.occluded != 0 || o.interpHit != 0 || o.visibility != 1.0f ||
+                o.nearestInstance != kNoInstance;
+  EXPECT_EQ(answered, 0u);
+  // And the full scene again after it: the same buffers grow back.
+  ASSERT_TRUE(gpu->update(full).ok());
+  const std::vector<GpuOut> g2 = runRays(*gpu, prog, rays);
+  uint32_t hits = 0;
+  for (const GpuOut& o : g2) hits += o.nearestHit != 0;
+  EXPECT_GT(hits, 0u);
+  glDeleteProgram(prog);
+}
+
 TEST(GpuScene, GroundAoMatchesCpuScene) {
   VFF_REQUIRE_GL();
   const Fields f = bakeFields();

@@ -44,7 +44,8 @@
 // answers in id order: the one-ray answers, in the time of a few large batches when instances are
 // few and rays many. The one-ray functions walk the hierarchy nearest first and stop early
 // (intersect: at the nearest hit; occluded: at the first). An Embree renderer can instead hand
-// the top level to Embree (vff/embree.h); vff-experiments scene-bench measures both.
+// the top level to Embree (vff/embree.h); vff-experiments scene-bench measures both. A GPU walks
+// the same hierarchy, exported by hierarchy(): gpu/glsl/vff_scene.glsl, vff/gl/scene_loader.h.
 //
 // Threads. The query functions are const and may run on many threads at once; add(),
 // setTransform() and commit() must not run while any query does.
