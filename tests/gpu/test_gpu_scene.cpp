@@ -47,7 +47,9 @@ constexpr double kVisEps = 1e-4;
 constexpr double kNormalEps = 1e-5;  // world normals, per component (the single-field bound)
 constexpr double kMaxDifferingShare = 0.005;
 
-// One ray per invocation: the four scene queries.
+// One ray per invocation: the four scene queries (vffSceneIntersect kNearest and kInterpolated,
+// vffSceneOccluded, vffSceneVisibility), through their common walk, called from a loop whose
+// count is a uniform (4) so that the driver compiles the walk once, not four times.
 const char* kMain = R"(
 layout(local_size_x = 64) in;
 struct TestRay { vec4 origin; vec4 direction; vec4 range; };  // range: tmin, tmax, intraBias
@@ -56,22 +58,34 @@ struct TestOut { uint nearestHit; float nearestT; uint nearestInstance; uint occ
                  vec4 normal; };  // normal: the kNearest hit's world normal, w = hasNormal
 layout(std430, binding = 8) readonly buffer TestRays { TestRay rays[]; };
 layout(std430, binding = 9) writeonly buffer TestOuts { TestOut outs[]; };
+layout(location = 0) uniform int queries;
 void main() {
   uint id = gl_GlobalInvocationID.x;
   if (id >= uint(rays.length())) return;
   TestRay r = rays[id];
-  VffSceneHit a = vffSceneIntersect(r.origin.xyz, r.direction.xyz, r.range.x, r.range.y, r.range.z, false);
-  VffSceneHit b = vffSceneIntersect(r.origin.xyz, r.direction.xyz, r.range.x, r.range.y, r.range.z, true);
   TestOut o;
-  o.nearestHit = a.hit ? 1u : 0u;
-  o.nearestT = a.t;
-  o.nearestInstance = a.instance;
-  o.occluded = vffSceneOccluded(r.origin.xyz, r.direction.xyz, r.range.x, r.range.y, r.range.z, false) ? 1u : 0u;
-  o.interpHit = b.hit ? 1u : 0u;
-  o.interpT = b.t;
-  o.interpInstance = b.instance;
-  o.visibility = vffSceneVisibility(r.origin.xyz, r.direction.xyz, r.range.x, r.range.y, r.range.z, true);
-  o.normal = vec4(a.normal, a.hasNormal ? 1.0 : 0.0);
+  for (int q = 0; q < queries; ++q) {
+    // q: 0 intersect kNearest (vffSceneIntersect), 1 intersect kInterpolated, 2 occluded
+    // (vffSceneOccluded), 3 visibility kInterpolated (vffSceneVisibility).
+    uint mode = q < 2 ? VFF_SCENE_INTERSECT : (q == 2 ? VFF_SCENE_OCCLUDED : VFF_SCENE_VISIBILITY);
+    float v;
+    VffSceneHit h = vffSceneWalk(r.origin.xyz, r.direction.xyz, r.range.x, r.range.y, r.range.z, q == 1 || q == 3,
+                                 mode, v);
+    if (q == 0) {
+      o.nearestHit = h.hit ? 1u : 0u;
+      o.nearestT = h.t;
+      o.nearestInstance = h.instance;
+      o.normal = vec4(h.normal, h.hasNormal ? 1.0 : 0.0);
+    } else if (q == 1) {
+      o.interpHit = h.hit ? 1u : 0u;
+      o.interpT = h.t;
+      o.interpInstance = h.instance;
+    } else if (q == 2) {
+      o.occluded = h.hit ? 1u : 0u;
+    } else {
+      o.visibility = v;
+    }
+  }
   outs[id] = o;
 }
 )";
@@ -205,6 +219,7 @@ std::vector<GpuOut> runRays(const gl::GpuScene& gpu, GLuint program, const std::
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, bufs[1]);
   gpu.bind();
   glUseProgram(program);
+  glUniform1i(0, 4);
   glDispatchCompute(GLuint((rays.size() + 63) / 64), 1, 1);
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
   glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
