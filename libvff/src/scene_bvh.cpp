@@ -235,4 +235,53 @@ void Bvh4::build(const std::vector<Box>& boxes) {
   }
 }
 
+void Bvh4::collect(std::span<const BoxRay> rays, RayLists* out) const {
+  out->prim.clear();
+  out->first.clear();
+  out->count.clear();
+  out->rays.clear();
+  if (nodes_.empty() || rays.empty()) return;
+  std::vector<uint32_t>& arena = out->arena;
+  const uint32_t n = uint32_t(rays.size());
+  if (arena.size() < n) arena.resize(n);
+  for (uint32_t r = 0; r < n; ++r) arena[r] = r;
+  out->stack.assign(1, {0, 0, n});
+  while (!out->stack.empty()) {
+    const RayLists::Item it = out->stack.back();
+    out->stack.pop_back();
+    // Depth first: everything in the arena above this item's rays belongs to items already done.
+    const uint32_t m = it.end - it.begin;
+    const size_t base = it.end;
+    if (arena.size() < base + 4 * size_t(m)) arena.resize(base + 4 * size_t(m));
+    const uint32_t* in = arena.data() + it.begin;
+    uint32_t* list = arena.data() + base;  // child c's rays at list[c * m ...]
+    const Node4& node = nodes_[it.node];
+    uint32_t count[4] = {0, 0, 0, 0};
+    float entry[4];
+    for (uint32_t i = 0; i < m; ++i) {
+      const uint32_t r = in[i];
+      const unsigned mask = hitNode4(node, rays[r], rays[r].tmax, entry) & node.valid;
+      for (uint32_t c = 0; c < 4; ++c) {  // no branch per child: the masks are random bits
+        list[c * m + count[c]] = r;
+        count[c] += (mask >> c) & 1u;
+      }
+    }
+    for (uint32_t c = 0; c < 4; ++c) {
+      if (count[c] == 0) continue;
+      const uint32_t begin = uint32_t(base + c * size_t(m));
+      if (node.count[c] == 0) {
+        out->stack.push_back({node.child[c], begin, begin + count[c]});
+        continue;
+      }
+      const uint32_t at = uint32_t(out->rays.size());
+      out->rays.insert(out->rays.end(), list + size_t(c) * m, list + size_t(c) * m + count[c]);
+      for (uint32_t i = 0; i < node.count[c]; ++i) {
+        out->prim.push_back(prims_[node.child[c] + i]);
+        out->first.push_back(at);
+        out->count.push_back(count[c]);
+      }
+    }
+  }
+}
+
 }  // namespace vff::detail

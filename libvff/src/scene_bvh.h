@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -33,6 +34,18 @@ struct BoxRay {
 
 BoxRay boxRay(const Ray& ray) noexcept;
 
+// What Bvh4::collect finds for a batch of rays: call c says that the rays
+// rays[first[c], first[c] + count[c]) (indices into the batch, ascending) reach primitive prim[c];
+// each primitive reached by any ray has one call. The rest is working space kept between batches.
+struct RayLists {
+  std::vector<uint32_t> prim, first, count, rays;
+  struct Item {
+    uint32_t node, begin, end;  // a node and its rays: arena[begin, end)
+  };
+  std::vector<uint32_t> arena;
+  std::vector<Item> stack;
+};
+
 class Bvh4 {
  public:
   static constexpr int kMaxDepth = 96;
@@ -48,6 +61,11 @@ class Bvh4 {
   // value to see everything); a negative value stops the walk.
   template <class Visit>
   void walk(const BoxRay& r, Visit&& visit) const;
+  // For a batch of rays, what walk() visits for each with a visit that never lowers tmax, found
+  // for all of them at once: the batch goes down the tree as a stream, each node testing the rays
+  // that reached it against its four boxes, so that a node is read once for the batch and no ray
+  // keeps a stack of its own.
+  void collect(std::span<const BoxRay> rays, RayLists* out) const;
 
  private:
   std::vector<Node4> nodes_;

@@ -4,8 +4,9 @@
 // For each instance count (--instances, default 1, 10, 100, 1000, 10000), N copies of the object
 // (one baked field, shared) stand at random in a cube whose volume grows with N (a constant
 // density: neighbours within a few R). Each of --frames frames gives every instance a new random
-// rotation and position, then casts the same number of AO rays (--scene-rays): each from a random
-// instance, 1.05 R to 2 R from its centre, cosine-weighted around the outward direction, range
+// rotation and position, then casts the same number of AO rays (--scene-rays), as a renderer's
+// AO pass does: each from a random point of a random instance's surface (area-weighted, lifted
+// 1e-3 R along the face normal), cosine-weighted around that normal, range
 // aoDistance * R; every side answers occluded for each. Per frame and side, the rebuild (new
 // transforms and commit) and the rays are timed separately:
 //   (a) exact: Embree 3 instancing, the mesh's scene under N instance geometries; rtcOccluded1
@@ -48,6 +49,38 @@ vff::RigidTransform randomPlacement(std::mt19937_64& g, float side) {
   const float angle = 2 * kPi * u(g);
   return vff::RigidTransform::fromAxisAngle(axis, angle, {side * u(g), side * u(g), side * u(g)});
 }
+
+// Points on the object's surface, area-weighted, with their face normals: in the object's frame
+// centred on its sphere.
+class SurfaceSampler {
+ public:
+  SurfaceSampler(const vff::bake::Mesh& m, const float center[3]) : m_(m) {
+    for (int a = 0; a < 3; ++a) c_[a] = center[a];
+    double sum = 0;
+    cdf_.reserve(m.triangleCount());
+    for (size_t t = 0; t < m.triangleCount(); ++t) {
+      sum += double(length(cross(vertex(t, 1) - vertex(t, 0), vertex(t, 2) - vertex(t, 0))));
+      cdf_.push_back(sum);
+    }
+  }
+  // A point and its unit face normal from three uniform numbers.
+  std::pair<Vec3, Vec3> sample(float u0, float u1, float u2) const {
+    const size_t t = std::min(cdf_.size() - 1, size_t(std::lower_bound(cdf_.begin(), cdf_.end(), double(u0) * cdf_.back()) -
+                                                      cdf_.begin()));
+    const float su = std::sqrt(u1);
+    const Vec3 a = vertex(t, 0), b = vertex(t, 1), c = vertex(t, 2);
+    return {a * (1 - su) + b * (su * (1 - u2)) + c * (su * u2), normalize(cross(b - a, c - a))};
+  }
+
+ private:
+  Vec3 vertex(size_t t, int k) const {
+    const float* p = &m_.positions[3 * size_t(m_.indices[3 * t + size_t(k)])];
+    return {p[0] - c_[0], p[1] - c_[1], p[2] - c_[2]};
+  }
+  const vff::bake::Mesh& m_;
+  float c_[3];
+  std::vector<double> cdf_;
+};
 
 struct Side {
   double commit = 0, rays = 0;  // seconds, summed over frames
@@ -94,7 +127,9 @@ int runSceneBench(const Options& o) {
     f.translation = x.translation - x.toWorldVector(toVec(s.center));
     return f;
   };
-  const vff::QueryOptions qo{.reconstruction = vff::Reconstruction::kNearest, .intraBias = 0.0f};
+  // The field's default intra bias: the rays start on the objects' surfaces.
+  const vff::QueryOptions qo{.reconstruction = vff::Reconstruction::kNearest};
+  const SurfaceSampler surface(world.objectMesh, s.center);
 
   std::printf("Scene benchmark: %s (%zu triangles), field %s, %u AO rays per frame (range %.1f R), %d frames, %u "
               "threads, %s\n\n",
@@ -130,9 +165,12 @@ int runSceneBench(const Options& o) {
       std::uniform_real_distribution<float> u(0, 1);
       for (auto& r : rays) {
         const vff::RigidTransform& x = placement[std::min(n - 1, uint32_t(u(g) * float(n)))];
-        const Vec3 out = uniformSphere(u(g), u(g));
-        r.origin = x.translation + out * (R * (1.05f + 0.95f * u(g)));
-        r.direction = cosineDirection(out, u(g), u(g));
+        const float u0 = u(g), u1 = u(g), u2 = u(g);
+        const auto [point, normal] = surface.sample(u0, u1, u2);
+        const Vec3 wn = x.toWorldVector(normal);
+        r.origin = x.toWorldPoint(point) + wn * (1e-3f * R);
+        const float u3 = u(g), u4 = u(g);
+        r.direction = cosineDirection(wn, u3, u4);
         r.tmin = 0;
         r.tmax = o.aoDistance * R;
       }
