@@ -220,6 +220,8 @@ vff::Status writePng(const Image& image, const std::string& path);
 vff::Status writeExr(const Image& image, const std::string& path);
 // |a - b| on the 8-bit scale, times `gain`, through a black-red-yellow-white ramp; pixels outside
 // the mask are dark grey.
+// The images side by side, left to right (all of the first one's height).
+Image sideBySide(const std::vector<Image>& images);
 vff::Status writeErrorMap(const Image& reference, const Image& image, const std::vector<uint8_t>& mask,
                           float gain, const std::string& path);
 
