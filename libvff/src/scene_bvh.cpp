@@ -5,11 +5,6 @@
 #include <cmath>
 #include <limits>
 
-#if defined(__SSE2__) || defined(_M_X64)
-#include <emmintrin.h>
-#define VFF_SCENE_SSE2 1
-#endif
-
 namespace vff::detail {
 namespace {
 
@@ -139,34 +134,6 @@ BoxRay boxRay(const Ray& ray) noexcept {
   }
   r.tmax = ray.tmax;
   return r;
-}
-
-unsigned hitNode4(const Node4& n, const BoxRay& r, float tmax, float entry[4]) noexcept {
-#if VFF_SCENE_SSE2
-  __m128 tn = _mm_setzero_ps(), tf = _mm_set1_ps(tmax);
-  for (int a = 0; a < 3; ++a) {
-    const __m128 o = _mm_set1_ps(r.origin[a]), inv = _mm_set1_ps(r.inv[a]);
-    const __m128 t1 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.lo[a]), o), inv);
-    const __m128 t2 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.hi[a]), o), inv);
-    tn = _mm_max_ps(tn, _mm_min_ps(t1, t2));
-    tf = _mm_min_ps(tf, _mm_max_ps(t1, t2));
-  }
-  _mm_storeu_ps(entry, tn);
-  return unsigned(_mm_movemask_ps(_mm_cmple_ps(tn, tf)));
-#else
-  unsigned mask = 0;
-  for (int c = 0; c < 4; ++c) {
-    float tn = 0, tf = tmax;
-    for (int a = 0; a < 3; ++a) {
-      const float t1 = (n.lo[a][c] - r.origin[a]) * r.inv[a], t2 = (n.hi[a][c] - r.origin[a]) * r.inv[a];
-      tn = std::max(tn, std::min(t1, t2));
-      tf = std::min(tf, std::max(t1, t2));
-    }
-    entry[c] = tn;
-    if (tn <= tf) mask |= 1u << c;
-  }
-  return mask;
-#endif
 }
 
 void Bvh4::build(const std::vector<Box>& boxes) {
