@@ -1,10 +1,7 @@
 // merge.cpp - vff-bake --merge: partial results (spec/partial.md) checked against each other and
 // assembled into the whole field. The maps go through the same Writer with the same field, options
 // and META as the whole bake, so the bytes are the whole bake's by construction.
-#include <unistd.h>
-
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <cstring>
 
@@ -71,17 +68,24 @@ std::optional<int> openPart(const std::string& path, std::vector<Part>* parts) {
   return std::nullopt;
 }
 
-// The field description and layout as text, for comparing parts and saying how they differ.
-std::string describe(const FieldDesc& f, const LayoutDesc& l) {
-  char sphere[96];
-  std::snprintf(sphere, sizeof sphere, "sphere %a %a %a r %a", double(f.sphere.center[0]), double(f.sphere.center[1]),
-                double(f.sphere.center[2]), double(f.sphere.radius));
-  return std::string(sphere) + ", positions " + positionSchemeName(f.positionScheme) + " " +
-         std::to_string(f.positionParam) + ", directions " + directionSchemeName(f.directionScheme) + ", map size " +
-         std::to_string(f.mapResolution) + ", encoding " + distanceEncodingName(f.distanceEncoding) + ", normals " +
-         (f.normalEncoding == NormalEncoding::kNone ? "no" : "yes") + ", layout " + layoutTargetName(l.target) +
-         " gutter " + std::to_string(l.gutter) + " max texture " + std::to_string(l.maxTextureSize) + " max layers " +
-         std::to_string(l.maxLayers);
+// The field description and layout, item by item, for comparing parts and saying how they differ.
+std::vector<std::pair<std::string, std::string>> describe(const FieldDesc& f, const LayoutDesc& l) {
+  char sphere[128], exact[128];  // 9 digits tell a float apart; %a shows every bit
+  std::snprintf(sphere, sizeof sphere, "centre %.9g %.9g %.9g radius %.9g", double(f.sphere.center[0]),
+                double(f.sphere.center[1]), double(f.sphere.center[2]), double(f.sphere.radius));
+  std::snprintf(exact, sizeof exact, "centre %a %a %a radius %a", double(f.sphere.center[0]),
+                double(f.sphere.center[1]), double(f.sphere.center[2]), double(f.sphere.radius));
+  return {{"sphere", sphere},
+          {"sphere", exact},
+          {"positions", std::string(positionSchemeName(f.positionScheme)) + " " + std::to_string(f.positionParam)},
+          {"directions", directionSchemeName(f.directionScheme)},
+          {"map size", std::to_string(f.mapResolution)},
+          {"encoding", distanceEncodingName(f.distanceEncoding)},
+          {"normals", normalEncodingName(f.normalEncoding)},
+          {"layout target", layoutTargetName(l.target)},
+          {"gutter", std::to_string(l.gutter)},
+          {"max texture size", std::to_string(l.maxTextureSize)},
+          {"max layers", std::to_string(l.maxLayers)}};
 }
 
 // The first key (one level into objects) where two META objects differ, or "".
@@ -117,8 +121,11 @@ std::optional<int> checkSameBake(const Part& p, const Part& q) {
   if (at(p.meta, version) != at(q.meta, version))
     return refuse(p.path, "different versions: baked by vff-bake " + at(p.meta, version) + ", but " + q.path +
                               " by " + at(q.meta, version));
-  const std::string a = describe(p.file.field(), p.file.layout()), b = describe(q.file.field(), q.file.layout());
-  if (a != b) return refuse(p.path, "different options: " + a + "; but " + q.path + ": " + b);
+  const auto a = describe(p.file.field(), p.file.layout()), b = describe(q.file.field(), q.file.layout());
+  for (size_t i = 0; i < a.size(); ++i)
+    if (a[i].second != b[i].second)
+      return refuse(p.path, "different options: " + a[i].first + " " + a[i].second + ", but " + q.path + " has " +
+                                b[i].second);
   for (const char* k : {"codec", "zstdLevel", "mapsPerBlock"})
     if (p.partial[k] != q.partial[k])
       return refuse(p.path, std::string("different options: ") + k + " " + p.partial[k].dump() + ", but " + q.path +
