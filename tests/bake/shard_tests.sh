@@ -9,11 +9,12 @@
 #   VFF_BAKE     the vff-bake executable
 #   VFF_INSPECT  the vff-inspect executable
 #   MESHGEN      the vff-procedural-mesh executable
+#   VFF_QUERY    the vff-query executable (a partial result answers no rays)
 #   EDIT         vff_shard_edit: a copy of a file with one META value changed (shard_edit.cpp)
 #   MESHES       the shared meshes' folder (test_shared_mesh skips without it)
 #   WORK         a scratch folder of this test (emptied first)
 set -euo pipefail
-: "${VFF_BAKE:?}" "${VFF_INSPECT:?}" "${MESHGEN:?}" "${EDIT:?}" "${WORK:?}"
+: "${VFF_BAKE:?}" "${VFF_INSPECT:?}" "${MESHGEN:?}" "${EDIT:?}" "${VFF_QUERY:?}" "${WORK:?}"
 
 here="$(dirname "${BASH_SOURCE[0]}")"
 source "$here/../common/cli_harness.sh"
@@ -104,6 +105,10 @@ test_partial_is_valid_and_says_so() {
   expect_out '"zstdLevel": 5'
   run "$VFF_INSPECT" "$WORK/p.vff"
   expect_out 'partial:    maps 10:30 of 82 only'
+  # a partial result answers no rays: its other maps are not the field's
+  run "$VFF_QUERY" "$WORK/p.vff" --ray 0 0 5 0 0 -1
+  expect_rc 5
+  expect_err "p.vff: unsupported (9005): the file is a partial result"
   # the maps outside the range are misses: the partial's hits are those of its range in the whole
   bake "$WORK/knot.obj" -o "$WORK/w.vff" "${small[@]}"
   bake "$WORK/knot.obj" -o "$WORK/r.vff" "${small[@]}" --map-range 0:82
