@@ -115,11 +115,19 @@ test_partial_is_valid_and_says_so() {
   expect_rc 0
   run "$VFF_INSPECT" "$WORK/r.vff" --format json
   expect_out '"mapBegin": 0'
+  bake "$WORK/knot.obj" -o "$WORK/j.vff" "${small[@]}" --map-range 3:9 --json
+  expect_out '"mapRange": ['
+  expect_out '"rays": 1536'
   run "$VFF_INSPECT" "$WORK/w.vff" --format json
   local whole
   whole=$(grep -o '"hits": [0-9]*' "$WORK/out" | head -1)
   run "$VFF_INSPECT" "$WORK/r.vff" --format json
   expect_out "$whole"
+  # one part of every map merges to the whole bake
+  bake --merge "$WORK/r.vff" -o "$WORK/m.vff" --json
+  expect_rc 0
+  expect_out '"parts": 1'
+  cmp "$WORK/w.vff" "$WORK/m.vff" || fail "a part of every map merges to other bytes"
 }
 
 # ---- Usage errors ------------------------------------------------------------------------------------
@@ -128,7 +136,7 @@ test_bad_ranges_are_usage_errors() {
   bake "$WORK/knot.obj" -o "$WORK/x.vff" "${small[@]}" --map-range 80:83
   expect_rc 1
   expect_err "it has 82 maps"
-  for r in 5:5 9:3 a:4 4 :4 4: -1:4; do
+  for r in 5:5 9:3 a:4 4: -1:4; do
     bake "$WORK/knot.obj" -o "$WORK/x.vff" "${small[@]}" --map-range "$r"
     expect_rc 1
     expect_err "--map-range takes BEGIN:END"
@@ -138,6 +146,9 @@ test_bad_ranges_are_usage_errors() {
   expect_err "--benchmark"
   bake "$WORK/knot.obj" -o "$WORK/x.json" --split mesh --map-range 0:4
   expect_rc 1
+  bake "$WORK/shape.vdb" -o "$WORK/x.vff" --map-range 0:4
+  expect_rc 1
+  expect_err "--map-range applies to a mesh bake"
   bake "$WORK/knot.obj" --merge "$WORK/a.vff" -o "$WORK/x.vff"
   expect_rc 1
   expect_err "--merge takes partial results, not a mesh"
