@@ -155,8 +155,15 @@ test_bad_ranges_are_usage_errors() {
   bake --merge "$WORK/a.vff" "$WORK/b.vff" -o "$WORK/x.vff" --codec zstd
   expect_rc 1
   expect_err "--codec does not apply"
+  bake "$WORK/knot.obj" -o "$WORK/a.vff" "${small[@]}" --map-range 0:82
+  expect_rc 0
+  cp "$WORK/a.vff" "$WORK/a.copy"
   bake --merge "$WORK/a.vff" -o "$WORK/a.vff"
   expect_rc 1
+  expect_err "is also a part to merge"
+  bake --merge "$WORK/a.vff" -o "$WORK/../$(basename "$WORK")/a.vff"
+  expect_rc 1
+  cmp "$WORK/a.vff" "$WORK/a.copy" || fail "the part was changed"
   bake --merge "$WORK/a.vff"
   expect_rc 1
   expect_err "-o FILE"

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 
 #include "bake.h"
 #include "cli.h"
@@ -177,8 +178,9 @@ Status copyMaps(const Part& p, Plane plane, Writer& w) {
 }  // namespace
 
 int mergeParts(const Options& o) {
+  std::error_code ec;
   for (const std::string& path : o.merge)
-    if (path == o.output) {
+    if (path == o.output || std::filesystem::equivalent(path, o.output, ec)) {
       cli::usageError(kProg, "-o " + o.output + " is also a part to merge: write the whole field elsewhere");
       return cli::kExitUsage;
     }
