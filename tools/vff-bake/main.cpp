@@ -5,9 +5,11 @@
 //   vff-bake mesh.obj --benchmark           Embree's raw throughput on the bake's rays vs the bake
 //   vff-bake shape.vdb -o f.vff [--grid NAME]   from an OpenVDB level set (vff/bake/levelset.h)
 //   vff-bake scene.glb --split mesh -o s.vffscene.json   a field per mesh and a scene description
+//   vff-bake mesh.obj -o p0.vff --map-range 0:2113      a partial result: maps [0, 2113) only
+//   vff-bake --merge p1.vff p0.vff -o field.vff         the partial results assembled (spec/partial.md)
 //
 // options.cpp reads the command line, mesh_bake.cpp, split_bake.cpp and levelset_bake.cpp bake, common.cpp holds
-// what the two bakes share (bake.h).
+// what the two bakes share, partial.cpp and merge.cpp the partial results (bake.h).
 #include "bake.h"
 #include "cli.h"
 
@@ -18,10 +20,20 @@ int main(int argc, char** argv) {
                "OpenVDB level set (rays intersected with its zero crossing, normals from its gradient).\n"
                "Inputs: .obj .ply .off .stl (OpenMesh), .gltf .glb (tinygltf), .vdb (OpenVDB: the first float\n"
                "grid of class level set by name, as vdb_print lists them, or --grid NAME; default sphere: the\n"
-               "one around the active voxels' bounding box).\n" +
+               "one around the active voxels' bounding box).\n"
+               "One field across tasks: --map-range BEGIN:END bakes those maps into a partial result; --merge\n"
+               "PART... -o OUT assembles the parts into the whole bake's bytes (spec/partial.md). Merge refusals:\n"
+               "gaps, overlaps, other geometry, options or version, a corrupt part: exit 3.\n" +
                vff::cli::exitCodeHelp()};
   addOptions(app, o);
   if (auto rc = vff::cli::parse(app, kProg, argc, argv)) return *rc;
+  if (!o.merge.empty()) {
+    if (auto problem = checkMergeOptions(app)) {
+      vff::cli::usageError(kProg, *problem);
+      return vff::cli::kExitUsage;
+    }
+    return mergeParts(o);
+  }
   if (auto problem = checkOptions(o)) {
     vff::cli::usageError(kProg, *problem);
     return vff::cli::kExitUsage;

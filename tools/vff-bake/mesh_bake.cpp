@@ -92,6 +92,7 @@ void reportMeshBake(const Options& o, const bake::BakeOptions& bo, const bake::M
                   {"seconds", {{"load", m.load}, {"build", m.build}, {"bake", m.bake}, {"write", m.write}}},
                   {"meshMiB", meshMiB},
                   {"bvhMiB", bvhMiB}});
+  if (!o.mapRange.empty()) summary["mapRange"] = {bo.mapBegin, bo.mapEnd};  // the maps baked, [begin, end)
   if (wrote) {
     summary["output"] = o.output;
     summary["fileBytes"] = m.fileBytes;
@@ -107,8 +108,11 @@ void reportMeshBake(const Options& o, const bake::BakeOptions& bo, const bake::M
   } else if (o.benchmark) {
     printBenchmark(o, mesh, field, rays, m, payloadMiB, meshMiB, bvhMiB);
   } else if (!o.quiet) {
-    std::fprintf(stderr, "%s: %s: %u maps of %ux%u (%.0f rays, %.1f%% hits) in %.2f s (%.1f Mrays/s), %.3f MiB payload -> %s\n",
-                 kProg, o.mesh.c_str(), field.mapCount, field.mapResolution, field.mapResolution, rays,
+    const std::string maps = o.mapRange.empty() ? std::to_string(field.mapCount)
+                                                : std::to_string(bo.mapEnd - bo.mapBegin) + " (" + o.mapRange + " of " +
+                                                      std::to_string(field.mapCount) + ")";
+    std::fprintf(stderr, "%s: %s: %s maps of %ux%u (%.0f rays, %.1f%% hits) in %.2f s (%.1f Mrays/s), %.3f MiB payload -> %s\n",
+                 kProg, o.mesh.c_str(), maps.c_str(), field.mapResolution, field.mapResolution, rays,
                  100.0 * double(s.hits) / rays, m.bake, rays / m.bake / 1e6, payloadMiB, o.output.c_str());
   }
 }
@@ -191,10 +195,21 @@ int bakeFromMesh(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
   if (auto rc = checkPlan(field, wo.layout, &m.payload)) return *rc;
   bool clipped = false;
   if (auto rc = checkUserSphere(o, bo, *mesh, &clipped)) return *rc;
+  std::optional<MapRange> range;
+  if (!o.mapRange.empty()) {
+    range = parseMapRange(o.mapRange);  // checkOptions made sure it parses
+    if (auto rc = checkMapRange(*range, field->mapCount)) return *rc;
+    bo.mapBegin = range->begin;
+    bo.mapEnd = range->end;
+  }
 
   // The writer creates its temporary file now, so an unwritable destination fails before baking.
   std::optional<Writer> writer;
   wo.metadataJson = meshMetadata(o, bo, *mesh, info, clipped);
+  if (range) {
+    wo.metadataJson = partialMetadata(wo.metadataJson, wo, *range, field->mapCount);
+    wo = partialWriteOptions(wo);
+  }
   if (!o.output.empty()) {
     removeStaleTemporaries(o.output);
     auto w = Writer::create(o.output, *field, wo);
@@ -210,8 +225,11 @@ int bakeFromMesh(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
 
   std::optional<bake::BakedField> baked;
   if (auto rc = traceAndBake(o, bo, *scene, &m, &baked)) return *rc;
-  if (writer)
+  if (writer && range) {
+    if (auto rc = writePartial(o, *writer, *field, *range, *baked, &m.write, &m.fileBytes)) return *rc;
+  } else if (writer) {
     if (auto rc = writeBaked(o, o.output, *writer, *baked, &m.write, &m.fileBytes)) return *rc;
+  }
   reportMeshBake(o, bo, *mesh, *scene, *field, baked->stats, m, writer.has_value());
   return cli::kExitSuccess;
 }
