@@ -9,6 +9,7 @@
 #include <optional>
 #include <thread>
 
+#include "arrays.h"
 #include "bindings.h"
 #include "errors.h"
 
@@ -18,7 +19,7 @@ namespace vff::python {
 
 namespace {
 
-constexpr size_t kChunk = 16384;  // rays per batch call on one thread
+constexpr size_t kChunk = 4096;  // rays per batch call on one thread (its rays and answers stay in L2)
 
 struct PyQuery {
   py::object owner;  // the vff.File whose maps the query borrows
@@ -92,6 +93,15 @@ struct RayBatch {
   unsigned threads = 0;
 
   void fill(size_t first, size_t count, Ray* out) const {
+    if (os0 == 12 && os1 == 4 && ds0 == 12 && ds1 == 4 && !tmin.array && !tmax.array) {
+      // C-order arrays, the usual case: straight loads the compiler can vectorise.
+      const float* po = reinterpret_cast<const float*>(o) + 3 * first;
+      const float* pd = reinterpret_cast<const float*>(d) + 3 * first;
+      for (size_t k = 0; k < count; ++k)
+        out[k] = Ray{{po[3 * k], po[3 * k + 1], po[3 * k + 2]}, {pd[3 * k], pd[3 * k + 1], pd[3 * k + 2]}, tmin.value,
+                     tmax.value};
+      return;
+    }
     for (size_t k = 0; k < count; ++k) {
       const size_t i = first + k;
       auto f = [](const uint8_t* base, py::ssize_t s0, py::ssize_t s1, size_t r, int c) {
@@ -156,9 +166,11 @@ struct Hits {
 // The Hits to fill: `out` when given (its arrays must hold n rays), else new arrays.
 Hits hitsFor(const py::object& out, size_t count) {
   const auto n = py::ssize_t(count);
-  if (out.is_none())
-    return Hits{py::array_t<bool>(n), py::array_t<float>(n), py::array_t<float>({n, py::ssize_t(3)}),
-                py::array_t<float>({n, py::ssize_t(3)}), py::array_t<bool>(n)};
+  if (out.is_none()) {
+    const ArrayBlock block({count, 4 * count, 12 * count, 12 * count, count});
+    return Hits{block.array<bool>(0, {n}), block.array<float>(1, {n}), block.array<float>(2, {n, 3}),
+                block.array<float>(3, {n, 3}), block.array<bool>(4, {n})};
+  }
   if (!py::isinstance<Hits>(out)) throw py::type_error("out: expected a vff.Hits from an earlier intersect()");
   Hits h = out.cast<Hits>();
   if (h.hit.size() != n)
@@ -195,7 +207,7 @@ Hits intersectBatch(const Target& target, const RayBatch& b, const py::object& r
 
 template <class Target>
 py::array_t<bool> occludedBatch(const Target& target, const RayBatch& b) {
-  py::array_t<bool> out(py::ssize_t(b.n));
+  py::array_t<bool> out = ArrayBlock({b.n}).array<bool>(0, {py::ssize_t(b.n)});
   uint8_t* dst = reinterpret_cast<uint8_t*>(out.mutable_data());
   const QueryOptions qo = b.options;
   parallel(b, [&](size_t first, std::span<const Ray> rays) {
@@ -207,7 +219,7 @@ py::array_t<bool> occludedBatch(const Target& target, const RayBatch& b) {
 
 template <class Target>
 py::array_t<float> visibilityBatch(const Target& target, const RayBatch& b) {
-  py::array_t<float> out(py::ssize_t(b.n));
+  py::array_t<float> out = ArrayBlock({4 * b.n}).array<float>(0, {py::ssize_t(b.n)});
   float* dst = out.mutable_data();
   const QueryOptions qo = b.options;
   parallel(b, [&](size_t first, std::span<const Ray> rays) {

@@ -36,7 +36,7 @@ using namespace vff;
 using namespace vff::query_tool;
 
 constexpr const char* kProg = "vff-query";
-constexpr size_t kChunk = 16384;  // rays per batch call on one thread
+constexpr size_t kChunk = 4096;  // rays per batch call on one thread (its rays and answers stay in L2)
 
 struct Options {
   std::string field;
