@@ -10,6 +10,9 @@
 #   accuracy     vff-experiments ao, intra-ao, shadows, reflections: fields against exact casts
 #   compression  vff-compress --benchmark: the hits-med codec against zstd, xz and OpenEXR's
 #   gpu          vff-gpu-bench, where a headless OpenGL 4.3 context opens (it names the renderer)
+#   python       benchmarks/python_query.py, where the Python module is built: a million rays through
+#                vff-query (.npy in and out, end to end) and through the Python batch, each against
+#                the C++ batch on the same rays and field in the same run
 # and writes benchmarks/results/<cpu>-<date>.md (or --out): the machine, the commit, a summary in
 # rounded tables (README.md copies it: python3 benchmarks/report.py readme) and the full output of
 # every command. --quick runs each at a tiny size: a check that the whole chain works, whose
@@ -55,12 +58,12 @@ trap 'rm -rf "$raw"' EXIT
 if ((quick)); then
   config=(-n 8 -m 16) field=290x16x16 expargs=(--size 48 --rays 8 --config 290x16x16)
   benchargs=(--config 290x16x16 --bench-rays 20000 --repeat 1) bakerepeat=1 compressrepeat=1
-  gpuargs=(--size 64 --spp 4)
+  gpuargs=(--size 64 --spp 4) pyargs=(--quick)
 else
   # The paper's configuration: octa-hemi2 n = 32 (4226 maps) of 64 x 64, unorm8-diameter.
   config=(-n 32 -m 64) field=4226x64x64 expargs=()
   benchargs=(--repeat 5) bakerepeat=3 compressrepeat=3
-  gpuargs=()
+  gpuargs=() pyargs=()
 fi
 
 # step NAME COMMAND...: runs COMMAND with its output in $raw/NAME.txt and its command line in
@@ -74,6 +77,7 @@ step() {
   shown="${shown//$raw\//}"
   shown="${shown//$raw/.}"
   shown="${shown//$(dirname "$mesh")\//}"
+  shown="${shown//$root\//}"
   echo "== $name: $shown" >&2
   local t0=$SECONDS
   if ! "$@" >"$raw/$name.txt" 2>"$raw/$name.err"; then
@@ -105,6 +109,16 @@ if [[ -x $gpubench ]]; then
   skip_if="no headless OpenGL" step gpu "$gpubench" --field "$raw/field.vff" "${gpuargs[@]}"
 else
   echo "vff-gpu-bench is not built (no OpenGL or EGL development files)" >"$raw/gpu.skip"
+fi
+
+# The Python batch and vff-query against the C++ batch, with the interpreter the module was built
+# for, where it was built; otherwise the results file says why it did not run.
+python="$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' "$build/CMakeCache.txt" | head -1)"
+if compgen -G "$build/python/vff/_vff*.so" >/dev/null && [[ -x $python && -x $build/tools/vff-query/vff-query ]]; then
+  step python env PYTHONPATH="$build/python" "$python" "$root/benchmarks/python_query.py" --field "$raw/field.vff" \
+    --query "$build/tools/vff-query/vff-query" "${pyargs[@]}"
+else
+  echo "the Python module is not built (VFF_PYTHON=OFF: pybind11-dev, python3-dev or python3-numpy missing)" >"$raw/python.skip"
 fi
 
 # The machine and the build.
