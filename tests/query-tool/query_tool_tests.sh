@@ -160,7 +160,8 @@ test_checksums_policy() {
   expect_rc 1
 }
 
-# A bad row past the first chunk of a large .npy is named by its index, and no output appears.
+# A bad row past the first chunk of a large .npy is named by its index, and no output appears; the
+# rows written chunk by chunk do not depend on the thread count.
 test_npy_bad_row_in_a_later_chunk() {
   has_numpy || { echo "SKIP: python3 with numpy is not installed"; return 0; }
   local f="$VECTORS/u8d-zstd-normals-meta.vff"
@@ -176,6 +177,21 @@ np.save('$WORK/bad.npy', r)"
 import numpy as np
 a = np.load('$WORK/ok-hits.npy')
 assert a.shape == (40000, 12) and (a == a[0]).all() and a[0, 0] == 1, a[:2]" || fail "40000 equal rays, unequal answers"
+  # Random rays over many chunks: the same bytes on one thread as on four.
+  /usr/bin/python3 -c "
+import numpy as np
+rng = np.random.default_rng(3)
+o = rng.uniform(-3, 3, (50000, 3)); d = rng.uniform(0.5, 1.5, (50000, 3)) * np.array([0.5, -1, 2]) - o
+np.save('$WORK/random.npy', np.hstack([o, d]).astype(np.float32))"
+  query "$f" -i "$WORK/random.npy" -o "$WORK/j1.npy" -j 1 --visibility --interpolated
+  expect_rc 0
+  query "$f" -i "$WORK/random.npy" -o "$WORK/j4.npy" -j 4 --visibility --interpolated
+  expect_rc 0
+  cmp -s "$WORK/j1.npy" "$WORK/j4.npy" || fail "the .npy answers depend on the thread count"
+  /usr/bin/python3 -c "
+import numpy as np
+a = np.load('$WORK/j1.npy')
+assert a.shape == (50000, 13) and 1000 < a[:, 0].sum() < 49000, a[:, 0].sum()" || fail "the random rays do not hit and miss"
   query "$f" -i "$WORK/bad.npy" -o "$WORK/bad-hits.npy" -j 3
   expect_rc 3
   expect_err "$WORK/bad.npy: row 33333, column 4: "
