@@ -8,6 +8,29 @@ namespace vff::python {
 
 namespace {
 
+template <class Target>
+py::tuple sitesBatch(const Target& target, const RayBatch& b) {
+  const ArrayBlock block({4 * b.n, 8 * b.n});
+  py::array_t<int32_t> sample = block.array<int32_t>(0, {py::ssize_t(b.n)});
+  py::array_t<int32_t> texel = block.array<int32_t>(1, {py::ssize_t(b.n), py::ssize_t(2)});
+  int32_t* ks = sample.mutable_data();
+  int32_t* ij = texel.mutable_data();
+  const QueryOptions qo = b.options;
+  parallel(b, [&](size_t first, std::span<const Ray> rays) {
+    thread_local std::vector<LookupSite> out;
+    out.resize(rays.size());
+    target.sites(rays, out, qo);
+    for (size_t k = 0; k < rays.size(); ++k) {
+      const LookupSite& s = out[k];
+      const size_t i = first + k;
+      ks[i] = s.valid ? int32_t(s.sample) : -1;
+      ij[2 * i] = s.valid ? int32_t(s.i) : -1;
+      ij[2 * i + 1] = s.valid ? int32_t(s.j) : -1;
+    }
+  });
+  return py::make_tuple(sample, texel);
+}
+
 // The batch and one-ray methods every query class has.
 template <class Py, class Get>
 void addQueries(py::class_<Py>& c, Get get) {
@@ -36,6 +59,17 @@ void addQueries(py::class_<Py>& c, Get get) {
       py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("threads") = 0u,
       (std::string(kBatchDoc) + "\nReturns an (N,) float32 array: the probability that each ray reaches tmax unoccluded "
                                 "(0 or 1 with nearest).").c_str());
+  c.def("sites", [get](const Py& self, const py::object& o, const py::object& d, const py::object& tmin, const py::object& tmax,
+                       bool interpolated, float intraBias, unsigned threads) {
+        return sitesBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, intraBias, threads));
+      },
+      py::arg("origins"), py::arg("directions"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(), py::kw_only(),
+      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("threads") = 0u,
+      (std::string(kBatchDoc) + "\nWhich map and texel answer each ray (libvff's LookupSite, as vff-query's columns "
+                                "sample, i, j): returns (sample, texel), (N,) int32 and (N, 2) int32 [i, j] (texel (i, "
+                                "j) is element [j, i] of File.distances(sample)); -1 for a ray that makes no lookup. "
+                                "The nearest reconstruction reads exactly that texel; the interpolated one centres "
+                                "its blend on it.").c_str());
   c.def("intersect_ray", [get](const Py& self, const py::object& o, const py::object& d, float tmin, float tmax, bool interpolated,
                                float intraBias) {
         return hitTuple(get(self).intersect(Ray{vec3(o, "origin"), vec3(d, "direction"), tmin, tmax}, optionsOf(interpolated, intraBias)));

@@ -89,6 +89,9 @@ class _Queries:
     def visibility(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
                    tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0,
                    threads: int = 0) -> npt.NDArray[np.float32]: ...
+    def sites(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
+              tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0,
+              threads: int = 0) -> Tuple[npt.NDArray[np.int32], npt.NDArray[np.int32]]: ...
     def intersect_ray(self, origin: Vec3, direction: Vec3, tmin: float = 0.0, tmax: float = ..., *,
                       interpolated: bool = False, intra_bias: float = -1.0) -> HitTuple: ...
     def occluded_ray(self, origin: Vec3, direction: Vec3, tmin: float = 0.0, tmax: float = ..., *,

@@ -111,6 +111,14 @@ def test_vff_query_sites_are_the_texels_read():
         assert abs(got[r, 1] * length[r] - (entry[r] + dist)) < 1e-3 * f.radius, r
         checked += 1
     assert checked > 100
+    # The Python batch names the same sites, and one placed instance the same as its field.
+    q = vff.FieldQuery(f)
+    ks, ij = q.sites(o, d, threads=3)
+    assert ks.dtype == np.int32 and ij.shape == (600, 2)
+    assert np.array_equal(ks, got[:, 9].astype(np.int32)) and np.array_equal(ij, got[:, 10:12].astype(np.int32))
+    moved = vff.Instance(q, None, (4, 5, 6), 2.0)
+    mk, mij = moved.sites(o * 2 + np.float32([4, 5, 6]), d, threads=2)
+    assert np.array_equal(mk, ks) and np.array_equal(mij, ij)
 
 
 def test_bounds_layouts_and_threads():
