@@ -12,6 +12,8 @@ Makes `--rays` ambient-occlusion rays about the field (origins on a disc around 
   vff-query    the same command end to end, as a shell runs it (process start, opening the field with
                its checksums, reading the .npy, querying, writing the answers .npy), with the lookup
                sites (the default) and with --no-sites
+  I/O floor    reading the rays file and writing the answers' bytes, through the page cache, in
+               Python: what vff-query's reading and writing cannot beat
   Python       FieldQuery.intersect(origins, directions) on numpy arrays (threads as vff-query's),
                and FieldQuery.occluded for reference
 and prints each in Mrays/s with its ratio to the C++ batch, naming the CPU. Each ratio is the
@@ -63,12 +65,14 @@ def main():
     q = vff.FieldQuery(f)
     o, d = ao_rays(f, a.rays)
     extra = ["--interpolated"] if a.interpolated else []
-    best = {"cpp": 0.0, "cli": 0.0, "nosites": 0.0, "py": 0.0, "reuse": 0.0, "occ": 0.0}
+    best = {"cpp": 0.0, "cli": 0.0, "nosites": 0.0, "floor": 0.0, "py": 0.0, "reuse": 0.0, "occ": 0.0}
     reuse = q.intersect(o, d, interpolated=a.interpolated, threads=a.threads)
     with tempfile.TemporaryDirectory() as tmp:
         rays = os.path.join(tmp, "rays.npy")
         out = os.path.join(tmp, "hits.npy")
         out_nosites = os.path.join(tmp, "hits-no-sites.npy")
+        floor_out = os.path.join(tmp, "floor.bin")
+        answer_bytes = bytes(a.rays * 12 * 4)
         np.save(rays, np.hstack([o, d]))
         base = [a.query, a.field, "-i", rays, "-j", str(a.threads), *extra]
         cmd = base + ["-o", out]
@@ -82,6 +86,15 @@ def main():
             t0 = time.perf_counter()
             subprocess.run(base + ["--no-sites", "-o", out_nosites], check=True)
             best["nosites"] = max(best["nosites"], a.rays / 1e6 / (time.perf_counter() - t0))
+            # The floor under vff-query's I/O: read the rays file and write as many bytes as its
+            # answers (12 float32 columns), through the page cache, and nothing else.
+            t0 = time.perf_counter()
+            with open(rays, "rb") as fin:
+                fin.read()
+            with open(floor_out, "wb") as fout:
+                fout.write(answer_bytes)
+            best["floor"] = max(best["floor"], a.rays / 1e6 / (time.perf_counter() - t0))
+            os.remove(floor_out)
             t0 = time.perf_counter()
             h = q.intersect(o, d, interpolated=a.interpolated, threads=a.threads)
             best["py"] = max(best["py"], a.rays / 1e6 / (time.perf_counter() - t0))
@@ -104,6 +117,8 @@ def main():
     print("| vff-query, .npy in and out, end to end | %.1f | %.2f |" % (best["cli"], best["cli"] / best["cpp"]))
     print("| vff-query --no-sites, .npy in and out, end to end | %.1f | %.2f |" % (
         best["nosites"], best["nosites"] / best["cpp"]))
+    print("| I/O floor: read the rays .npy, write the answers' bytes (no query) | %.1f | %.2f |" % (
+        best["floor"], best["floor"] / best["cpp"]))
     print("| Python FieldQuery.intersect, numpy in and out | %.1f | %.2f |" % (best["py"], best["py"] / best["cpp"]))
     print("| Python FieldQuery.intersect, out= (arrays reused) | %.1f | %.2f |" % (best["reuse"], best["reuse"] / best["cpp"]))
     print("| Python FieldQuery.occluded (a byte per ray out; no C++ baseline here) | %.1f | - |" % best["occ"])
