@@ -134,6 +134,14 @@ test_sites_and_no_sites() {
   query "$f" --ray 9 9 9 1 0 0 --no-sites --format jsonl
   expect_rc 0
   expect_out '{"hit":false,"t":null,"point":null,"normal":null,"inside":false}'
+  # No rays at all: the header names the same columns.
+  printf '# nothing\n' >"$WORK/none.csv"
+  query "$f" -i "$WORK/none.csv" --visibility
+  expect_rc 0
+  [[ $(cat "$WORK/out") == hit,t,x,y,z,nx,ny,nz,inside,sample,i,j,visibility ]] || { show; fail "empty input's header"; }
+  query "$f" -i "$WORK/none.csv" --no-sites
+  expect_rc 0
+  [[ $(cat "$WORK/out") == hit,t,x,y,z,nx,ny,nz,inside ]] || { show; fail "empty input's --no-sites header"; }
   query "$f" --ray 9 9 9 1 0 0 --no-sites -o "$WORK/h.npy"
   expect_rc 0
   if has_numpy; then

@@ -224,7 +224,7 @@ std::optional<size_t> answer(const Target& target, const RaySource& src, const Q
         continue;
       }
       Answers a{std::span<const QueryHit>(hits.data(), n), std::span<const LookupSite>(where.data(), sites ? n : 0),
-                std::span<const float>(vis.data(), visibility ? n : 0)};
+                std::span<const float>(vis.data(), visibility ? n : 0), sites, visibility};
       target.intersect(in, std::span(hits.data(), n), qo);
       if (sites) target.sites(in, std::span(where.data(), n), qo);
       if (visibility) target.visibility(in, std::span(vis.data(), n), qo);
@@ -391,7 +391,7 @@ int run(int argc, char** argv) {
       cli::printError(kProg, label + ": " + badRowMessage(src, *badRow));
       return cli::kExitInvalidFile;
     }
-    const std::vector<uint8_t> out = formatAnswers({hits, where, vis}, format);
+    const std::vector<uint8_t> out = formatAnswers({hits, where, vis, sites, o.visibility}, format);
     if (auto st = cli::writeFileAtomic(o.output, out); !st) return cli::reportError(kProg, "", st.error());
   }
   if (o.timing) {

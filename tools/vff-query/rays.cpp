@@ -164,7 +164,7 @@ ParsedRays parseRayLines(std::string_view text, float tmin, float tmax) {
 }
 
 void answerRows(const Answers& a, float* rows) {
-  const bool vis = !a.visibility.empty(), sites = !a.sites.empty();
+  const bool vis = a.withVisibility, sites = a.withSites;
   const size_t cols = columnCount(sites, vis);
   const float nan = std::numeric_limits<float>::quiet_NaN();
   for (size_t i = 0; i < a.hits.size(); ++i) {
@@ -191,7 +191,7 @@ void answerRows(const Answers& a, float* rows) {
 }
 
 std::vector<uint8_t> formatAnswers(const Answers& a, OutputFormat format) {
-  const bool vis = !a.visibility.empty(), sites = !a.sites.empty();
+  const bool vis = a.withVisibility, sites = a.withSites;
   if (format == OutputFormat::kNpy) {
     const uint64_t cols = columnCount(sites, vis);
     std::vector<float> m(a.hits.size() * cols);

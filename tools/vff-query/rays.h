@@ -53,6 +53,8 @@ struct Answers {
   std::span<const QueryHit> hits;
   std::span<const LookupSite> sites;
   std::span<const float> visibility;
+  bool withSites = true;         // the columns sample, i, j (sites holds one per ray)
+  bool withVisibility = false;   // the column visibility (visibility holds one per ray)
 };
 
 // The .npy rows of answers: kColumnCount floats per ray (hit and inside as 0/1, NaN where there is
