@@ -2,7 +2,7 @@
 //
 //   vff-query bunny.vff --ray 0 0 5 0 0 -1                    one ray (repeatable); CSV on stdout
 //   vff-query bunny.vff < rays.csv --format jsonl            CSV or JSON lines on stdin
-//   vff-query bunny.vff -i rays.npy -o hits.npy              (N, 6) or (N, 8) float32 in, (N, 9) out
+//   vff-query bunny.vff -i rays.npy -o hits.npy              (N, 6) or (N, 8) float32 in, (N, 12) out
 //   vff-query bunny.vff -i rays.csv --interpolated --visibility --rotate 0 1 0 0.5 --translate 2 0 0
 //
 // Every answer is the C++ batch query's (FieldQuery or Instance), split over threads in chunks;
@@ -243,12 +243,13 @@ std::optional<size_t> answer(const Target& target, const RaySource& src, const Q
 int run(int argc, char** argv) {
   Options o;
   CLI::App app{
-      "Answers rays with a visibility field: hit, t, point, normal and whether the origin was inside the\n"
-      "bounding sphere, one line (or .npy row) per ray, in the order given. Rays come from --ray, from\n"
+      "Answers rays with a visibility field: hit, t, point, normal, whether the origin was inside the\n"
+      "bounding sphere and which map and texel answered, one line (or .npy row) per ray, in the order given. Rays come from --ray, from\n"
       "a .npy file, or as text lines (CSV: ox,oy,oz,dx,dy,dz[,tmin,tmax]; JSON: {\"origin\":[..],\n"
       "\"direction\":[..],\"tmin\":..,\"tmax\":..} or [6 or 8 numbers]) from a file or standard input.\n"
       "A bad line is reported as FILE:LINE:COLUMN (exit 3) after the rays before it are answered.\n"
-      "Output columns: hit,t,x,y,z,nx,ny,nz,inside[,visibility] (a miss: t inf, point nan; no normal: nan).\n\n"
+      "Output columns: hit,t,x,y,z,nx,ny,nz,inside,sample,i,j[,visibility] (a miss: t inf, point nan; no\n"
+      "normal: nan; sample, i, j: the map and texel that answered, -1 without a lookup; --no-sites: left out).\n\n"
       "  vff-query field.vff --ray 0 0 5 0 0 -1\n"
       "  vff-query field.vff -i rays.npy -o hits.npy --interpolated\n",
       kProg};
