@@ -25,7 +25,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BEGIN = "<!-- benchmarks:begin: made by `python3 benchmarks/report.py readme`; do not edit -->"
 END = "<!-- benchmarks:end -->"
 STEPS = ["bake", "query", "accuracy-ao", "accuracy-intra-ao", "accuracy-shadows", "accuracy-reflections",
-         "compression", "gpu", "python"]
+         "scene", "triangles", "compression", "gpu", "python"]
 OPTIONAL = ("gpu", "python")  # steps a run leaves out where the machine or the build lacks them
 
 
@@ -157,6 +157,35 @@ def parse_gpu(text):
     return {"gpu": gpu.group(1), "queries": queries}
 
 
+def parse_scene(text):
+    rows = md_rows(text)
+    if len(rows) < 2 or rows[0][0] != "instances":
+        raise ParseError("no scene-bench table")
+    m = re.search(r"(\d+) AO rays per frame.*?(\d+) frames, (\d+) threads", text)
+    if not m:
+        raise ParseError("no 'N AO rays per frame ... F frames, T threads' line")
+    out = {"rays": int(m.group(1)), "frames": int(m.group(2)), "threads": int(m.group(3)), "rows": []}
+    for r in rows[1:]:
+        out["rows"].append({"instances": int(r[0]), "exact": number(r[1]) + number(r[2]),
+                            "scene": number(r[3]) + number(r[4]), "hybrid": number(r[5]) + number(r[6]),
+                            "ab": number(r[7]), "ac": number(r[8]), "agree": number(r[9])})
+    return out
+
+
+def parse_triangles(text):
+    rows = md_rows(text)
+    if len(rows) < 2 or rows[0][0] != "triangles":
+        raise ParseError("no triangle-bench table")
+    m = re.search(r"(\d+) threads", text)
+    out = {"threads": int(m.group(1)) if m else 0, "rows": [], "summary": []}
+    for r in rows[1:]:
+        out["rows"].append({"triangles": int(r[0]), "build": number(r[1]), "bake": number(r[2]),
+                            "surface": (number(r[3]), number(r[4]), number(r[5])),
+                            "aimed": (number(r[6]), number(r[7]), number(r[8]))})
+    out["summary"] = [l.strip() for l in text.splitlines() if l.startswith(("surface rays:", "aimed rays:"))]
+    return out
+
+
 def parse_python(text):
     """benchmarks/python_query.py: the threads and rays, and each path's Mrays/s and ratio."""
     head = re.search(r"^cpu: .*, (\d+) threads, batch kernel (\w+)$", text, re.M)
@@ -170,8 +199,8 @@ def parse_python(text):
                      for r in rows]}
 
 
-PARSERS = {"bake": parse_bake, "query": parse_query, "compression": parse_compression, "gpu": parse_gpu,
-           "python": parse_python}
+PARSERS = {"bake": parse_bake, "scene": parse_scene, "triangles": parse_triangles, "query": parse_query,
+           "compression": parse_compression, "gpu": parse_gpu, "python": parse_python}
 
 
 def parse_step(name, text):
@@ -257,6 +286,33 @@ def gpu_table(g):
     return lines
 
 
+def scene_table(sc):
+    lines = ["| moving instances | Embree instancing, ms/frame | vff::Scene, ms/frame | hybrid (Embree top level), "
+             "ms/frame | vff::Scene / Embree speed-up | hybrid speed-up | answers equal to Embree's |",
+             "|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in sc["rows"]:
+        lines.append(f"| {r['instances']} | {fmt(r['exact'], 1)} | {fmt(r['scene'], 1)} | {fmt(r['hybrid'], 1)} | "
+                     f"{r['ab']:.2f}x | {r['ac']:.2f}x | {100 * r['agree']:.1f}% |")
+    single = next((r["ab"] for r in sc["rows"] if r["instances"] == 1), None)
+    k = next((r["ab"] for r in sc["rows"] if r["instances"] == 1000), None)
+    if single and k:
+        lines += ["", f"At 1000 instances the field scene keeps {k / single:.2f} of the single object's speed-up "
+                      f"({k:.2f}x against {single:.2f}x; target 0.8)."]
+    return lines
+
+
+def triangles_table(t):
+    lines = ["| triangles | surface AO rays: Embree, ns/ray | field, ns/ray | speed-up | aimed rays: Embree, ns/ray | "
+             "field, ns/ray | speed-up |", "|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in t["rows"]:
+        s, a = r["surface"], r["aimed"]
+        lines.append(f"| {r['triangles']} | {fmt(s[0], 1)} | {fmt(s[1], 1)} | {s[2]:.1f}x | {fmt(a[0], 1)} | "
+                     f"{fmt(a[1], 1)} | {a[2]:.1f}x |")
+    if t["summary"]:
+        lines += ["", *[f"- {l}" for l in t["summary"]]]
+    return lines
+
+
 def python_table(p):
     lines = ["| path | Mrays/s | x C++ batch |", "|---|---:|---:|"]
     for r in p["rows"]:
@@ -283,6 +339,14 @@ def sections(machine, steps, heading, queries=None, only=None):
                 *query_header(False), *query_rows(machine, q, False), ""]
     if any(k.startswith("accuracy-") for k in steps):
         out += [f"{heading} Accuracy against exact Embree casts (8-bit scale)", "", *accuracy_table(steps, only), ""]
+    if "scene" in steps:
+        sc = steps["scene"]
+        out += [f"{heading} Scenes: time per frame against moving instances ({sc['rays']} AO rays per frame, "
+                f"{sc['threads']} threads)", "", *scene_table(sc), ""]
+    if "triangles" in steps:
+        t = steps["triangles"]
+        out += [f"{heading} Time per ray against the object's triangle count ({t['threads']} threads)", "",
+                *triangles_table(t), ""]
     if "compression" in steps:
         c = steps["compression"]
         out += [f"{heading} Compression of the distance payload ({c['payload']})", "", *compression_table(c), ""]

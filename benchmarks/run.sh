@@ -8,6 +8,8 @@
 #   bake         vff-bake --benchmark: the whole bake against Embree alone on the bake's rays
 #   query        vff-experiments bench: field queries against Embree and against the memory floor
 #   accuracy     vff-experiments ao, intra-ao, shadows, reflections: fields against exact casts
+#   scene        vff-experiments scene-bench: 1 to 10000 moving instances, Embree instancing vs vff::Scene
+#   triangles    vff-experiments triangle-bench: time per ray from about 10k to 1M triangles
 #   compression  vff-compress --benchmark: the hits-med codec against zstd, xz and OpenEXR's
 #   gpu          vff-gpu-bench, where a headless OpenGL 4.3 context opens (it names the renderer)
 #   python       benchmarks/python_query.py, where the Python module is built: a million rays through
@@ -58,11 +60,14 @@ trap 'rm -rf "$raw"' EXIT
 if ((quick)); then
   config=(-n 8 -m 16) field=290x16x16 expargs=(--size 48 --rays 8 --config 290x16x16)
   benchargs=(--config 290x16x16 --bench-rays 20000 --repeat 1) bakerepeat=1 compressrepeat=1
+  sceneargs=(--config 290x16x16 --instances 1 10 --scene-rays 4096 --frames 1)
+  triangleargs=(--config 290x16x16 --bench-rays 4096 --min-triangles 500 --max-triangles 8000 --repeat 1)
   gpuargs=(--size 64 --spp 4) pyargs=(--quick)
 else
   # The paper's configuration: octa-hemi2 n = 32 (4226 maps) of 64 x 64, unorm8-diameter.
   config=(-n 32 -m 64) field=4226x64x64 expargs=()
   benchargs=(--repeat 5) bakerepeat=3 compressrepeat=3
+  sceneargs=(--frames 5) triangleargs=(--repeat 5)
   gpuargs=() pyargs=()
 fi
 
@@ -101,6 +106,8 @@ step query "$experiments" bench --mesh "$mesh" "${benchargs[@]}"
 for e in ao intra-ao shadows reflections; do
   step "accuracy-$e" "$experiments" "$e" --mesh "$mesh" "${expargs[@]}" -o "$raw/experiments"
 done
+step scene "$experiments" scene-bench --mesh "$mesh" "${sceneargs[@]}"
+step triangles "$experiments" triangle-bench --mesh "$mesh" "${triangleargs[@]}"
 "$bake" "$mesh" -o "$raw/field.vff" "${config[@]}" -q
 step compression "$compress" --benchmark "$raw/field.vff" --repeat "$compressrepeat" --tmp "$raw"
 # The GPU bench where it is built and a headless OpenGL 4.3 context opens; otherwise the results

@@ -1,10 +1,13 @@
-// scene_batch.cpp - vff::Scene's batches (vff/scene.h): the rays of a chunk are sorted by the
-// instances whose spheres they reach, each instance answers its rays through its batch path, and
-// the answers are combined per ray in id order (as the one-ray functions and the loop over
-// instances do).
+// scene_batch.cpp - vff::Scene's batches (vff/scene.h). The rays of a chunk are paired with the
+// instances whose spheres they reach; each pair's ray is taken into its instance's object space
+// exactly as Instance's one-ray functions do; each field then answers the rays of all its
+// instances in one call of its batch path (a thousand instances of one field make one large batch,
+// which keeps the batch path's memory pipeline full); the answers are combined per ray in id order,
+// as the one-ray functions and the loop over instances do.
 #include <algorithm>
 #include <string>
 
+#include "query_impl.h"
 #include "scene_impl.h"
 
 namespace vff {
@@ -13,32 +16,56 @@ namespace {
 
 constexpr size_t kChunk = 32768;  // rays a chunk
 
-// The (instance, ray) pairs of a chunk, grouped by instance in ascending id, rays ascending within.
+// The (instance, ray) pairs of a chunk. Instance i's pairs are [first[i], first[i] + count[i]),
+// rays ascending; the instances of a field (Scene::Impl::byField) lie back to back, so that the
+// pairs of a field form one range.
 struct Pairs {
-  std::vector<uint32_t> first;  // per instance: its pairs are [first[i], first[i + 1])
-  std::vector<uint32_t> ray;    // per pair: the ray's index in the chunk
-  std::vector<Ray> rays;        // per pair: the ray, gathered for the instance's batch
+  std::vector<uint32_t> first, count;  // per instance
+  std::vector<uint32_t> ray;           // per pair: the ray's index in the chunk
+  std::vector<Ray> rays;               // per pair: the ray in the instance's object space
 };
 
-void pairUp(const Scene::Impl& m, std::span<const Ray> chunk, Pairs* p) {
-  const size_t n = m.instances.size();
-  std::vector<uint32_t> inst, rayOf;
-  inst.reserve(chunk.size() * 2);
-  rayOf.reserve(chunk.size() * 2);
-  for (uint32_t r = 0; r < chunk.size(); ++r)
-    m.bvh.walk(detail::boxRay(chunk[r]), [&](uint32_t id) {
-      inst.push_back(id);
-      rayOf.push_back(r);
-      return chunk[r].tmax;
-    });
-  p->first.assign(n + 1, 0);
-  for (uint32_t id : inst) ++p->first[id + 1];
-  for (size_t i = 0; i < n; ++i) p->first[i + 1] += p->first[i];
-  std::vector<uint32_t> fill(p->first.begin(), p->first.end() - 1);
-  p->ray.resize(inst.size());
-  for (size_t k = 0; k < inst.size(); ++k) p->ray[fill[inst[k]]++] = rayOf[k];
-  p->rays.resize(inst.size());
-  for (size_t k = 0; k < p->ray.size(); ++k) p->rays[k] = chunk[p->ray[k]];
+// What a batch call works in, kept per thread from call to call: fresh large vectors would cost
+// page faults and zeroing on every call.
+struct Scratch {
+  Pairs pairs;
+  std::vector<detail::BoxRay> boxRays;
+  detail::RayLists lists;
+  std::vector<QueryHit> hits;
+  std::vector<uint8_t> blocked;
+  std::vector<float> vis;
+};
+
+Scratch& scratch() {
+  thread_local Scratch s;
+  return s;
+}
+
+void pairUp(const Scene::Impl& m, std::span<const Ray> chunk, Scratch* s) {
+  Pairs* p = &s->pairs;
+  s->boxRays.resize(chunk.size());
+  for (size_t r = 0; r < chunk.size(); ++r) s->boxRays[r] = detail::boxRay(chunk[r]);
+  const detail::RayLists& l = s->lists;
+  m.bvh.collect(s->boxRays, &s->lists);
+  p->count.assign(m.instances.size(), 0);
+  for (size_t c = 0; c < l.prim.size(); ++c) p->count[l.prim[c]] = l.count[c];
+  p->first.resize(m.instances.size());
+  uint32_t at = 0;
+  for (uint32_t id : m.byField) {
+    p->first[id] = at;
+    at += p->count[id];
+  }
+  p->ray.resize(at);
+  p->rays.resize(at);
+  for (size_t c = 0; c < l.prim.size(); ++c) {
+    const uint32_t id = l.prim[c], to = p->first[id];
+    const detail::ToObject x(m.instances[id].transform);
+    for (uint32_t k = 0; k < l.count[c]; ++k) {
+      const uint32_t r = l.rays[l.first[c] + k];
+      p->ray[to + k] = r;
+      p->rays[to + k] = x.ray(chunk[r]);
+    }
+  }
 }
 
 Status sizes(size_t rays, size_t out) {
@@ -47,15 +74,17 @@ Status sizes(size_t rays, size_t out) {
                    "scene: out has " + std::to_string(out) + " entries for " + std::to_string(rays) + " rays");
 }
 
-// Runs answer(instance, rays of the pairs, answers of the pairs) for every instance with pairs.
+// Runs answer(field, object-space rays, answers) once per field, over the pairs of all its
+// instances.
 template <class T, class Answer>
 void answerPairs(const Scene::Impl& m, const Pairs& p, std::vector<T>* answers, Answer&& answer) {
   answers->resize(p.rays.size());
   const std::span<const Ray> rays(p.rays);
   const std::span<T> out(*answers);
-  for (size_t i = 0; i + 1 < p.first.size(); ++i) {
-    const uint32_t a = p.first[i], b = p.first[i + 1];
-    if (a < b) answer(m.instances[i], rays.subspan(a, b - a), out.subspan(a, b - a));
+  for (size_t g = 0; g + 1 < m.fieldStart.size(); ++g) {
+    const uint32_t lo = m.byField[m.fieldStart[g]], hi = m.byField[m.fieldStart[g + 1] - 1];
+    const uint32_t a = p.first[lo], b = p.first[hi] + p.count[hi];
+    if (a < b) answer(*m.instances[lo].field, rays.subspan(a, b - a), out.subspan(a, b - a));
   }
 }
 
@@ -66,19 +95,23 @@ Status Scene::intersect(std::span<const Ray> rays, std::span<SceneHit> out, cons
   if (Status s = sizes(rays.size(), out.size()); !s) return s;
   std::fill(out.begin(), out.end(), SceneHit{});
   if (!impl_) return {};
-  Pairs p;
-  std::vector<QueryHit> hits;
+  const Impl& m = *impl_;
+  Scratch& s = scratch();
+  const Pairs& p = s.pairs;
+  std::vector<QueryHit>& hits = s.hits;
   for (size_t c = 0; c < rays.size(); c += kChunk) {
     const std::span<const Ray> chunk = rays.subspan(c, std::min(kChunk, rays.size() - c));
-    pairUp(*impl_, chunk, &p);
-    answerPairs(*impl_, p, &hits, [&](const Instance& in, std::span<const Ray> r, std::span<QueryHit> h) {
-      in.intersect(r, h, options);
+    pairUp(m, chunk, &s);
+    answerPairs(m, p, &hits, [&](const FieldQuery& f, std::span<const Ray> r, std::span<QueryHit> h) {
+      f.intersect(r, h, options);
     });
-    for (uint32_t i = 0; i + 1 < p.first.size(); ++i)
-      for (uint32_t k = p.first[i]; k < p.first[i + 1]; ++k) {
+    for (uint32_t i = 0; i < m.instances.size(); ++i)
+      for (uint32_t k = p.first[i]; k < p.first[i] + p.count[i]; ++k) {
         SceneHit& best = out[c + p.ray[k]];
         if (hits[k].hit && hits[k].t < best.t) {
-          static_cast<QueryHit&>(best) = hits[k];
+          QueryHit h = hits[k];
+          detail::toWorld(m.instances[i].transform, chunk[p.ray[k]], &h);
+          static_cast<QueryHit&>(best) = h;
           best.instance = i;
         }
       }
@@ -91,30 +124,17 @@ Status Scene::occluded(std::span<const Ray> rays, std::span<uint8_t> out, const 
   if (Status s = sizes(rays.size(), out.size()); !s) return s;
   std::fill(out.begin(), out.end(), uint8_t(0));
   if (!impl_) return {};
-  Pairs p;
-  std::vector<Ray> open;
-  std::vector<uint32_t> openRay;
-  std::vector<uint8_t> blocked;
+  const Impl& m = *impl_;
+  Scratch& s = scratch();
+  const Pairs& p = s.pairs;
+  std::vector<uint8_t>& blocked = s.blocked;
   for (size_t c = 0; c < rays.size(); c += kChunk) {
     const std::span<const Ray> chunk = rays.subspan(c, std::min(kChunk, rays.size() - c));
-    const std::span<uint8_t> o = out.subspan(c, chunk.size());
-    pairUp(*impl_, chunk, &p);
-    // Instance by instance, only the rays no earlier instance has blocked: any instance's "yes"
-    // is the answer, so the rest are not asked.
-    for (size_t i = 0; i + 1 < p.first.size(); ++i) {
-      open.clear();
-      openRay.clear();
-      for (uint32_t k = p.first[i]; k < p.first[i + 1]; ++k)
-        if (!o[p.ray[k]]) {
-          open.push_back(p.rays[k]);
-          openRay.push_back(p.ray[k]);
-        }
-      if (open.empty()) continue;
-      blocked.resize(open.size());
-      impl_->instances[i].occluded(open, blocked, options);
-      for (size_t k = 0; k < open.size(); ++k)
-        if (blocked[k]) o[openRay[k]] = 1;
-    }
+    pairUp(m, chunk, &s);
+    answerPairs(m, p, &blocked, [&](const FieldQuery& f, std::span<const Ray> r, std::span<uint8_t> o) {
+      f.occluded(r, o, options);
+    });
+    for (size_t k = 0; k < p.ray.size(); ++k) out[c + p.ray[k]] |= blocked[k];
   }
   return {};
 }
@@ -124,15 +144,18 @@ Status Scene::visibility(std::span<const Ray> rays, std::span<float> out, const 
   if (Status s = sizes(rays.size(), out.size()); !s) return s;
   std::fill(out.begin(), out.end(), 1.0f);
   if (!impl_) return {};
-  Pairs p;
-  std::vector<float> vis;
+  const Impl& m = *impl_;
+  Scratch& s = scratch();
+  const Pairs& p = s.pairs;
+  std::vector<float>& vis = s.vis;
   for (size_t c = 0; c < rays.size(); c += kChunk) {
     const std::span<const Ray> chunk = rays.subspan(c, std::min(kChunk, rays.size() - c));
-    pairUp(*impl_, chunk, &p);
-    answerPairs(*impl_, p, &vis, [&](const Instance& in, std::span<const Ray> r, std::span<float> o) {
-      in.visibility(r, o, options);
+    pairUp(m, chunk, &s);
+    answerPairs(m, p, &vis, [&](const FieldQuery& f, std::span<const Ray> r, std::span<float> o) {
+      f.visibility(r, o, options);
     });
-    for (size_t k = 0; k < p.ray.size(); ++k) out[c + p.ray[k]] *= vis[k];  // pairs in id order
+    for (uint32_t i = 0; i < m.instances.size(); ++i)  // the product in id order
+      for (uint32_t k = p.first[i]; k < p.first[i] + p.count[i]; ++k) out[c + p.ray[k]] *= vis[k];
   }
   return {};
 }

@@ -5,11 +5,6 @@
 #include <cmath>
 #include <limits>
 
-#if defined(__SSE2__) || defined(_M_X64)
-#include <emmintrin.h>
-#define VFF_SCENE_SSE2 1
-#endif
-
 namespace vff::detail {
 namespace {
 
@@ -141,34 +136,6 @@ BoxRay boxRay(const Ray& ray) noexcept {
   return r;
 }
 
-unsigned hitNode4(const Node4& n, const BoxRay& r, float tmax, float entry[4]) noexcept {
-#if VFF_SCENE_SSE2
-  __m128 tn = _mm_setzero_ps(), tf = _mm_set1_ps(tmax);
-  for (int a = 0; a < 3; ++a) {
-    const __m128 o = _mm_set1_ps(r.origin[a]), inv = _mm_set1_ps(r.inv[a]);
-    const __m128 t1 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.lo[a]), o), inv);
-    const __m128 t2 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.hi[a]), o), inv);
-    tn = _mm_max_ps(tn, _mm_min_ps(t1, t2));
-    tf = _mm_min_ps(tf, _mm_max_ps(t1, t2));
-  }
-  _mm_storeu_ps(entry, tn);
-  return unsigned(_mm_movemask_ps(_mm_cmple_ps(tn, tf)));
-#else
-  unsigned mask = 0;
-  for (int c = 0; c < 4; ++c) {
-    float tn = 0, tf = tmax;
-    for (int a = 0; a < 3; ++a) {
-      const float t1 = (n.lo[a][c] - r.origin[a]) * r.inv[a], t2 = (n.hi[a][c] - r.origin[a]) * r.inv[a];
-      tn = std::max(tn, std::min(t1, t2));
-      tf = std::min(tf, std::max(t1, t2));
-    }
-    entry[c] = tn;
-    if (tn <= tf) mask |= 1u << c;
-  }
-  return mask;
-#endif
-}
-
 void Bvh4::build(const std::vector<Box>& boxes) {
   nodes_.clear();
   prims_.resize(boxes.size());
@@ -230,6 +197,55 @@ void Bvh4::build(const std::vector<Box>& boxes) {
         n.count[c] = kid.count;
       } else {
         work.push_back({kids[c], (id << 2) | uint32_t(c)});
+      }
+    }
+  }
+}
+
+void Bvh4::collect(std::span<const BoxRay> rays, RayLists* out) const {
+  out->prim.clear();
+  out->first.clear();
+  out->count.clear();
+  out->rays.clear();
+  if (nodes_.empty() || rays.empty()) return;
+  std::vector<uint32_t>& arena = out->arena;
+  const uint32_t n = uint32_t(rays.size());
+  if (arena.size() < n) arena.resize(n);
+  for (uint32_t r = 0; r < n; ++r) arena[r] = r;
+  out->stack.assign(1, {0, 0, n});
+  while (!out->stack.empty()) {
+    const RayLists::Item it = out->stack.back();
+    out->stack.pop_back();
+    // Depth first: everything in the arena above this item's rays belongs to items already done.
+    const uint32_t m = it.end - it.begin;
+    const size_t base = it.end;
+    if (arena.size() < base + 4 * size_t(m)) arena.resize(base + 4 * size_t(m));
+    const uint32_t* in = arena.data() + it.begin;
+    uint32_t* list = arena.data() + base;  // child c's rays at list[c * m ...]
+    const Node4& node = nodes_[it.node];
+    uint32_t count[4] = {0, 0, 0, 0};
+    float entry[4];
+    for (uint32_t i = 0; i < m; ++i) {
+      const uint32_t r = in[i];
+      const unsigned mask = hitNode4(node, rays[r], rays[r].tmax, entry) & node.valid;
+      for (uint32_t c = 0; c < 4; ++c) {  // no branch per child: the masks are random bits
+        list[c * m + count[c]] = r;
+        count[c] += (mask >> c) & 1u;
+      }
+    }
+    for (uint32_t c = 0; c < 4; ++c) {
+      if (count[c] == 0) continue;
+      const uint32_t begin = uint32_t(base + c * size_t(m));
+      if (node.count[c] == 0) {
+        out->stack.push_back({node.child[c], begin, begin + count[c]});
+        continue;
+      }
+      const uint32_t at = uint32_t(out->rays.size());
+      out->rays.insert(out->rays.end(), list + size_t(c) * m, list + size_t(c) * m + count[c]);
+      for (uint32_t i = 0; i < node.count[c]; ++i) {
+        out->prim.push_back(prims_[node.child[c] + i]);
+        out->first.push_back(at);
+        out->count.push_back(count[c]);
       }
     }
   }

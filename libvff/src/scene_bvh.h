@@ -3,9 +3,16 @@
 // so that a ray tests the four child boxes of a node at once in SSE2 lanes.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <span>
 #include <utility>
 #include <vector>
+
+#if defined(__SSE2__) || defined(_M_X64)
+#include <emmintrin.h>
+#define VFF_SCENE_SSE2 1
+#endif
 
 #include "vff/query.h"
 
@@ -33,6 +40,18 @@ struct BoxRay {
 
 BoxRay boxRay(const Ray& ray) noexcept;
 
+// What Bvh4::collect finds for a batch of rays: call c says that the rays
+// rays[first[c], first[c] + count[c]) (indices into the batch, ascending) reach primitive prim[c];
+// each primitive reached by any ray has one call. The rest is working space kept between batches.
+struct RayLists {
+  std::vector<uint32_t> prim, first, count, rays;
+  struct Item {
+    uint32_t node, begin, end;  // a node and its rays: arena[begin, end)
+  };
+  std::vector<uint32_t> arena;
+  std::vector<Item> stack;
+};
+
 class Bvh4 {
  public:
   static constexpr int kMaxDepth = 96;
@@ -48,6 +67,11 @@ class Bvh4 {
   // value to see everything); a negative value stops the walk.
   template <class Visit>
   void walk(const BoxRay& r, Visit&& visit) const;
+  // For a batch of rays, what walk() visits for each with a visit that never lowers tmax, found
+  // for all of them at once: the batch goes down the tree as a stream, each node testing the rays
+  // that reached it against its four boxes, so that a node is read once for the batch and no ray
+  // keeps a stack of its own.
+  void collect(std::span<const BoxRay> rays, RayLists* out) const;
 
  private:
   std::vector<Node4> nodes_;
@@ -56,7 +80,34 @@ class Bvh4 {
 
 // The entry distances of the ray into the four boxes of a node, and which it reaches within
 // [0, tmax] (bit c of the result).
-unsigned hitNode4(const Node4& n, const BoxRay& r, float tmax, float entry[4]) noexcept;
+// Inline: the walks call it for every ray at every node.
+inline unsigned hitNode4(const Node4& n, const BoxRay& r, float tmax, float entry[4]) noexcept {
+#if VFF_SCENE_SSE2
+  __m128 tn = _mm_setzero_ps(), tf = _mm_set1_ps(tmax);
+  for (int a = 0; a < 3; ++a) {
+    const __m128 o = _mm_set1_ps(r.origin[a]), inv = _mm_set1_ps(r.inv[a]);
+    const __m128 t1 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.lo[a]), o), inv);
+    const __m128 t2 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.hi[a]), o), inv);
+    tn = _mm_max_ps(tn, _mm_min_ps(t1, t2));
+    tf = _mm_min_ps(tf, _mm_max_ps(t1, t2));
+  }
+  _mm_storeu_ps(entry, tn);
+  return unsigned(_mm_movemask_ps(_mm_cmple_ps(tn, tf)));
+#else
+  unsigned mask = 0;
+  for (int c = 0; c < 4; ++c) {
+    float tn = 0, tf = tmax;
+    for (int a = 0; a < 3; ++a) {
+      const float t1 = (n.lo[a][c] - r.origin[a]) * r.inv[a], t2 = (n.hi[a][c] - r.origin[a]) * r.inv[a];
+      tn = std::max(tn, std::min(t1, t2));
+      tf = std::min(tf, std::max(t1, t2));
+    }
+    entry[c] = tn;
+    if (tn <= tf) mask |= 1u << c;
+  }
+  return mask;
+#endif
+}
 
 template <class Visit>
 void Bvh4::walk(const BoxRay& r, Visit&& visit) const {

@@ -14,6 +14,10 @@ struct Scene::Impl {
   std::vector<Instance> instances;
   detail::Bvh4 bvh;
   float maxRadius = 0;  // the largest enlarged world radius
+  // The instance ids grouped by field (ascending id within a group), and where each group starts
+  // in it (fieldStart.back() == instances.size()): the batches ask each field once for the rays
+  // of all its instances.
+  std::vector<uint32_t> byField, fieldStart;
   bool committed = true;
 
   static Impl& of(std::unique_ptr<Impl>& p);

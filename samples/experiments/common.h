@@ -93,6 +93,8 @@ struct World {
 
 // Loads the mesh (errors name the file), stands it on the plane, aims the camera.
 vff::Result<World> makeWorld(const std::string& meshPath);
+// The same for a mesh in memory (checked: vff::bake::checkMesh).
+World makeWorld(vff::bake::Mesh mesh);
 
 // ---- Exact tracer (Embree 3, the object's triangles in world space) ------------------------------
 struct ExactHit {
@@ -218,6 +220,8 @@ vff::Status writePng(const Image& image, const std::string& path);
 vff::Status writeExr(const Image& image, const std::string& path);
 // |a - b| on the 8-bit scale, times `gain`, through a black-red-yellow-white ramp; pixels outside
 // the mask are dark grey.
+// The images side by side, left to right (all of the first one's height).
+Image sideBySide(const std::vector<Image>& images);
 vff::Status writeErrorMap(const Image& reference, const Image& image, const std::vector<uint8_t>& mask,
                           float gain, const std::string& path);
 
@@ -248,6 +252,9 @@ struct Options {
   // scene-bench
   std::vector<uint32_t> instanceCounts{1, 10, 100, 1000, 10000};
   uint32_t sceneRays = 1u << 18;  // AO rays per frame
+  // triangle-bench
+  uint32_t minTriangles = 10000;    // the coarsest level has at least this many
+  uint32_t maxTriangles = 1000000;  // subdivide until at least this many
   int frames = 3;
   // scene
   std::vector<std::string> objects;  // meshes besides --mesh (none: four procedural shapes)
@@ -278,6 +285,7 @@ int runShadows(const Options& o);
 int runReflections(const Options& o);
 int runBench(const Options& o);
 int runSceneBench(const Options& o);
+int runTriangleBench(const Options& o);
 int runScene(const Options& o);
 
 // The CPU as Linux names it ("model name", family and model from /proc/cpuinfo), or "unknown CPU".

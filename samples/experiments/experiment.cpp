@@ -138,14 +138,7 @@ int runImageExperiment(const Options& o, const ImageExperiment& e) {
   }
 
   // The side-by-side comparison: exact, then the first configuration nearest and interpolated.
-  Image side;
-  side.width = reference.width * int(strip.size());
-  side.height = reference.height;
-  side.rgb.resize(size_t(side.width) * size_t(side.height));
-  for (size_t k = 0; k < strip.size(); ++k)
-    for (int y = 0; y < side.height; ++y)
-      for (int x = 0; x < reference.width; ++x) side.at(int(k) * reference.width + x, y) = strip[k].at(x, y);
-  if (auto w = writePng(side, base + "-comparison.png"); !w) return vff::cli::reportError(kProg, "", w.error());
+  if (auto w = writePng(sideBySide(strip), base + "-comparison.png"); !w) return vff::cli::reportError(kProg, "", w.error());
 
   uint64_t compared = 0;
   for (uint8_t m : mask) compared += m;

@@ -90,4 +90,19 @@ ErrorStats compareImages(const Image& reference, const Image& image, const std::
   return s;
 }
 
+Image sideBySide(const std::vector<Image>& images) {
+  Image side;
+  if (images.empty()) return side;
+  side.height = images[0].height;
+  for (const Image& im : images) side.width += im.width;
+  side.rgb.resize(size_t(side.width) * size_t(side.height));
+  int left = 0;
+  for (const Image& im : images) {
+    for (int y = 0; y < std::min(side.height, im.height); ++y)
+      for (int x = 0; x < im.width; ++x) side.at(left + x, y) = im.at(x, y);
+    left += im.width;
+  }
+  return side;
+}
+
 }  // namespace vffx

@@ -11,9 +11,9 @@
 //           top level recommitted every frame;
 //   fields  the room in Embree (exact), the objects through a vff::Scene (kNearest), committed
 //           every frame; a pixel on an object answers with its intra-object test.
-// Writes OUT/scene-fF-exact.png, -fields.png and -error.png (|difference| x 4) and
-// OUT/scene-table.md: RMS and max error (8-bit scale) and the time of each frame, rebuild
-// included.
+// Writes OUT/scene-fF-exact.png, -fields.png, -comparison.png (the two side by side) and
+// -error.png (|difference| x 4) and OUT/scene-table.md: RMS and max error (8-bit scale) and the
+// time of each frame, rebuild included.
 #include <embree3/rtcore.h>
 
 #include <chrono>
@@ -249,6 +249,7 @@ int runScene(const Options& o) {
     }, &fieldSeconds);
     const std::string base = o.out + "/scene-f" + std::to_string(frame);
     for (auto st : {writePng(ref, base + "-exact.png"), writePng(img, base + "-fields.png"),
+                    writePng(sideBySide({ref, img}), base + "-comparison.png"),
                     writeErrorMap(ref, img, mask, 4.0f, base + "-error.png")})
       if (!st) return vff::cli::reportError(kProg, base, st.error());
     const ErrorStats e = compareImages(ref, img, mask);

@@ -26,8 +26,12 @@ Vec3 Camera::rayDirection(float px, float py, int width, int height) const {
 vff::Result<World> makeWorld(const std::string& meshPath) {
   auto mesh = vff::bake::loadMesh(meshPath);
   if (!mesh) return std::move(mesh).error();
+  return makeWorld(std::move(*mesh));
+}
+
+World makeWorld(vff::bake::Mesh mesh) {
   World w;
-  w.objectMesh = std::move(*mesh);
+  w.objectMesh = std::move(mesh);
   w.objectSphere = vff::bake::minimalEnclosingSphere(w.objectMesh.positions);
   float minY = std::numeric_limits<float>::infinity();
   for (size_t i = 1; i < w.objectMesh.positions.size(); i += 3) minY = std::min(minY, w.objectMesh.positions[i]);

@@ -42,7 +42,7 @@ test_quick_run_writes_a_results_file() {
   ! grep -q -F "$WORK" "$WORK/r.md" || fail "the results file names the scratch folder"
   run "$PYTHON" "$report" check "$WORK/r.md"
   expect_rc 0
-  expect_out "bake, query, accuracy-ao, accuracy-intra-ao, accuracy-shadows, accuracy-reflections, compression"
+  expect_out "bake, query, accuracy-ao, accuracy-intra-ao, accuracy-shadows, accuracy-reflections, scene, triangles, compression"
 }
 
 test_report_rejects_an_output_that_does_not_parse() {

@@ -39,12 +39,21 @@
 // bias. Between the two objects, occlusion is approximate by that much; elsewhere overlap costs
 // nothing but the extra lookups of the instances whose spheres the ray crosses.
 //
-// Speed. The batch functions gather, for each instance, the rays of the batch that reach its
-// sphere and answer them through the instance's batch path (vff/query.h), then combine the
-// answers in id order: the one-ray answers, in the time of a few large batches when instances are
-// few and rays many. The one-ray functions walk the hierarchy nearest first and stop early
-// (intersect: at the nearest hit; occluded: at the first). An Embree renderer can instead hand
-// the top level to Embree (vff/embree.h); vff-experiments scene-bench measures both.
+// Speed. The batch functions send a chunk of rays down the hierarchy together (each node tested
+// once against the rays that reached it), take each (ray, instance) pair into the instance's
+// object space as the one-ray functions do, and let each field answer the rays of all its
+// instances in one call of its batch path (vff/query.h); then they combine the answers per ray in
+// id order. A thousand instances of one field thus cost one large batch, not a thousand small
+// ones. The one-ray functions walk the hierarchy nearest first and stop early (intersect: at the
+// nearest hit; occluded: at the first).
+//
+// Why the batches are built beside Embree and not on it: an Embree renderer can hand the top level
+// to Embree instead (vff/embree.h: each instance a user geometry), and that is the way to mix
+// fields with exact triangles in one traversal. But Embree calls a user geometry back with the
+// rays of one traversal step, mostly one ray at a time for incoherent rays, so the field's batch
+// path never gets a batch; vff-experiments scene-bench measures Scene's batches, the Embree top
+// level over fields and Embree instancing of the triangles side by side in one run, and Scene's
+// batches are the fastest of the three there.
 //
 // Threads. The query functions are const and may run on many threads at once; add(),
 // setTransform() and commit() must not run while any query does.
