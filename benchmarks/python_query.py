@@ -2,17 +2,23 @@
 """The Python batch and vff-query against libvff's C++ batch, on the same rays, in one run.
 
     PYTHONPATH=build/python python3 benchmarks/python_query.py --field out/bunny.vff \\
-        --query build/tools/vff-query/vff-query [--rays 1000000] [--repeat 5]
+        --query build/tools/vff-query/vff-query [--rays 1000000] [--repeat 5] [--quick]
 
 Makes `--rays` ambient-occlusion rays about the field (origins on a disc around its foot, up to
 2R, cosine-weighted; as vff-experiments bench's "ao" set) and writes them as an (N, 6) float32
 .npy. Then, best of --repeat each, alternating:
   C++ batch    vff-query --timing: the batch calls alone on warm memory (FieldQuery::intersect in
                chunks over its threads, the answers dropped)
-  vff-query    the same command end to end: reading the .npy, querying, writing the answers .npy
+  vff-query    the same command end to end, as a shell runs it (process start, opening the field with
+               its checksums, reading the .npy, querying, writing the answers .npy), with the lookup
+               sites (the default) and with --no-sites
+  I/O floor    reading the rays file and writing the answers' bytes, through the page cache, in
+               Python: what vff-query's reading and writing cannot beat
   Python       FieldQuery.intersect(origins, directions) on numpy arrays (threads as vff-query's),
                and FieldQuery.occluded for reference
-and prints each in Mrays/s with its ratio to the C++ batch, naming the CPU.
+and prints each in Mrays/s with its ratio to the C++ batch, naming the CPU. Each ratio is the
+path's rate over the C++ batch's, on the same rays and the same field, both the best of --repeat
+runs taken alternately in this one run. --quick: 20000 rays, one run (a check of the chain).
 """
 import argparse
 import os
@@ -51,18 +57,25 @@ def main():
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--threads", type=int, default=os.cpu_count())
     ap.add_argument("--interpolated", action="store_true")
+    ap.add_argument("--quick", action="store_true", help="20000 rays, one run: the figures mean nothing")
     a = ap.parse_args()
+    if a.quick:
+        a.rays, a.repeat = 20000, 1
     f = vff.open(a.field)
     q = vff.FieldQuery(f)
     o, d = ao_rays(f, a.rays)
     extra = ["--interpolated"] if a.interpolated else []
-    best = {"cpp": 0.0, "cli": 0.0, "py": 0.0, "reuse": 0.0, "occ": 0.0}
+    best = {"cpp": 0.0, "cli": 0.0, "nosites": 0.0, "floor": 0.0, "py": 0.0, "reuse": 0.0, "occ": 0.0}
     reuse = q.intersect(o, d, interpolated=a.interpolated, threads=a.threads)
     with tempfile.TemporaryDirectory() as tmp:
         rays = os.path.join(tmp, "rays.npy")
         out = os.path.join(tmp, "hits.npy")
+        out_nosites = os.path.join(tmp, "hits-no-sites.npy")
+        floor_out = os.path.join(tmp, "floor.bin")
+        answer_bytes = bytes(a.rays * 12 * 4)
         np.save(rays, np.hstack([o, d]))
-        cmd = [a.query, a.field, "-i", rays, "-o", out, "-j", str(a.threads), *extra]
+        base = [a.query, a.field, "-i", rays, "-j", str(a.threads), *extra]
+        cmd = base + ["-o", out]
         for _ in range(a.repeat):
             r = subprocess.run(cmd + ["--timing"], capture_output=True, text=True, check=True)
             m = re.search(r"batch alone, warm: [0-9.]+ s \(([0-9.]+) Mrays/s\)", r.stderr)
@@ -70,6 +83,18 @@ def main():
             t0 = time.perf_counter()
             subprocess.run(cmd, check=True)
             best["cli"] = max(best["cli"], a.rays / 1e6 / (time.perf_counter() - t0))
+            t0 = time.perf_counter()
+            subprocess.run(base + ["--no-sites", "-o", out_nosites], check=True)
+            best["nosites"] = max(best["nosites"], a.rays / 1e6 / (time.perf_counter() - t0))
+            # The floor under vff-query's I/O: read the rays file and write as many bytes as its
+            # answers (12 float32 columns), through the page cache, and nothing else.
+            t0 = time.perf_counter()
+            with open(rays, "rb") as fin:
+                fin.read()
+            with open(floor_out, "wb") as fout:
+                fout.write(answer_bytes)
+            best["floor"] = max(best["floor"], a.rays / 1e6 / (time.perf_counter() - t0))
+            os.remove(floor_out)
             t0 = time.perf_counter()
             h = q.intersect(o, d, interpolated=a.interpolated, threads=a.threads)
             best["py"] = max(best["py"], a.rays / 1e6 / (time.perf_counter() - t0))
@@ -81,6 +106,7 @@ def main():
             best["occ"] = max(best["occ"], a.rays / 1e6 / (time.perf_counter() - t0))
         got = np.load(out)
         assert np.array_equal(got[:, 1], h.t), "vff-query and the Python batch disagree"
+        assert np.array_equal(np.load(out_nosites), got[:, :9], equal_nan=True), "--no-sites changes the answers"
     print("cpu: %s, %d threads, batch kernel %s" % (cpu_name(), a.threads, vff.batch_kernel()))
     print("field: %s (%d maps of %dx%d), %d ao rays, %s, best of %d" % (
         os.path.basename(a.field), f.map_count, f.map_resolution, f.map_resolution, a.rays,
@@ -89,9 +115,15 @@ def main():
     print("|---|---:|---:|")
     print("| C++ batch (FieldQuery::intersect, warm, vff-query --timing) | %.1f | 1.00 |" % best["cpp"])
     print("| vff-query, .npy in and out, end to end | %.1f | %.2f |" % (best["cli"], best["cli"] / best["cpp"]))
+    print("| vff-query --no-sites, .npy in and out, end to end | %.1f | %.2f |" % (
+        best["nosites"], best["nosites"] / best["cpp"]))
+    print("| I/O floor: read the rays .npy, write the answers' bytes (no query) | %.1f | %.2f |" % (
+        best["floor"], best["floor"] / best["cpp"]))
     print("| Python FieldQuery.intersect, numpy in and out | %.1f | %.2f |" % (best["py"], best["py"] / best["cpp"]))
     print("| Python FieldQuery.intersect, out= (arrays reused) | %.1f | %.2f |" % (best["reuse"], best["reuse"] / best["cpp"]))
     print("| Python FieldQuery.occluded (a byte per ray out; no C++ baseline here) | %.1f | - |" % best["occ"])
+    print("ratio: the path's Mrays/s over the C++ batch's, same rays and field, best of %d each, "
+          "taken alternately in this run" % a.repeat)
     return 0
 
 

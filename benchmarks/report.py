@@ -25,7 +25,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BEGIN = "<!-- benchmarks:begin: made by `python3 benchmarks/report.py readme`; do not edit -->"
 END = "<!-- benchmarks:end -->"
 STEPS = ["bake", "query", "accuracy-ao", "accuracy-intra-ao", "accuracy-shadows", "accuracy-reflections",
-         "scene", "triangles", "compression", "gpu"]
+         "scene", "triangles", "compression", "gpu", "python"]
+OPTIONAL = ("gpu", "python")  # steps a run leaves out where the machine or the build lacks them
 
 
 class ParseError(Exception):
@@ -185,7 +186,21 @@ def parse_triangles(text):
     return out
 
 
-PARSERS = {"bake": parse_bake, "scene": parse_scene, "triangles": parse_triangles, "query": parse_query, "compression": parse_compression, "gpu": parse_gpu}
+def parse_python(text):
+    """benchmarks/python_query.py: the threads and rays, and each path's Mrays/s and ratio."""
+    head = re.search(r"^cpu: .*, (\d+) threads, batch kernel (\w+)$", text, re.M)
+    rays = re.search(r"^field: .*?, (\d+) ao rays, (\w+), best of (\d+)$", text, re.M)
+    rows = [r for r in md_rows(text) if len(r) == 3 and r[0] != "path"]
+    if not head or not rays or not rows or not rows[0][0].startswith("C++ batch"):
+        raise ParseError("python_query.py output lacks its cpu and field lines or its table")
+    return {"threads": int(head.group(1)), "kernel": head.group(2), "rays": int(rays.group(1)),
+            "reconstruction": rays.group(2), "repeat": int(rays.group(3)),
+            "rows": [{"path": r[0], "mrays": number(r[1]), "ratio": None if r[2] == "-" else number(r[2])}
+                     for r in rows]}
+
+
+PARSERS = {"bake": parse_bake, "scene": parse_scene, "triangles": parse_triangles, "query": parse_query,
+           "compression": parse_compression, "gpu": parse_gpu, "python": parse_python}
 
 
 def parse_step(name, text):
@@ -298,6 +313,13 @@ def triangles_table(t):
     return lines
 
 
+def python_table(p):
+    lines = ["| path | Mrays/s | x C++ batch |", "|---|---:|---:|"]
+    for r in p["rows"]:
+        lines.append(f"| {r['path']} | {rate(r['mrays'])} | " + ("-" if r["ratio"] is None else f"{r['ratio']:.2f}") + " |")
+    return lines
+
+
 def sections(machine, steps, heading, queries=None, only=None):
     """The summary's tables, one per topic; `queries` (a list of (machine, query)) replaces the
     query table of this run by one row per ray set of each CPU on record; `only` keeps the
@@ -332,6 +354,12 @@ def sections(machine, steps, heading, queries=None, only=None):
         renderer = steps["gpu"]["gpu"]
         soft = ": Mesa's software rasteriser, on the CPU" if "llvmpipe" in renderer else ""
         out += [f"{heading} GPU query ({renderer}{soft})", "", *gpu_table(steps["gpu"]), ""]
+    if "python" in steps:
+        p = steps["python"]
+        out += [f"{heading} Python and vff-query against the C++ batch ({p['rays']} ao rays, {p['reconstruction']}, "
+                f"{p['threads']} threads)", "", *python_table(p), "",
+                "Each ratio: the path's rate over the C++ batch's (FieldQuery::intersect on the same rays and field, "
+                "warm, answers dropped), each the best of its runs, taken alternately in the same run.", ""]
     return out
 
 
@@ -377,10 +405,11 @@ def compose(rawdir, out):
         if name in texts:
             lines += [f"### {name}", "", "`" + texts[name + ".cmd"] + "`", "", "```text", texts[name].rstrip("\n"),
                       "```", ""]
-    skip = os.path.join(rawdir, "gpu.skip")
-    if "gpu" not in texts and os.path.exists(skip):
-        with open(skip, encoding="utf-8") as f:
-            lines += ["### gpu", "", "Not run: " + (f.read().strip() or "vff-gpu-bench failed to start") + ".", ""]
+    for name in OPTIONAL:
+        skip = os.path.join(rawdir, name + ".skip")
+        if name not in texts and os.path.exists(skip):
+            with open(skip, encoding="utf-8") as f:
+                lines += [f"### {name}", "", "Not run: " + (f.read().strip() or f"the {name} step failed to start") + ".", ""]
     with open(out, "w", encoding="utf-8") as f:
         f.write("\n".join(lines))
 
@@ -459,7 +488,7 @@ def main(argv):
         return 0
     if len(argv) == 3 and argv[1] == "check":
         machine, steps = read_results(argv[2])
-        missing = [n for n in STEPS if n != "gpu" and n not in steps]
+        missing = [n for n in STEPS if n not in OPTIONAL and n not in steps]
         if missing:
             raise ParseError(f"{argv[2]}: no output of " + ", ".join(missing))
         print(f"report.py: {argv[2]}: {machine['cpu']}, {machine['date']}: " + ", ".join(steps))

@@ -12,6 +12,9 @@
 #   triangles    vff-experiments triangle-bench: time per ray from about 10k to 1M triangles
 #   compression  vff-compress --benchmark: the hits-med codec against zstd, xz and OpenEXR's
 #   gpu          vff-gpu-bench, where a headless OpenGL 4.3 context opens (it names the renderer)
+#   python       benchmarks/python_query.py, where the Python module is built: a million rays through
+#                vff-query (.npy in and out, end to end) and through the Python batch, each against
+#                the C++ batch on the same rays and field in the same run
 # and writes benchmarks/results/<cpu>-<date>.md (or --out): the machine, the commit, a summary in
 # rounded tables (README.md copies it: python3 benchmarks/report.py readme) and the full output of
 # every command. --quick runs each at a tiny size: a check that the whole chain works, whose
@@ -59,13 +62,13 @@ if ((quick)); then
   benchargs=(--config 290x16x16 --bench-rays 20000 --repeat 1) bakerepeat=1 compressrepeat=1
   sceneargs=(--config 290x16x16 --instances 1 10 --scene-rays 4096 --frames 1)
   triangleargs=(--config 290x16x16 --bench-rays 4096 --min-triangles 500 --max-triangles 8000 --repeat 1)
-  gpuargs=(--size 64 --spp 4)
+  gpuargs=(--size 64 --spp 4) pyargs=(--quick)
 else
   # The paper's configuration: octa-hemi2 n = 32 (4226 maps) of 64 x 64, unorm8-diameter.
   config=(-n 32 -m 64) field=4226x64x64 expargs=()
   benchargs=(--repeat 5) bakerepeat=3 compressrepeat=3
   sceneargs=(--frames 5) triangleargs=(--repeat 5)
-  gpuargs=()
+  gpuargs=() pyargs=()
 fi
 
 # step NAME COMMAND...: runs COMMAND with its output in $raw/NAME.txt and its command line in
@@ -79,6 +82,7 @@ step() {
   shown="${shown//$raw\//}"
   shown="${shown//$raw/.}"
   shown="${shown//$(dirname "$mesh")\//}"
+  shown="${shown//$root\//}"
   echo "== $name: $shown" >&2
   local t0=$SECONDS
   if ! "$@" >"$raw/$name.txt" 2>"$raw/$name.err"; then
@@ -112,6 +116,16 @@ if [[ -x $gpubench ]]; then
   skip_if="no headless OpenGL" step gpu "$gpubench" --field "$raw/field.vff" "${gpuargs[@]}"
 else
   echo "vff-gpu-bench is not built (no OpenGL or EGL development files)" >"$raw/gpu.skip"
+fi
+
+# The Python batch and vff-query against the C++ batch, with the interpreter the module was built
+# for, where it was built; otherwise the results file says why it did not run.
+python="$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' "$build/CMakeCache.txt" | head -1)"
+if compgen -G "$build/python/vff/_vff*.so" >/dev/null && [[ -x $python && -x $build/tools/vff-query/vff-query ]]; then
+  step python env PYTHONPATH="$build/python" "$python" "$root/benchmarks/python_query.py" --field "$raw/field.vff" \
+    --query "$build/tools/vff-query/vff-query" "${pyargs[@]}"
+else
+  echo "the Python module is not built (VFF_PYTHON=OFF: pybind11-dev, python3-dev or python3-numpy missing)" >"$raw/python.skip"
 fi
 
 # The machine and the build.

@@ -26,6 +26,10 @@ void bindFile(pybind11::module_& m);
 void bindQuery(pybind11::module_& m);
 void bindBake(pybind11::module_& m);
 void bindRewrite(pybind11::module_& m);
+void bindScene(pybind11::module_& m);
+
+// A checksum policy spelled "all", "lazy" or "none" (else a ValueError).
+ChecksumPolicy checksumPolicy(const std::string& s);
 
 // The open() of the module: a File from a path, with a checksum policy "all", "lazy" or "none".
 std::shared_ptr<PyFile> openFile(const std::string& path, const std::string& checksums);

@@ -9,14 +9,14 @@ namespace py = pybind11;
 
 namespace vff::python {
 
-namespace {
-
 ChecksumPolicy checksumPolicy(const std::string& s) {
   if (s == "all") return ChecksumPolicy::kVerifyAll;
   if (s == "lazy") return ChecksumPolicy::kLazy;
   if (s == "none") return ChecksumPolicy::kNone;
   throw py::value_error("checksums: expected \"all\", \"lazy\" or \"none\", got \"" + s + "\"");
 }
+
+namespace {
 
 Plane planeOf(const std::string& s) {
   if (s == "distance") return Plane::kDistance;

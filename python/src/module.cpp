@@ -13,6 +13,7 @@ PYBIND11_MODULE(_vff, m) {
         "The kernel the batch queries use on this CPU: \"avx512\", \"avx2\", \"sse2\" or \"scalar\".");
   vff::python::bindFile(m);
   vff::python::bindQuery(m);
+  vff::python::bindScene(m);
   vff::python::bindBake(m);
   vff::python::bindRewrite(m);
 }

@@ -28,6 +28,15 @@ test_quick_run_writes_a_results_file() {
   done
   # The GPU bench ran (a table naming the renderer) or the file says why not.
   grep -q -E "^### GPU query \(|^Not run: " "$WORK/r.md" || fail "the results file says nothing of the GPU bench"
+  # The Python module's step ran (its table, each path against the C++ batch) or the file says why not.
+  if grep -q -F "### Python and vff-query against the C++ batch" "$WORK/r.md"; then
+    for path in "C++ batch" "vff-query, .npy in and out, end to end" "Python FieldQuery.intersect, numpy in and out"; do
+      grep -q -E "^\| ${path//+/\\+}[^|]* \| [0-9.,]+ \| [0-9.]+ \|$" "$WORK/r.md" || fail "no Python table row '$path'"
+    done
+  else
+    grep -q -E "^### python$" "$WORK/r.md" && grep -q "^Not run: the Python module is not built" "$WORK/r.md" ||
+      fail "the results file says nothing of the Python step"
+  fi
   # No machine path: the commands are shown relative to the build folder.
   ! grep -q -F "$VFF_BUILD_DIR" "$WORK/r.md" || fail "the results file names the build folder"
   ! grep -q -F "$WORK" "$WORK/r.md" || fail "the results file names the scratch folder"

@@ -79,7 +79,46 @@ def test_batch_equals_vff_query():
     assert np.array_equal(got[:, 2:5], h.point, equal_nan=True)
     assert np.array_equal(got[:, 5:8], h.normal, equal_nan=True)
     assert np.array_equal(got[:, 8] == 1, h.inside)
-    assert np.array_equal(got[:, 9], q.visibility(o, d, interpolated=True))
+    assert np.array_equal(got[:, 12], q.visibility(o, d, interpolated=True))
+
+
+def test_vff_query_sites_are_the_texels_read():
+    # vff-query's sample, i, j: for a nearest hit from outside the sphere, the texel's decoded
+    # distance from the entry point gives the hit's t; a ray that misses the sphere has none.
+    path = VECTORS / "valid" / "u16d-zstd-normals-gutter2.vff"
+    f = vff.open(str(path))
+    o, d = rays_around(f.center, f.radius, 600, 9)
+    o[-1], d[-1] = np.float32(f.center) + 5 * f.radius, (1, 0, 0)  # misses the sphere
+    buf = io.BytesIO()
+    np.save(buf, np.hstack([o, d]).astype(np.float32))
+    rc, out, err = vff_query(path, "--format", "npy", stdin=buf.getvalue())
+    assert rc == 0, err
+    got = np.load(io.BytesIO(out))
+    assert got.shape == (600, 12)
+    assert (got[-1, 9:12] == -1).all()
+    sample, i, j = got[:, 9].astype(int), got[:, 10].astype(int), got[:, 11].astype(int)
+    m = f.map_resolution
+    assert (sample[:-1] >= 0).all() and (sample < f.map_count).all() and (i < m).all() and (j < m).all()
+    length = np.linalg.norm(d.astype(np.float64), axis=1)
+    w = d / length[:, None]
+    delta = o.astype(np.float64) - np.asarray(f.center, np.float64)
+    beta = np.einsum("ij,ij->i", delta, w)
+    entry = -beta - np.sqrt(np.maximum(beta**2 - (np.einsum("ij,ij->i", delta, delta) - f.radius**2), 0))
+    checked = 0
+    for r in np.flatnonzero((got[:, 0] == 1) & (got[:, 8] == 0) & (entry > 0)):
+        dist = f.distances(sample[r])[j[r], i[r]]
+        assert np.isfinite(dist), r
+        assert abs(got[r, 1] * length[r] - (entry[r] + dist)) < 1e-3 * f.radius, r
+        checked += 1
+    assert checked > 100
+    # The Python batch names the same sites, and one placed instance the same as its field.
+    q = vff.FieldQuery(f)
+    ks, ij = q.sites(o, d, threads=3)
+    assert ks.dtype == np.int32 and ij.shape == (600, 2)
+    assert np.array_equal(ks, got[:, 9].astype(np.int32)) and np.array_equal(ij, got[:, 10:12].astype(np.int32))
+    moved = vff.Instance(q, None, (4, 5, 6), 2.0)
+    mk, mij = moved.sites(o * 2 + np.float32([4, 5, 6]), d, threads=2)
+    assert np.array_equal(mk, ks) and np.array_equal(mij, ij)
 
 
 def test_bounds_layouts_and_threads():
@@ -143,3 +182,27 @@ def test_queries_keep_their_file_alive():
     f = inst.field.file
     o = np.array([[f.center[0] + 1, f.center[1] + 2, f.center[2] + 3 + 4 * f.radius]], np.float32)
     assert inst.intersect(o, np.array([[0, 0, -1]], np.float32)).hit[0]
+
+
+def test_large_batches_own_their_arrays():
+    # Batches large enough for the huge-page blocks (and their reuse once released): every array
+    # keeps its answers while later batches run, and a reused block answers afresh.
+    f = vff.open(str(VECTORS / "valid" / "u8d-zstd-normals-meta.vff"))
+    q = vff.FieldQuery(f)
+    o, d = rays_around(f.center, f.radius, 120000, 21)
+    first = q.intersect(o, d, threads=3)
+    keep = first.t.copy(), first.point.copy(), first.hit.copy()
+    assert first.hit.any() and not first.hit.all()
+    other = q.intersect(o[::-1].copy(), d[::-1].copy(), threads=2)
+    assert not np.shares_memory(first.t, other.t)
+    assert np.array_equal(first.t, keep[0]) and np.array_equal(first.hit, keep[2])
+    assert np.array_equal(first.point, keep[1], equal_nan=True)
+    assert np.array_equal(other.t, keep[0][::-1])
+    del first
+    again = q.intersect(o, d, threads=1)  # (may land in the released block)
+    assert np.array_equal(again.t, keep[0]) and np.array_equal(again.hit, keep[2])
+    assert np.array_equal(again.point, keep[1], equal_nan=True)
+    vis = q.visibility(o, d)
+    occ = q.occluded(o, d)
+    assert vis.shape == (120000,) and vis.dtype == np.float32 and occ.dtype == np.bool_
+    assert np.array_equal(occ, keep[2]) and np.array_equal(vis == 0, keep[2])

@@ -21,7 +21,7 @@ test_help() {
   query --help
   expect_rc 0
   for opt in --ray --input --output --format --interpolated --visibility --tmin --tmax --rotate --translate --scale \
-    --threads "Exit codes:" "3  invalid input file"; do expect_out "$opt"; done
+    --threads --checksums --no-sites "Exit codes:" "3  invalid input file"; do expect_out "$opt"; done
 }
 
 # Nearest answers, split over threads in batches, equal the one-ray calls on every encoding.
@@ -79,7 +79,8 @@ test_input_spellings_agree() {
   query "$f" -i "$WORK/rays.jsonl" --format jsonl
   expect_rc 0
   expect_out '{"hit":true,"t":2.31000018,"point":[0.5,-1,2.68999982],"normal":['
-  expect_out '{"hit":false,"t":null,"point":null,"normal":null,"inside":false}'
+  expect_out_re '"inside":false,"sample":[0-9]+,"texel":\[[0-9]+,[0-9]+\]}'
+  expect_out '{"hit":false,"t":null,"point":null,"normal":null,"inside":false,"sample":null,"texel":null}'
   # tmax before the surface: a miss.
   query "$f" --ray 0.5 -1 5 0 0 -1 --tmax 2
   expect_rc 0
@@ -101,7 +102,8 @@ test_npy_in_and_out() {
 import sys, numpy as np
 got = np.load(sys.argv[1])
 want = np.genfromtxt(sys.argv[2], delimiter=',', names=True)
-assert got.dtype == np.float32 and got.shape == (300, 10), (got.dtype, got.shape)
+assert got.dtype == np.float32 and got.shape == (300, 13), (got.dtype, got.shape)
+assert want.dtype.names[9:] == ("sample", "i", "j", "visibility"), want.dtype.names
 for i, name in enumerate(want.dtype.names):
     assert np.array_equal(got[:, i], want[name].astype(np.float32), equal_nan=True), name
 PY
@@ -109,6 +111,101 @@ PY
   query "$f" --format npy --visibility <"$WORK/rays.npy"
   expect_rc 0
   cmp -s "$WORK/out" "$WORK/hits.npy" || fail ".npy from standard input differs"
+}
+
+# The columns sample, i, j: -1 for a ray that makes no lookup (it misses the sphere), a map and a
+# texel inside the field otherwise; --no-sites leaves them out of every format.
+test_sites_and_no_sites() {
+  local f="$VECTORS/u8d-zstd-normals-meta.vff"
+  query "$f" --ray 0.5 -1 5 0 0 -1 --ray 9 9 9 1 0 0
+  expect_rc 0
+  [[ $(sed -n 1p "$WORK/out") == hit,t,x,y,z,nx,ny,nz,inside,sample,i,j ]] || { show; fail "CSV header"; }
+  [[ $(sed -n 3p "$WORK/out") == *,0,-1,-1,-1 ]] || { show; fail "a ray missing the sphere has a site"; }
+  local maps res
+  maps=$("$REFERENCE" describe "$f" | cut -d' ' -f1)
+  res=$("$REFERENCE" describe "$f" | cut -d' ' -f2)
+  IFS=, read -r -a row < <(sed -n 2p "$WORK/out")
+  ((row[9] >= 0 && row[9] < maps && row[10] >= 0 && row[10] < res && row[11] >= 0 && row[11] < res)) ||
+    fail "site ${row[9]} (${row[10]}, ${row[11]}) outside $maps maps of $res x $res"
+  query "$f" --ray 0.5 -1 5 0 0 -1 --ray 9 9 9 1 0 0 --no-sites --visibility
+  expect_rc 0
+  [[ $(sed -n 1p "$WORK/out") == hit,t,x,y,z,nx,ny,nz,inside,visibility ]] || { show; fail "--no-sites CSV header"; }
+  [[ $(sed -n 3p "$WORK/out") == 0,inf,nan,nan,nan,nan,nan,nan,0,1 ]] || { show; fail "--no-sites row"; }
+  query "$f" --ray 9 9 9 1 0 0 --no-sites --format jsonl
+  expect_rc 0
+  expect_out '{"hit":false,"t":null,"point":null,"normal":null,"inside":false}'
+  # No rays at all: the header names the same columns.
+  printf '# nothing\n' >"$WORK/none.csv"
+  query "$f" -i "$WORK/none.csv" --visibility
+  expect_rc 0
+  [[ $(cat "$WORK/out") == hit,t,x,y,z,nx,ny,nz,inside,sample,i,j,visibility ]] || { show; fail "empty input's header"; }
+  query "$f" -i "$WORK/none.csv" --no-sites
+  expect_rc 0
+  [[ $(cat "$WORK/out") == hit,t,x,y,z,nx,ny,nz,inside ]] || { show; fail "empty input's --no-sites header"; }
+  query "$f" --ray 9 9 9 1 0 0 --no-sites -o "$WORK/h.npy"
+  expect_rc 0
+  if has_numpy; then
+    /usr/bin/python3 -c "import numpy as np; a = np.load('$WORK/h.npy'); assert a.shape == (1, 9), a.shape" ||
+      fail "--no-sites .npy shape"
+  fi
+}
+
+# --checksums: all (the default) refuses a field whose bytes do not match their checksum; none
+# answers from it anyway.
+test_checksums_policy() {
+  local f="$WORK/corrupt.vff"
+  cp "$VECTORS/u8c-stored-normals-3d-gutter1.vff" "$f"
+  printf '\x5a' | dd of="$f" bs=1 seek=18000 conv=notrunc 2>/dev/null
+  query "$f" --ray 0.5 -1 5 0 0 -1
+  expect_rc 3
+  expect_err "section-checksum (4008)"
+  query "$f" --ray 0.5 -1 5 0 0 -1 --checksums lazy
+  expect_rc 3
+  query "$f" --ray 0.5 -1 5 0 0 -1 --checksums none
+  expect_rc 0
+  [[ $(sed -n 2p "$WORK/out") == 1,* ]] || { show; fail "--checksums none: no hit"; }
+  query "$f" --ray 0.5 -1 5 0 0 -1 --checksums some
+  expect_rc 1
+}
+
+# A bad row past the first chunk of a large .npy is named by its index, and no output appears; the
+# rows written chunk by chunk do not depend on the thread count.
+test_npy_bad_row_in_a_later_chunk() {
+  has_numpy || { echo "SKIP: python3 with numpy is not installed"; return 0; }
+  local f="$VECTORS/u8d-zstd-normals-meta.vff"
+  /usr/bin/python3 -c "
+import numpy as np
+r = np.tile(np.array([[0.5, -1, 5, 0, 0, -1]], np.float32), (40000, 1))
+np.save('$WORK/ok.npy', r)
+r[33333, 4] = np.nan
+np.save('$WORK/bad.npy', r)"
+  query "$f" -i "$WORK/ok.npy" -o "$WORK/ok-hits.npy" -j 3
+  expect_rc 0
+  /usr/bin/python3 -c "
+import numpy as np
+a = np.load('$WORK/ok-hits.npy')
+assert a.shape == (40000, 12) and (a == a[0]).all() and a[0, 0] == 1, a[:2]" || fail "40000 equal rays, unequal answers"
+  # Random rays over many chunks: the same bytes on one thread as on four.
+  /usr/bin/python3 -c "
+import numpy as np
+rng = np.random.default_rng(3)
+o = rng.uniform(-3, 3, (50000, 3)); d = rng.uniform(0.5, 1.5, (50000, 3)) * np.array([0.5, -1, 2]) - o
+np.save('$WORK/random.npy', np.hstack([o, d]).astype(np.float32))"
+  query "$f" -i "$WORK/random.npy" -o "$WORK/j1.npy" -j 1 --visibility --interpolated
+  expect_rc 0
+  query "$f" -i "$WORK/random.npy" -o "$WORK/j4.npy" -j 4 --visibility --interpolated
+  expect_rc 0
+  cmp -s "$WORK/j1.npy" "$WORK/j4.npy" || fail "the .npy answers depend on the thread count"
+  /usr/bin/python3 -c "
+import numpy as np
+a = np.load('$WORK/j1.npy')
+assert a.shape == (50000, 13) and 1000 < a[:, 0].sum() < 49000, a[:, 0].sum()" || fail "the random rays do not hit and miss"
+  query "$f" -i "$WORK/bad.npy" -o "$WORK/bad-hits.npy" -j 3
+  expect_rc 3
+  expect_err "$WORK/bad.npy: row 33333, column 4: "
+  [[ ! -e $WORK/bad-hits.npy ]] || fail "an output was written for a bad .npy"
+  compgen -G "$WORK/bad-hits.npy.tmp-*" >/dev/null && fail "a temporary file was left behind"
+  return 0
 }
 
 test_bad_lines_name_line_and_column() {

@@ -1,9 +1,10 @@
 // reference.cpp - vff_query_reference: what vff-query must print, from libvff's one-ray calls.
 //
 //   vff_query_reference rays FIELD N SEED > rays.csv       N rays around FIELD's sphere (CSV lines)
+//   vff_query_reference describe FIELD                     "MAPS M": its map count and resolution
 //   vff_query_reference answer FIELD rays.csv [--interpolated] [--visibility] [--rotate AX AY AZ A]
 //                       [--translate X Y Z] [--scale S]    the answers as vff-query's CSV
-// The answers come from FieldQuery/Instance::intersect and ::visibility on one ray at a time, so the
+// The answers come from FieldQuery/Instance::intersect, ::site and ::visibility on one ray at a time, so the
 // tests compare vff-query's batches (split over threads) with the one-ray path.
 #include <cmath>
 #include <cstdio>
@@ -73,19 +74,29 @@ int answer(int argc, char** argv) {
   }
   if (placed) inst = vff::Instance{&*q, vff::RigidTransform::fromAxisAngle(axis, angle, t, scale)};
   std::vector<vff::QueryHit> hits;
+  std::vector<vff::LookupSite> sites;
   std::vector<float> vis;
   for (const vff::Ray& r : parsed.rays) {
     hits.push_back(inst ? inst->intersect(r, qo) : q->intersect(r, qo));
+    sites.push_back(inst ? inst->site(r, qo) : q->site(r, qo));
     if (visibility) vis.push_back(inst ? inst->visibility(r, qo) : q->visibility(r, qo));
   }
-  const auto out = vff::query_tool::formatAnswers(hits, vis, vff::query_tool::OutputFormat::kCsv);
+  const auto out = vff::query_tool::formatAnswers({hits, sites, vis, true, visibility}, vff::query_tool::OutputFormat::kCsv);
   std::fwrite(out.data(), 1, out.size(), stdout);
   return 0;
 }
 
 }  // namespace
 
+int describe(const char* path) {
+  auto f = vff::File::open(path);
+  if (!f) return std::fprintf(stderr, "%s\n", f.error().toString().c_str()), 1;
+  std::printf("%llu %u\n", (unsigned long long)f->field().mapCount, f->field().mapResolution);
+  return 0;
+}
+
 int main(int argc, char** argv) {
+  if (argc == 3 && !std::strcmp(argv[1], "describe")) return describe(argv[2]);
   if (argc == 5 && !std::strcmp(argv[1], "rays")) return makeRays(argv[2], std::atoi(argv[3]), unsigned(std::atoi(argv[4])));
   if (argc >= 4 && !std::strcmp(argv[1], "answer")) return answer(argc, argv);
   std::fprintf(stderr, "usage: vff_query_reference rays FIELD N SEED | answer FIELD RAYS.csv [options]\n");

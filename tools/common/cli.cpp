@@ -3,6 +3,7 @@
 
 #include <new>
 #include <stdexcept>
+#include <utility>
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -230,27 +231,63 @@ Status writeFileAtomic(const std::string& path, std::span<const uint8_t> bytes) 
     if (!writeAll(STDOUT_FILENO, bytes)) return writeError("standard output", "cannot write");
     return {};
   }
+  auto out = AtomicFile::create(path);
+  if (!out) return std::move(out).error();
+  if (Status st = out->writeAt(0, bytes); !st) return st;
+  return out->commit();
+}
+
+Result<AtomicFile> AtomicFile::create(const std::string& path) {
   // The temporary lives next to the destination so that the rename stays within one file system.
   std::string tmp = path + ".tmp-XXXXXX";
   const int fd = ::mkstemp(tmp.data());
   if (fd < 0) return writeError(path, "cannot create a temporary file");
+  return AtomicFile(path, std::move(tmp), fd);
+}
+
+AtomicFile::AtomicFile(AtomicFile&& o) noexcept
+    : path_(std::move(o.path_)),
+      tmp_(std::move(o.tmp_)),
+      fd_(std::exchange(o.fd_, -1)) {}
+
+AtomicFile::~AtomicFile() {
+  if (fd_ < 0) return;
+  ::close(fd_);
+  ::unlink(tmp_.c_str());
+}
+
+Status AtomicFile::writeAt(uint64_t offset, std::span<const uint8_t> bytes) const {
+  size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::pwrite(fd_, bytes.data() + done, bytes.size() - done, off_t(offset + done));
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return writeError(path_, "cannot write");
+    }
+    done += static_cast<size_t>(n);
+  }
+  return {};
+}
+
+Status AtomicFile::commit() {
   // mkstemp creates the file 0600; give it the mode a plain create would (0666 less the umask).
   const mode_t mask = ::umask(0);
   ::umask(mask);
-  const bool wrote = writeAll(fd, bytes) && ::fchmod(fd, 0666 & ~mask) == 0;
+  const int fd = std::exchange(fd_, -1);
+  const bool moded = ::fchmod(fd, 0666 & ~mask) == 0;
   int err = errno;
   const bool closed = ::close(fd) == 0;
-  if (wrote && !closed) err = errno;
-  if (!wrote || !closed) {
-    ::unlink(tmp.c_str());
+  if (moded && !closed) err = errno;
+  if (!moded || !closed) {
+    ::unlink(tmp_.c_str());
     errno = err;
-    return writeError(path, "cannot write");
+    return writeError(path_, "cannot write");
   }
-  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+  if (::rename(tmp_.c_str(), path_.c_str()) != 0) {
     const int e = errno;
-    ::unlink(tmp.c_str());
+    ::unlink(tmp_.c_str());
     errno = e;
-    return writeError(path, "cannot rename the temporary file into place");
+    return writeError(path_, "cannot rename the temporary file into place");
   }
   return {};
 }

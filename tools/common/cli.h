@@ -23,6 +23,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "vff/error.h"
@@ -126,5 +127,31 @@ Result<std::vector<uint8_t>> readStdin();
 // failure never leaves a partial file (nor removes an existing one). "-" writes to stdout.
 // Fails with kIoWrite (the message names the file).
 Status writeFileAtomic(const std::string& path, std::span<const uint8_t> bytes);
+
+// An output file written in pieces, in any order and from many threads (pwrite at offsets), that
+// appears at `path` only when commit() succeeds: a temporary file in the same folder renamed into
+// place. Dropped without commit(), the temporary is removed. writeFileAtomic is this in one piece.
+//
+//   auto out = vff::cli::AtomicFile::create("hits.npy");
+//   if (!out) return reportError(prog, "", out.error());
+//   if (auto st = out->writeAt(0, header); !st) ...;   // any thread, any order
+//   if (auto st = out->commit(); !st) ...;
+class AtomicFile {
+ public:
+  // Fails with kIoWrite naming the file (its folder cannot take a temporary file).
+  static Result<AtomicFile> create(const std::string& path);
+  AtomicFile(AtomicFile&& o) noexcept;
+  AtomicFile& operator=(AtomicFile&&) = delete;
+  ~AtomicFile();
+  // Writes all of `bytes` at `offset`; safe from many threads at once for disjoint ranges.
+  Status writeAt(uint64_t offset, std::span<const uint8_t> bytes) const;
+  // Gives the file a plain create's mode, closes it and renames it over `path` (kIoWrite).
+  Status commit();
+
+ private:
+  AtomicFile(std::string path, std::string tmp, int fd) : path_(std::move(path)), tmp_(std::move(tmp)), fd_(fd) {}
+  std::string path_, tmp_;
+  int fd_ = -1;
+};
 
 }  // namespace vff::cli

@@ -163,12 +163,12 @@ ParsedRays parseRayLines(std::string_view text, float tmin, float tmax) {
   return out;
 }
 
-void answerRows(std::span<const QueryHit> hits, std::span<const float> visibility, float* rows) {
-  const bool vis = !visibility.empty();
-  const size_t cols = kColumnCount + (vis ? 1 : 0);
+void answerRows(const Answers& a, float* rows) {
+  const bool vis = a.withVisibility, sites = a.withSites;
+  const size_t cols = columnCount(sites, vis);
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  for (size_t i = 0; i < hits.size(); ++i) {
-    const QueryHit& h = hits[i];
+  for (size_t i = 0; i < a.hits.size(); ++i) {
+    const QueryHit& h = a.hits[i];
     float* r = rows + i * cols;
     r[0] = h.hit ? 1.0f : 0.0f;
     r[1] = h.t;
@@ -179,27 +179,34 @@ void answerRows(std::span<const QueryHit> hits, std::span<const float> visibilit
     r[6] = h.hasNormal ? h.normal.y : nan;
     r[7] = h.hasNormal ? h.normal.z : nan;
     r[8] = h.inside ? 1.0f : 0.0f;
-    if (vis) r[9] = visibility[i];
+    if (sites) {
+      // (sample indices stay below 2^24, so float32 holds them exactly)
+      const LookupSite& s = a.sites[i];
+      r[9] = s.valid ? float(s.sample) : -1.0f;
+      r[10] = s.valid ? float(s.i) : -1.0f;
+      r[11] = s.valid ? float(s.j) : -1.0f;
+    }
+    if (vis) r[cols - 1] = a.visibility[i];
   }
 }
 
-std::vector<uint8_t> formatAnswers(std::span<const QueryHit> hits, std::span<const float> visibility,
-                                   OutputFormat format) {
-  const bool vis = !visibility.empty();
+std::vector<uint8_t> formatAnswers(const Answers& a, OutputFormat format) {
+  const bool vis = a.withVisibility, sites = a.withSites;
   if (format == OutputFormat::kNpy) {
-    const uint64_t cols = kColumnCount + (vis ? 1 : 0);
-    std::vector<float> m(hits.size() * cols);
-    answerRows(hits, visibility, m.data());
-    return npyMatrixBytes(m, hits.size(), cols);
+    const uint64_t cols = columnCount(sites, vis);
+    std::vector<float> m(a.hits.size() * cols);
+    answerRows(a, m.data());
+    return npyMatrixBytes(m, a.hits.size(), cols);
   }
   std::string out;
-  out.reserve(hits.size() * 64 + 64);
+  out.reserve(a.hits.size() * 80 + 80);
   if (format == OutputFormat::kCsv) {
-    out = "hit,t,x,y,z,nx,ny,nz,inside";
+    for (int c = 0; c < kColumnCount - (sites ? 0 : kSiteColumns); ++c) out += c ? "," : "", out += kColumns[c];
     out += vis ? ",visibility\n" : "\n";
   }
-  for (size_t i = 0; i < hits.size(); ++i) {
-    const QueryHit& h = hits[i];
+  for (size_t i = 0; i < a.hits.size(); ++i) {
+    const QueryHit& h = a.hits[i];
+    const LookupSite s = sites ? a.sites[i] : LookupSite{};
     if (format == OutputFormat::kCsv) {
       out += h.hit ? "1," : "0,";
       if (h.hit) {
@@ -213,6 +220,10 @@ std::vector<uint8_t> formatAnswers(std::span<const QueryHit> hits, std::span<con
       else
         out += ",nan,nan,nan";
       out += h.inside ? ",1" : ",0";
+      if (sites && s.valid)
+        out += ',' + std::to_string(s.sample) + ',' + std::to_string(s.i) + ',' + std::to_string(s.j);
+      else if (sites)
+        out += ",-1,-1,-1";
     } else {
       out += h.hit ? "{\"hit\":true,\"t\":" : "{\"hit\":false,\"t\":null";
       if (h.hit) {
@@ -231,10 +242,15 @@ std::vector<uint8_t> formatAnswers(std::span<const QueryHit> hits, std::span<con
         out += ",\"normal\":null";
       }
       out += h.inside ? ",\"inside\":true" : ",\"inside\":false";
+      if (sites && s.valid)
+        out += ",\"sample\":" + std::to_string(s.sample) + ",\"texel\":[" + std::to_string(s.i) + ',' +
+               std::to_string(s.j) + ']';
+      else if (sites)
+        out += ",\"sample\":null,\"texel\":null";
     }
     if (vis) {
       out += format == OutputFormat::kCsv ? "," : ",\"visibility\":";
-      appendNumber(out, visibility[i]);
+      appendNumber(out, a.visibility[i]);
     }
     out += format == OutputFormat::kCsv ? "\n" : "}\n";
   }

@@ -38,19 +38,36 @@ ParsedRays parseRayLines(std::string_view text, float tmin, float tmax);
 // Returns the problem and the 0-based index of the number it concerns (0..7).
 std::optional<std::pair<std::string, int>> checkRay(const Ray& ray);
 
-// The columns of every answer, in order (CSV header, .npy columns).
-inline constexpr const char* kColumns[] = {"hit", "t", "x", "y", "z", "nx", "ny", "nz", "inside"};
-inline constexpr int kColumnCount = 9;
+// The columns of every answer, in order (CSV header, .npy columns): the hit, then which map
+// (positional sample) and texel (i, j) of it answered (vff::LookupSite; -1 where the ray made no
+// lookup).
+inline constexpr const char* kColumns[] = {"hit", "t", "x", "y", "z", "nx", "ny", "nz", "inside", "sample", "i", "j"};
+inline constexpr int kColumnCount = 12;
+inline constexpr int kSiteColumns = 3;  // sample, i, j: left out when the sites are not asked for
 
 enum class OutputFormat { kCsv, kJsonLines, kNpy };
 
-// The .npy rows of answers: kColumnCount floats per ray (hit and inside as 0/1, NaN where there is
-// no point or normal), and visibility last when `visibility` is not empty.
-void answerRows(std::span<const QueryHit> hits, std::span<const float> visibility, float* rows);
+// The answers to a run of rays: one hit per ray, one site per ray and one visibility per ray when
+// asked for (else empty).
+struct Answers {
+  std::span<const QueryHit> hits;
+  std::span<const LookupSite> sites;
+  std::span<const float> visibility;
+  bool withSites = true;         // the columns sample, i, j (sites holds one per ray)
+  bool withVisibility = false;   // the column visibility (visibility holds one per ray)
+};
 
-// The answers as one output document. `visibility`, when not empty, adds a last column
-// "visibility" (one value per ray).
-std::vector<uint8_t> formatAnswers(std::span<const QueryHit> hits, std::span<const float> visibility,
-                                   OutputFormat format);
+// The .npy rows of answers: kColumnCount floats per ray (hit and inside as 0/1, NaN where there is
+// no point or normal, sample and texel exact as floats, -1 without a lookup; without sites those
+// three columns are left out), and visibility last when asked for.
+void answerRows(const Answers& a, float* rows);
+// The number of those columns.
+inline size_t columnCount(bool sites, bool visibility) {
+  return size_t(kColumnCount - (sites ? 0 : kSiteColumns) + (visibility ? 1 : 0));
+}
+
+// The answers as one output document (CSV with a header line, JSON lines, or .npy). With
+// visibility, a last column "visibility".
+std::vector<uint8_t> formatAnswers(const Answers& a, OutputFormat format);
 
 }  // namespace vff::query_tool

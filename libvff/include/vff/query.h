@@ -80,6 +80,19 @@ enum class Reconstruction : uint8_t {
   kInterpolated = 1,  // miss-aware blend of the neighbouring samples and texels (see above)
 };
 
+// Which map and texel answer a ray: the positional sample nearest to the point where the lookup
+// enters the sphere, and the texel of that sample's map that holds the lookup's direction (section
+// 7.2; for a ray from inside, section 7.3's reversed ray entering at the exit point). kNearest
+// reads exactly this texel; kInterpolated centres its blend on it (the sample always contributes,
+// its neighbours and the 2 x 2 texels around the direction with it). valid is false when the ray
+// makes no lookup: it misses the sphere, the sphere begins beyond tmax, or (bit1 fields) it starts
+// inside. Texel (i, j) is byte j * M + i of map `sample` (vff/direction.h).
+struct LookupSite {
+  bool valid = false;
+  uint32_t sample = 0;
+  uint32_t i = 0, j = 0;
+};
+
 struct QueryOptions {
   Reconstruction reconstruction = Reconstruction::kNearest;
   // Intra-object bias, as a fraction of the radius R: a ray from inside is occluded when
@@ -170,6 +183,11 @@ class FieldQuery {
   void occluded(std::span<const Ray> rays, std::span<uint8_t> out, const QueryOptions& options = {}) const noexcept;
   void visibility(std::span<const Ray> rays, std::span<float> out, const QueryOptions& options = {}) const noexcept;
 
+  // The lookup site of a ray (LookupSite above), found by the same steps as the queries'. The batch
+  // runs on the calling thread; out.size() must equal rays.size() (extra entries are ignored).
+  LookupSite site(const Ray& ray, const QueryOptions& options = {}) const noexcept;
+  void sites(std::span<const Ray> rays, std::span<LookupSite> out, const QueryOptions& options = {}) const noexcept;
+
   struct Impl;  // opaque
   friend struct Instance;  // (its batches reach the field's kernel with their transform)
 
@@ -208,6 +226,9 @@ struct Instance {
   void intersect(std::span<const Ray> worldRays, std::span<QueryHit> out, const QueryOptions& options = {}) const noexcept;
   void occluded(std::span<const Ray> worldRays, std::span<uint8_t> out, const QueryOptions& options = {}) const noexcept;
   void visibility(std::span<const Ray> worldRays, std::span<float> out, const QueryOptions& options = {}) const noexcept;
+  // The lookup site (LookupSite) of a world-space ray, one ray or a batch.
+  LookupSite site(const Ray& worldRay, const QueryOptions& options = {}) const noexcept;
+  void sites(std::span<const Ray> worldRays, std::span<LookupSite> out, const QueryOptions& options = {}) const noexcept;
   // The bounding sphere in world space.
   Sphere worldSphere() const noexcept;
 };
