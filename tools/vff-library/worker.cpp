@@ -1,0 +1,121 @@
+// worker.cpp - bakes one entry into the cache: vff-bake writes it in a private folder (its own
+// temporary and rename there), then a rename moves it to CACHE/ab/KEY.vff. A process killed at any
+// point leaves at most a private folder, which the next run on that machine removes.
+#include <fcntl.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "cli.h"
+#include "library.h"
+
+namespace fs = std::filesystem;
+
+namespace vff::library {
+
+std::string readText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+namespace {
+
+// The last "error:" line of vff-bake's stderr (or its last line).
+std::string lastErrorLine(const std::string& err) {
+  std::string last, lastError;
+  std::stringstream s(err);
+  for (std::string line; std::getline(s, line);) {
+    if (line.empty() || line[0] == '\r') continue;
+    last = line;
+    if (line.find(": error: ") != std::string::npos) lastError = line;
+  }
+  return lastError.empty() ? last : lastError;
+}
+
+}  // namespace
+
+int runProcess(const std::vector<std::string>& args, const std::string& out, const std::string& err) {
+  std::vector<char*> argv;
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  const pid_t parent = getpid();
+  const pid_t pid = fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {
+    // The bake ends with the process that waits for it (a killed pool leaves no bake running).
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (getppid() != parent) _exit(127);
+    const int o = open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int e = open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (o < 0 || e < 0) _exit(127);
+    dup2(o, 1);
+    dup2(e, 2);
+    execvp(argv[0], argv.data());
+    _exit(127);
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) return -1;
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
+  return -1;
+}
+
+BakeResult bakeEntry(const Entry& e, const WorkerOptions& o) {
+  BakeResult r;
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string dir = makePrivateDir(o.cacheDir);
+  const std::string file = dir + "/" + e.key + ".vff";
+  std::vector<std::string> args = {o.vffBake, e.mesh};
+  args.insert(args.end(), e.args.begin(), e.args.end());
+  args.insert(args.end(), {"-o", file, "-j", std::to_string(o.threads), "--json", "-q"});
+  const int rc = runProcess(args, dir + "/stdout.json", dir + "/stderr.txt");
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.exitCode = rc;
+  if (rc == 0) {
+    auto summary = nlohmann::json::parse(readText(dir + "/stdout.json"), nullptr, false);
+    if (!summary.is_discarded()) r.rays = summary.value("rays", uint64_t{0});
+    if (auto problem = commitToCache(o.cacheDir, e.key, file)) {
+      r.error = *problem;
+      r.exitCode = cli::kExitIo;
+    } else {
+      r.ok = true;
+    }
+  } else if (rc < 0 || rc == 127) {
+    r.error = "cannot run " + o.vffBake;
+    r.exitCode = cli::kExitRuntime;
+  } else {
+    r.error = lastErrorLine(readText(dir + "/stderr.txt"));
+    if (rc > 128) r.error = "vff-bake killed by signal " + std::to_string(rc - 128) + (r.error.empty() ? "" : ": " + r.error);
+    if (r.error.empty()) r.error = "vff-bake failed with exit code " + std::to_string(rc);
+  }
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+  return r;
+}
+
+std::string selfPath() {
+  std::error_code ec;
+  auto p = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string(kProg) : p.string();
+}
+
+std::string findVffBake() {
+  if (const char* env = std::getenv("VFF_BAKE"); env && *env) return env;
+  const fs::path beside = fs::path(selfPath()).parent_path();
+  for (const fs::path& p : {beside / "vff-bake", beside / ".." / "vff-bake" / "vff-bake"}) {
+    std::error_code ec;
+    if (fs::exists(p, ec)) return fs::absolute(p).lexically_normal().string();
+  }
+  return "vff-bake";
+}
+
+}  // namespace vff::library
