@@ -53,7 +53,8 @@ void addBakeOptions(CLI::App& bake, Options& o) {
   bake.add_option("--max-running", s.maxRunning, "slurm: the most array tasks at once (%N)");
   bake.add_option("--tasks", s.tasks, "slurm: array tasks (0: one per entry, at most 1000)");
   bake.add_option("--cpus-per-task", s.cpusPerTask, "slurm: CPUs of each task, and vff-bake's threads");
-  bake.add_option("--sbatch-arg", s.sbatchArgs, "slurm: another sbatch option (repeatable), e.g. --sbatch-arg=--account=A");
+  bake.add_option("--sbatch-arg", s.sbatchArgs, "slurm: another sbatch option (repeatable), e.g. --sbatch-arg=--account=A")
+      ->allow_extra_args(false);
   bake.add_option("--state", s.stateDir, "slurm: plans, scripts, logs and reports (default: CACHE/slurm/TIME-PID)");
   bake.add_option("--retries", s.retries, "slurm: resubmissions of what an array left missing")->capture_default_str();
   bake.add_option("--poll", s.pollSeconds, "slurm: seconds between squeue polls")->capture_default_str();
@@ -176,7 +177,7 @@ int bakeLibrary(const Options& o) {
   }
   if (!o.quiet) printReport(entries, report, stderr);
   else
-    for (const auto& f : reportJson(entries, report)["failed"])
+    for (const nlohmann::json j = reportJson(entries, report); const auto& f : j["failed"])
       std::fprintf(stderr, "%s: error: %s: %s\n", kProg, f["mesh"].get<std::string>().c_str(),
                    f["error"].get<std::string>().c_str());
   return report.failed.empty() ? cli::kExitSuccess : failureExitCode(entries, report);

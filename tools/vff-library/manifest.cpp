@@ -92,9 +92,9 @@ std::optional<std::string> readManifest(const std::string& path, const std::stri
     if (k != "vffLibrary" && k != "defaults" && k != "output" && k != "entries" && k != "shardMaps")
       return path + ": unknown field \"" + k + "\"";
   const fs::path base = fs::absolute(fs::path(path)).parent_path();
-  std::vector<std::string> defaults;
-  if (m.contains("defaults"))
-    if (auto p = appendOptions(m["defaults"], path + ": defaults", &defaults)) return p;
+  const nlohmann::json defaults = m.contains("defaults") ? m["defaults"] : nlohmann::json::object();
+  std::vector<std::string> checked;
+  if (auto p = appendOptions(defaults, path + ": defaults", &checked)) return p;
   const std::string pattern = m.value("output", std::string("{dir}{stem}.vff"));
   const uint64_t shardDefault = m.value("shardMaps", uint64_t{0});
   if (!m.contains("entries") || !m["entries"].is_array()) return path + ": \"entries\" must be an array";
@@ -109,9 +109,13 @@ std::optional<std::string> readManifest(const std::string& path, const std::stri
     e.name = j["mesh"].get<std::string>();
     const fs::path mesh = fs::path(e.name).is_absolute() ? fs::path(e.name) : base / e.name;
     e.mesh = mesh.lexically_normal().string();
-    e.args = defaults;
-    if (j.contains("options"))
-      if (auto p = appendOptions(j["options"], where + ".options", &e.args)) return p;
+    // The entry's options over the defaults, key by key.
+    nlohmann::json options = defaults;
+    if (j.contains("options")) {
+      if (!j["options"].is_object()) return where + ".options: must be an object of vff-bake options";
+      for (const auto& [k, v] : j["options"].items()) options[k] = v;
+    }
+    if (auto p = appendOptions(options, where + ".options", &e.args)) return p;
     const std::string rel = j.contains("output") ? j["output"].get<std::string>()
                                                  : expandPattern(pattern, fs::path(e.name).is_absolute()
                                                                               ? fs::path(e.name).filename()
@@ -143,7 +147,7 @@ std::optional<std::string> readFolder(const std::string& folder, const std::stri
     const std::string name = it->path().filename().string();
     for (const auto& p : patterns)
       if (fnmatch(p.c_str(), rel.c_str(), 0) == 0 || fnmatch(p.c_str(), name.c_str(), 0) == 0) {
-        found.push_back(fs::relative(it->path(), root));
+        found.push_back(it->path().lexically_relative(root));  // a linked file keeps its link's name
         break;
       }
   }

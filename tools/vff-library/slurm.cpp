@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <thread>
 
 #include "cli.h"
@@ -90,7 +91,10 @@ std::optional<std::string> runSlurm(const std::vector<Entry>& entries, const std
                                     : std::min<unsigned>(1000, unsigned(pending.size()));
     const std::string stem = state + "/round-" + std::to_string(round);
     const std::string plan = stem + ".plan.json", script = stem + ".sh";
-    if (auto p = writeText(plan, makePlan(entries, pending, wo, tasks).dump(1))) return *rc = cli::kExitIo, *p;
+    const nlohmann::json planJson = makePlan(entries, pending, wo, tasks);
+    std::map<size_t, unsigned> taskOf;
+    for (const auto& j : planJson["entries"]) taskOf[j["index"].get<size_t>()] = j["task"].get<unsigned>();
+    if (auto p = writeText(plan, planJson.dump(1))) return *rc = cli::kExitIo, *p;
     if (auto p = writeText(script, batchScript(so, plan, stem + ".task-%a.log"))) return *rc = cli::kExitIo, *p;
     std::string array = "--array=0-" + std::to_string(tasks - 1);
     if (so.maxRunning) array += "%" + std::to_string(so.maxRunning);
@@ -139,7 +143,7 @@ std::optional<std::string> runSlurm(const std::vector<Entry>& entries, const std
       auto it = reported.find(i);
       EntryOutcome o;
       o.entry = i;
-      o.where = "slurm " + jobId;
+      o.where = "slurm " + jobId + "_" + std::to_string(taskOf[i]);
       if (it != reported.end()) o = it->second;
       if (cached) {
         o.result.ok = true;
