@@ -54,6 +54,19 @@ test_all_good_exits_zero_and_reports() {
   [[ $(json '[b["mesh"] for b in r["baked"]]') == "['c.obj']" ]] || fail "c.obj"
 }
 
+test_changed_mesh_rebakes_only_it() {
+  make_library "$WORK/lib"
+  lib_bake "$WORK/lib" -- "${OPTS[@]}"
+  # Another shape in box.obj: baked again; the same bytes written anew: read again, not baked.
+  "$MESHGEN" rod "$WORK/lib/box.obj"
+  touch "$WORK/lib/bowl.obj"
+  lib_bake "$WORK/lib" -- "${OPTS[@]}"
+  [[ $(json '[b["mesh"] for b in r["baked"]]') == "['box.obj']" ]] || { show; fail "only box.obj re-baked"; }
+  expect_matches_plain_bake box "${OPTS[@]}"
+  lib_bake "$WORK/lib" --rehash -- "${OPTS[@]}"
+  [[ $(json 'len(r["baked"])') == 0 ]] || fail "--rehash re-baked an unchanged mesh"
+}
+
 test_dry_run_bakes_nothing() {
   make_library "$WORK/lib"
   run "$VFF_LIBRARY" bake "$WORK/lib" --out "$WORK/fields" --dry-run -- -m 8

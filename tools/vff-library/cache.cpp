@@ -93,8 +93,44 @@ std::optional<std::string> canonicalOptions(const Entry& e, bake_tool::Options* 
   return c.dump();
 }
 
+// What the bake reads of a mesh and records of it, as one line; read from the mesh, or from the
+// note CACHE/sources/ab/ID.txt an earlier run left for the same file (path, device, inode, size and
+// modification time in nanoseconds unchanged), so that an up-to-date run reads no mesh.
+// *error: why the mesh could not be read.
+std::optional<std::string> meshGeometry(const Entry& e, const bake_tool::Options& o, const CacheOptions& c,
+                                        Error* error) {
+  struct stat st{};
+  std::string note;
+  if (c.statNotes && ::stat(e.mesh.c_str(), &st) == 0) {
+    const std::string id = e.mesh + "\n" + std::to_string(st.st_dev) + " " + std::to_string(st.st_ino) + " " +
+                           std::to_string(st.st_size) + " " + std::to_string(st.st_mtim.tv_sec) + "." +
+                           std::to_string(st.st_mtim.tv_nsec) + "\nscene " + std::to_string(o.scene);
+    const std::string key = hex128(XXH3_128bits(id.data(), id.size()));
+    note = c.dir + "/sources/" + key.substr(0, 2) + "/" + key + ".txt";
+    std::ifstream in(note, std::ios::binary);
+    std::string line;
+    if (in && std::getline(in, line) && line.rfind("mesh ", 0) == 0) return line;
+  }
+  bake::MeshInfo info;
+  auto mesh = bake::loadMesh(e.mesh, &info, {.gltfScene = o.scene});
+  if (!mesh) {
+    *error = mesh.error();
+    return std::nullopt;
+  }
+  const std::string geometry = "mesh " + info.format + " " + cli::hexDigits64(bake::geometryHash(*mesh)) + " " +
+                               cli::hexDigits64(bake::meshHash(*mesh)) + " " + std::to_string(mesh->droppedDegenerate) +
+                               " " + std::to_string(info.gltfScene);
+  if (!note.empty()) {
+    std::error_code ec;
+    fs::create_directories(fs::path(note).parent_path(), ec);
+    const std::string text = geometry + "\n";
+    (void)cli::writeFileAtomic(note, {reinterpret_cast<const uint8_t*>(text.data()), text.size()});
+  }
+  return geometry;
+}
+
 // The key of one entry, or its error.
-void computeKey(Entry& e) {
+void computeKey(Entry& e, const CacheOptions& c) {
   bake_tool::Options o;
   std::string error;
   auto options = canonicalOptions(e, &o, &error);
@@ -114,21 +150,17 @@ void computeKey(Entry& e) {
       return;
     }
     geometry = "vdb " + *h;
+  } else if (Error err; auto g = meshGeometry(e, o, c, &err)) {
+    geometry = *g;
   } else {
-    bake::MeshInfo info;
-    auto mesh = bake::loadMesh(e.mesh, &info, {.gltfScene = o.scene});
-    if (!mesh) {
-      e.error = cli::formatDiagnostic("vff-bake", "error", e.mesh, mesh.error());
-      e.exitCode = cli::exitCodeFor(mesh.error().code);
-      return;
-    }
-    geometry = "mesh " + info.format + " " + cli::hexDigits64(bake::geometryHash(*mesh)) + " " +
-               cli::hexDigits64(bake::meshHash(*mesh)) + " " + std::to_string(mesh->droppedDegenerate) + " " +
-               std::to_string(info.gltfScene);
-    if (auto field = bake::describeBake(*mesh, bake_tool::bakeOptions(o))) {
-      e.maps = field->mapCount;
-      e.rays = uint64_t(field->mapCount) * field->mapResolution * field->mapResolution;
-    }
+    e.error = cli::formatDiagnostic("vff-bake", "error", e.mesh, err);
+    e.exitCode = cli::exitCodeFor(err.code);
+    return;
+  }
+  const bake::BakeOptions bo = bake_tool::bakeOptions(o);
+  if (auto maps = positionCount(bo.positionScheme, bo.positionParam)) {
+    e.maps = *maps;
+    e.rays = uint64_t(*maps) * bo.mapResolution * bo.mapResolution;
   }
   const std::string text = std::string("vff-library key 1\nbaker vff-bake ") + kLibraryVersion + "\nformat " +
                            std::to_string(kVersionMajor) + "\nsource " + fs::path(e.mesh).filename().string() +
@@ -147,7 +179,7 @@ std::string hostName() {
 void computeKeys(std::vector<Entry>& entries, const CacheOptions& o) {
   std::atomic<size_t> next{0};
   auto work = [&] {
-    for (size_t i; (i = next++) < entries.size();) computeKey(entries[i]);
+    for (size_t i; (i = next++) < entries.size();) computeKey(entries[i], o);
   };
   std::vector<std::thread> pool;
   const unsigned n = std::max(1u, std::min<unsigned>(o.threads, unsigned(entries.size())));

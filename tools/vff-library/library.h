@@ -44,6 +44,7 @@ std::optional<std::string> readFolder(const std::string& folder, const std::stri
 struct CacheOptions {
   std::string dir;       // the cache folder
   unsigned threads = 1;  // for reading the meshes
+  bool statNotes = true;  // reuse what an earlier run read of an unchanged file (cache.cpp)
 };
 
 // Reads every entry's mesh and options and sets its key (or its error), in parallel.

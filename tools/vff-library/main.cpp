@@ -30,7 +30,7 @@ struct Options {
   std::string input, out, cache, glob = "*.obj,*.ply,*.off,*.stl,*.gltf,*.glb", json;
   std::vector<std::string> bakeArgs;
   unsigned workers = 0, threads = 0;
-  bool slurm = false, dryRun = false, quiet = false;
+  bool slurm = false, dryRun = false, quiet = false, rehash = false;
   SlurmOptions slurmOptions;
   std::string planPath;
   unsigned task = 0;
@@ -58,6 +58,8 @@ void addBakeOptions(CLI::App& bake, Options& o) {
   bake.add_option("--state", s.stateDir, "slurm: plans, scripts, logs and reports (default: CACHE/slurm/TIME-PID)");
   bake.add_option("--retries", s.retries, "slurm: resubmissions of what an array left missing")->capture_default_str();
   bake.add_option("--poll", s.pollSeconds, "slurm: seconds between squeue polls")->capture_default_str();
+  bake.add_flag("--rehash", o.rehash,
+                "read every mesh again, even those whose path, size and time are unchanged since a run noted them");
   bake.add_flag("--dry-run", o.dryRun, "print what would be baked (with --slurm: the batch script) and bake nothing");
   bake.add_option("--json", o.json, "also write the report as JSON to this file (- for stdout)");
   bake.add_flag("-q,--quiet", o.quiet, "no progress line, no report on stderr (errors still)");
@@ -110,7 +112,7 @@ int bakeLibrary(const Options& o) {
     return cli::kExitIo;
   }
   removeStalePrivateDirs(wo.cacheDir);
-  computeKeys(entries, {.dir = wo.cacheDir, .threads = cores});
+  computeKeys(entries, {.dir = wo.cacheDir, .threads = cores, .statNotes = !o.rehash});
 
   Report report;
   report.mode = o.slurm ? "slurm" : "local";
