@@ -49,6 +49,14 @@ struct Options {
   bool quiet = false;
   bool benchmark = false;
   int repeat = 3;
+  std::string mapRange;            // --map-range BEGIN:END: a partial result of those maps
+  std::vector<std::string> merge;  // --merge PART...: the partial results to assemble into -o
+};
+
+// A half-open range of map indices, [begin, end), in the field's sample order.
+struct MapRange {
+  uint32_t begin = 0;
+  uint32_t end = 0;
 };
 
 // Adds every option of `o` to `app`.
@@ -56,6 +64,8 @@ void addOptions(CLI::App& app, Options& o);
 // The usage error of a parsed command line that CLI11 cannot see (an option that needs another, or
 // does not apply to the input's kind); nothing when there is none.
 std::optional<std::string> checkOptions(const Options& o);
+// The usage error of a --merge command line that also gives a bake option (the parts carry them).
+std::optional<std::string> checkMergeOptions(const CLI::App& app);
 // The baker's options and the writer's, from the command line.
 bake::BakeOptions bakeOptions(const Options& o);
 WriteOptions writeOptions(const Options& o);
@@ -85,6 +95,27 @@ std::optional<int> writeBaked(const Options& o, const std::string& output, Write
 // The --json keys every bake reports (the callers add their input's and timing keys).
 nlohmann::json bakeSummary(const bake::BakeOptions& bo, const FieldDesc& field, const bake::BakeStats& s,
                            uint64_t payload, double bakeSeconds);
+
+// ---- Partial results: --map-range (partial.cpp) and --merge (merge.cpp); spec/partial.md -------
+// The version of "vff.partial" this vff-bake writes and reads.
+inline constexpr int kPartialVersion = 1;
+// "BEGIN:END" with BEGIN < END, decimal; nothing when the text is not that.
+std::optional<MapRange> parseMapRange(const std::string& text);
+// A range that ends past the field's `mapCount` maps is a usage error (printed here, naming the
+// count); returns its exit code, else nothing.
+std::optional<int> checkMapRange(const MapRange& r, uint32_t mapCount);
+// The writer's options of a partial result whose whole bake writes with `whole`.
+WriteOptions partialWriteOptions(const WriteOptions& whole);
+// META of a partial result: the whole bake's META and "vff.partial".
+std::string partialMetadata(const std::string& wholeMetadata, const WriteOptions& whole, const MapRange& r,
+                            uint32_t mapCount);
+// Writes the partial result: misses, the baked maps of `r` (baked holds only those), misses; then
+// the normals likewise; finishes the file. Returns the exit code of a failure.
+std::optional<int> writePartial(const Options& o, Writer& writer, const FieldDesc& field, const MapRange& r,
+                                const bake::BakedField& baked, double* seconds, uint64_t* fileBytes);
+// --merge: checks the parts o.merge against each other and writes the whole field to o.output
+// through the same Writer and options as a whole bake. Returns the exit code.
+int mergeParts(const Options& o);
 
 // ---- The temporary file (interrupt.cpp) ---------------------------------------------------------
 // Removes the temporaries of `output` (.NAME.tmp-PID-N beside it) left by processes that no longer

@@ -5,9 +5,11 @@
 //   vff-bake mesh.obj --benchmark           Embree's raw throughput on the bake's rays vs the bake
 //   vff-bake shape.vdb -o f.vff [--grid NAME]   from an OpenVDB level set (vff/bake/levelset.h)
 //   vff-bake scene.glb --split mesh -o s.vffscene.json   a field per mesh and a scene description
+//   vff-bake mesh.obj -o p0.vff --map-range 0:2113      a partial result: maps [0, 2113) only
+//   vff-bake --merge p1.vff p0.vff -o field.vff         the partial results assembled (spec/partial.md)
 //
 // options.cpp reads the command line, mesh_bake.cpp, split_bake.cpp and levelset_bake.cpp bake, common.cpp holds
-// what the two bakes share (bake.h).
+// what the two bakes share, partial.cpp and merge.cpp the partial results (bake.h).
 #include "bake.h"
 #include "cli.h"
 
@@ -22,6 +24,13 @@ int main(int argc, char** argv) {
                vff::cli::exitCodeHelp()};
   addOptions(app, o);
   if (auto rc = vff::cli::parse(app, kProg, argc, argv)) return *rc;
+  if (!o.merge.empty()) {
+    if (auto problem = checkMergeOptions(app)) {
+      vff::cli::usageError(kProg, *problem);
+      return vff::cli::kExitUsage;
+    }
+    return mergeParts(o);
+  }
   if (auto problem = checkOptions(o)) {
     vff::cli::usageError(kProg, *problem);
     return vff::cli::kExitUsage;

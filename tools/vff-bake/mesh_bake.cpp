@@ -191,10 +191,21 @@ int bakeFromMesh(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
   if (auto rc = checkPlan(field, wo.layout, &m.payload)) return *rc;
   bool clipped = false;
   if (auto rc = checkUserSphere(o, bo, *mesh, &clipped)) return *rc;
+  std::optional<MapRange> range;
+  if (!o.mapRange.empty()) {
+    range = parseMapRange(o.mapRange);  // checkOptions made sure it parses
+    if (auto rc = checkMapRange(*range, field->mapCount)) return *rc;
+    bo.mapBegin = range->begin;
+    bo.mapEnd = range->end;
+  }
 
   // The writer creates its temporary file now, so an unwritable destination fails before baking.
   std::optional<Writer> writer;
   wo.metadataJson = meshMetadata(o, bo, *mesh, info, clipped);
+  if (range) {
+    wo.metadataJson = partialMetadata(wo.metadataJson, wo, *range, field->mapCount);
+    wo = partialWriteOptions(wo);
+  }
   if (!o.output.empty()) {
     removeStaleTemporaries(o.output);
     auto w = Writer::create(o.output, *field, wo);
@@ -210,8 +221,11 @@ int bakeFromMesh(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
 
   std::optional<bake::BakedField> baked;
   if (auto rc = traceAndBake(o, bo, *scene, &m, &baked)) return *rc;
-  if (writer)
+  if (writer && range) {
+    if (auto rc = writePartial(o, *writer, *field, *range, *baked, &m.write, &m.fileBytes)) return *rc;
+  } else if (writer) {
     if (auto rc = writeBaked(o, o.output, *writer, *baked, &m.write, &m.fileBytes)) return *rc;
+  }
   reportMeshBake(o, bo, *mesh, *scene, *field, baked->stats, m, writer.has_value());
   return cli::kExitSuccess;
 }

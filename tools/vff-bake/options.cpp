@@ -22,7 +22,7 @@ uint32_t defaultCount(PositionScheme s) {
 
 void addOptions(CLI::App& app, Options& o) {
   cli::addVersionFlag(app, kProg);
-  app.add_option("mesh", o.mesh, "input mesh, or OpenVDB level set (.vdb)")->required();
+  app.add_option("mesh", o.mesh, "input mesh, or OpenVDB level set (.vdb); none with --merge");
   app.add_option("-o,--output", o.output, "output .vff file (written atomically)");
   app.add_option("--grid", o.grid, ".vdb input: name of the level set grid to bake (default: the first level set by name)");
   app.add_option("--scene", o.scene, "glTF input: the scene to bake (default: the file's default scene)")
@@ -57,9 +57,35 @@ void addOptions(CLI::App& app, Options& o) {
   app.add_flag("--benchmark", o.benchmark,
                "measure Embree's raw throughput on exactly the bake's rays against the whole bake, and print both");
   app.add_option("--repeat", o.repeat, "benchmark repetitions (best is reported)")->check(CLI::Range(1, 100));
+  app.add_option("--map-range", o.mapRange,
+                 "bake only maps [BEGIN, END) of the field (indices in its sample order) into a partial result "
+                 "(a .vff whose other maps are misses, spec/partial.md); --merge assembles the parts")
+      ->type_name("BEGIN:END");
+  app.add_option("--merge", o.merge,
+                 "assemble partial results (any order; together exactly the field's maps) into -o: the same "
+                 "bytes as the whole bake with their options, which they carry (no mesh, no bake options)")
+      ->type_name("PART...");
+}
+
+std::optional<std::string> checkMergeOptions(const CLI::App& app) {
+  if (app.count("mesh")) return "--merge takes partial results, not a mesh";
+  for (const char* name : {"--grid", "--scene", "--split", "--positions", "--count", "--map-size", "--directions",
+                           "--encoding", "--normals", "--center", "--radius", "--allow-clipped-sphere", "--codec",
+                           "--zstd-level", "--maps-per-block", "--target", "--max-texture-size", "--max-layers",
+                           "--gutter", "--benchmark", "--repeat", "--map-range"})
+    if (app.count(name)) return std::string("--merge takes every bake option from its parts: ") + name + " does not apply";
+  if (app.get_option("--output")->count() == 0) return "--merge needs an output file (-o FILE)";
+  return std::nullopt;
 }
 
 std::optional<std::string> checkOptions(const Options& o) {
+  if (o.mesh.empty()) return "an input mesh is required (or --merge PART... -o FILE)";
+  if (!o.mapRange.empty()) {
+    if (!parseMapRange(o.mapRange)) return "--map-range takes BEGIN:END, map indices with BEGIN < END, not '" + o.mapRange + "'";
+    if (o.benchmark) return "--benchmark measures the whole bake; it does not apply to --map-range";
+    if (!o.split.empty()) return "--split writes a field per object; it does not apply to --map-range";
+    if (isVdbPath(o.mesh)) return "--map-range applies to a mesh bake, not to a .vdb level set";
+  }
   if (o.output.empty() && !o.benchmark) return "an output file is required (-o FILE), unless --benchmark is given";
   if ((!o.center.empty()) != (o.radius > 0)) return "--center and --radius go together (radius > 0)";
   if (o.allowClippedSphere && o.center.empty()) return "--allow-clipped-sphere needs --center and --radius";

@@ -124,6 +124,15 @@ void printSummary(const json& doc, std::FILE* out) {
   std::fprintf(out, "  distance:   %s, miss code %" PRIu64 "\n", str(f["distanceEncoding"]).c_str(),
                u64(f["missCode"]));
   std::fprintf(out, "  normals:    %s\n", str(f["normalEncoding"]).c_str());
+  // A partial result of vff-bake --map-range (spec/partial.md): say so beside the field it is part of.
+  if (const json& m = doc["metadata"]; m.is_object() && m.contains("vff.partial") && m["vff.partial"].is_object()) {
+    const json& p = m["vff.partial"];
+    auto has = [&](const char* k) { return p.contains(k) && p[k].is_number_unsigned(); };
+    if (has("mapBegin") && has("mapEnd") && has("mapCount"))
+      std::fprintf(out, "  partial:    maps %" PRIu64 ":%" PRIu64 " of %" PRIu64
+                   " only (vff-bake --map-range); the others hold misses until vff-bake --merge\n",
+                   u64(p["mapBegin"]), u64(p["mapEnd"]), u64(p["mapCount"]));
+  }
 
   std::fprintf(out, "\npayload:\n");
   printPlane(out, "distance", doc["planes"]["distance"]);

@@ -124,6 +124,10 @@ struct Plan {
 Result<Plan> makePlan(const Mesh& mesh, const BakeOptions& o) {
   auto f = describeBake(mesh, o);
   if (!f) return std::move(f).error();
+  const uint32_t last = o.mapEnd ? o.mapEnd : f->mapCount;
+  if (o.mapBegin >= last || last > f->mapCount)
+    return makeError(Code::kInvalidArgument, "map range " + std::to_string(o.mapBegin) + ":" + std::to_string(last) +
+                                                 " is not inside the field's " + std::to_string(f->mapCount) + " maps");
   auto ps = PositionSet::fromField(*f);
   if (!ps) return std::move(ps).error();
   Plan p{*f, *ps, {}, {}, 0, 0};
@@ -218,14 +222,15 @@ uint64_t traceMap(const Scene::Impl& s, const Plan& plan, uint32_t map, uint8_t*
 
 template <bool kKeep>
 BakeStats runAll(const Scene::Impl& s, const Plan& plan, const BakeOptions& o, uint8_t* dist, uint8_t* norm) {
-  const uint32_t maps = plan.field.mapCount;
+  const uint32_t first = o.mapBegin, last = o.mapEnd ? o.mapEnd : plan.field.mapCount;
+  const uint32_t maps = last - first;
   std::atomic<uint32_t> next{0};
   std::atomic<uint64_t> hits{0}, done{0};
   auto work = [&] {
     uint64_t h = 0;
     for (uint32_t i; (i = next.fetch_add(1, std::memory_order_relaxed)) < maps;) {
       if (o.cancel && o.cancel->load(std::memory_order_relaxed)) break;
-      h += traceMap<kKeep>(s, plan, i, kKeep ? dist + i * plan.distBytes : nullptr,
+      h += traceMap<kKeep>(s, plan, first + i, kKeep ? dist + i * plan.distBytes : nullptr,
                            kKeep && norm ? norm + i * plan.normBytes : nullptr);
       const uint64_t d = done.fetch_add(1, std::memory_order_relaxed) + 1;
       if (o.progress) o.progress(d, maps);
@@ -253,13 +258,13 @@ Result<BakedField> bakeField(const Scene& scene, const BakeOptions& o) {
   if (!plan) return std::move(plan).error();
   BakedField out;
   out.field = plan->field;
+  const uint64_t maps = uint64_t(o.mapEnd ? o.mapEnd : plan->field.mapCount) - o.mapBegin;
   try {
-    out.distance.assign(plan->distBytes * plan->field.mapCount, 0);
-    if (o.normals) out.normals.assign(plan->normBytes * plan->field.mapCount, 0);
+    out.distance.assign(plan->distBytes * maps, 0);
+    if (o.normals) out.normals.assign(plan->normBytes * maps, 0);
   } catch (const std::bad_alloc&) {
-    return makeError(Code::kOutOfMemory, "cannot allocate the field's " +
-                                             std::to_string((plan->distBytes + plan->normBytes) * plan->field.mapCount) +
-                                             " bytes");
+    return makeError(Code::kOutOfMemory,
+                     "cannot allocate the field's " + std::to_string((plan->distBytes + plan->normBytes) * maps) + " bytes");
   }
   out.stats = runAll<true>(*scene.impl_, *plan, o, out.distance.data(), o.normals ? out.normals.data() : nullptr);
   if (o.cancel && o.cancel->load()) return makeError(Code::kBadState, "the bake was cancelled");

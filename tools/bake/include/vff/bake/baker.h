@@ -34,6 +34,11 @@ struct BakeOptions {
   // maps and bakeField fails with kBadState ("cancelled"). For callers that stop a bake from
   // another thread (a Ctrl-C in the Python module).
   const std::atomic<bool>* cancel = nullptr;
+  // Bake only maps [mapBegin, mapEnd) of the field (indices in its sample order); mapEnd 0 means
+  // the last map. A map's bytes do not depend on the range it is baked in, so ranges baked apart
+  // and put side by side are the whole bake's maps. A range outside the field is kInvalidArgument.
+  uint32_t mapBegin = 0;
+  uint32_t mapEnd = 0;
 };
 
 struct BakeStats {
@@ -44,8 +49,10 @@ struct BakeStats {
 
 struct BakedField {
   FieldDesc field;
-  std::vector<uint8_t> distance;  // mapCount maps, map-major
-  std::vector<uint8_t> normals;   // empty unless options.normals
+  // The baked maps, map-major: mapCount maps, or mapEnd - mapBegin of a range bake (field still
+  // describes the whole field).
+  std::vector<uint8_t> distance;
+  std::vector<uint8_t> normals;  // empty unless options.normals
   BakeStats stats;
 };
 
