@@ -14,6 +14,7 @@ fi
 test_outputs_match_plain_bake() { case_outputs_match_plain_bake; }
 test_rerun_submits_nothing() { case_rerun_bakes_nothing; }
 test_changed_option_rebakes_only_affected() { case_changed_option_rebakes_only_affected; }
+test_sharded_bake_merges_to_whole() { case_sharded_bake_merges_to_whole; }
 
 test_cancelled_task_completed_by_next_run() {
   make_library "$WORK/lib" shared

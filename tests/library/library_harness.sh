@@ -112,3 +112,28 @@ case_changed_option_rebakes_only_affected() {
 
 # The number of output fields.
 outputs() { find "$WORK/fields" -maxdepth 1 -name '*.vff' | wc -l; }
+
+# An entry above --shard-maps is baked in map ranges (vff-bake --map-range) and merged (--merge):
+# the same bytes as a whole bake; entries below it are baked whole.
+case_sharded_bake_merges_to_whole() {
+  mkdir -p "$WORK/lib"
+  "$MESHGEN" torus-knot "$WORK/lib/knot.obj"
+  "$MESHGEN" box "$WORK/lib/box.obj"
+  # knot: 290 maps in ranges of at most 100; box: 82 maps, whole.
+  cat >"$WORK/lib/library.json" <<JSON
+{"vffLibrary": 1, "defaults": {"count": 4, "map-size": 8},
+ "entries": [{"mesh": "knot.obj", "options": {"count": 8}}, {"mesh": "box.obj"}]}
+JSON
+  lib_bake "$WORK/lib/library.json" --shard-maps 100
+  expect_rc 0
+  [[ $(json '[t["maps"] for t in r["tasks"] if t["mesh"] == "knot.obj"]') == "[[0, 100], [100, 200], [200, 290]]" ]] \
+    || { show; fail "knot.obj not baked as three ranges: $(json '[t["maps"] for t in r["tasks"]]')"; }
+  [[ $(json '[t["maps"] for t in r["tasks"] if t["mesh"] == "box.obj"]') == "['all']" ]] || fail "box.obj baked whole"
+  "$VFF_BAKE" "$WORK/lib/knot.obj" -o "$WORK/plain.vff" -q -n 8 -m 8
+  cmp "$WORK/plain.vff" "$WORK/fields/knot.vff" || fail "the merged field differs from the whole bake"
+  expect_matches_plain_bake box -n 4 -m 8
+  [[ -z $(find "$WORK/fields/.vff-cache" -name '*.maps-*') ]] || fail "parts left in the cache after the merge"
+  # Sharded or not, the same key: nothing to do without sharding.
+  lib_bake "$WORK/lib/library.json"
+  [[ $(json 'len(r["upToDate"])') == 2 ]] || fail "the merged field is not the whole bake's cache entry"
+}

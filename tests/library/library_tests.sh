@@ -9,6 +9,7 @@ source "$(dirname "${BASH_SOURCE[0]}")/library_harness.sh"
 test_outputs_match_plain_bake() { case_outputs_match_plain_bake; }
 test_rerun_bakes_nothing() { case_rerun_bakes_nothing; }
 test_changed_option_rebakes_only_affected() { case_changed_option_rebakes_only_affected; }
+test_sharded_bake_merges_to_whole() { case_sharded_bake_merges_to_whole; }
 
 test_killed_pool_loses_nothing_and_resumes() {
   make_library "$WORK/lib" shared

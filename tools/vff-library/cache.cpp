@@ -192,6 +192,11 @@ std::string cachePath(const std::string& cacheDir, const std::string& key) {
   return cacheDir + "/" + key.substr(0, 2) + "/" + key + ".vff";
 }
 
+std::string partPath(const std::string& cacheDir, const std::string& key, uint32_t begin, uint32_t end) {
+  return cacheDir + "/" + key.substr(0, 2) + "/" + key + ".maps-" + std::to_string(begin) + "-" + std::to_string(end) +
+         ".vff";
+}
+
 bool inCache(const std::string& cacheDir, const std::string& key) {
   struct stat st{};
   return ::stat(cachePath(cacheDir, key).c_str(), &st) == 0 && S_ISREG(st.st_mode);

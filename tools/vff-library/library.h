@@ -51,6 +51,8 @@ struct CacheOptions {
 void computeKeys(std::vector<Entry>& entries, const CacheOptions& o);
 // CACHE/ab/KEY.vff
 std::string cachePath(const std::string& cacheDir, const std::string& key);
+// CACHE/ab/KEY.maps-BEGIN-END.vff: a partial result of maps [begin, end) (vff-bake --map-range).
+std::string partPath(const std::string& cacheDir, const std::string& key, uint32_t begin, uint32_t end);
 // The entry's field is in the cache.
 bool inCache(const std::string& cacheDir, const std::string& key);
 // The entry's output is the cached field: the same file (a hard link) or a copy of it with its size
@@ -84,8 +86,19 @@ struct WorkerOptions {
   uint64_t shardMaps = 0;  // unused until the sharded bake is available
 };
 
-// Bakes `e` into the cache through vff-bake in a private folder. Blocking.
-BakeResult bakeEntry(const Entry& e, const WorkerOptions& o);
+// One bake: a whole entry, or maps [begin, end) of it (a part, for entries above their shardMaps).
+struct Unit {
+  size_t entry = 0;
+  uint32_t begin = 0, end = 0;  // both 0: the whole field
+  bool part() const { return end > begin; }
+};
+
+// Bakes `u` of `e` into the cache (a part to its partPath) through vff-bake in a private folder.
+// Blocking.
+BakeResult bakeUnit(const Entry& e, const Unit& u, const WorkerOptions& o);
+// vff-bake --merge of the entry's parts into its cached field (the whole bake's bytes), then the
+// parts are removed.
+BakeResult mergeParts(const Entry& e, const std::vector<Unit>& parts, const WorkerOptions& o);
 // Runs `args` (args[0] looked up in PATH) with stdout and stderr into the files `out` and `err`,
 // killed if this thread ends first; its exit code (128 + N when killed by signal N, -1 when it
 // could not be started).
@@ -97,21 +110,35 @@ std::string findVffBake();
 // This program, absolute (for Slurm's batch script).
 std::string selfPath();
 
-// ---- Running (pool.cpp, slurm.cpp) --------------------------------------------------------------
+// ---- Running (shard.cpp, pool.cpp, slurm.cpp) ---------------------------------------------------
+// The bakes of the entries `todo`: one unit each, or for an entry with more maps than its
+// shardMaps, one per range of at most shardMaps maps not yet in the cache.
+std::vector<Unit> planUnits(const std::vector<Entry>& entries, const std::vector<size_t>& todo,
+                            const std::string& cacheDir);
+
 struct EntryOutcome {
   size_t entry = 0;  // index into the entries
+  Unit unit;
   BakeResult result;
   std::string where;  // "local", or "slurm JOB_TASK"
 };
+// Each entry of `todo` once its units ran (`units`: their outcomes): whole ones as they ended,
+// sharded ones merged and installed when every part is in the cache.
+std::vector<EntryOutcome> finishEntries(const std::vector<Entry>& entries, const std::vector<size_t>& todo,
+                                        const std::vector<EntryOutcome>& units, const WorkerOptions& wo);
+
+
+// The rays of one unit.
+uint64_t unitRays(const std::vector<Entry>& entries, const Unit& u);
 
 struct PoolOptions {
   unsigned workers = 1;
   unsigned threadsPerWorker = 1;
   bool progress = false;
 };
-// Bakes the entries `todo` (indices) with a pool of `workers` vff-bake processes at a time; each
-// finished entry is installed at its output at once.
-std::vector<EntryOutcome> runPool(const std::vector<Entry>& entries, const std::vector<size_t>& todo,
+// Bakes the units `todo` with a pool of `workers` vff-bake processes at a time; each finished whole
+// entry is installed at its output at once.
+std::vector<EntryOutcome> runPool(const std::vector<Entry>& entries, const std::vector<Unit>& todo,
                                   const WorkerOptions& wo, const PoolOptions& po);
 
 struct SlurmOptions {
@@ -128,7 +155,7 @@ struct SlurmOptions {
 };
 // Bakes `todo` as one Slurm job array (and resubmissions of what it left missing); returns the
 // outcomes collected from the tasks' reports, or an error message with its exit code in *rc.
-std::optional<std::string> runSlurm(const std::vector<Entry>& entries, const std::vector<size_t>& todo,
+std::optional<std::string> runSlurm(const std::vector<Entry>& entries, const std::vector<Unit>& todo,
                                     const WorkerOptions& wo, const SlurmOptions& so,
                                     std::vector<EntryOutcome>* outcomes, std::vector<std::string>* jobIds, int* rc);
 // `vff-library run-shard STATE TASK`: bakes the plan's entries of array task TASK into the cache
@@ -138,7 +165,8 @@ int runShard(const std::string& stateDir, unsigned task);
 // ---- Report (report.cpp) ------------------------------------------------------------------------
 struct Report {
   std::vector<size_t> upToDate, baked, failed;
-  std::vector<EntryOutcome> outcomes;  // what ran, with its time
+  std::vector<EntryOutcome> outcomes;  // each bake that ran (a whole entry or a part), with its time
+  std::vector<EntryOutcome> entryOutcomes;  // each entry that was to be baked
   std::vector<std::string> slurmJobs;
   double seconds = 0;  // the whole run
   std::string mode;    // "local" or "slurm"

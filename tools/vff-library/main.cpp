@@ -30,6 +30,7 @@ struct Options {
   std::string input, out, cache, glob = "*.obj,*.ply,*.off,*.stl,*.gltf,*.glb", json;
   std::vector<std::string> bakeArgs;
   unsigned workers = 0, threads = 0;
+  uint64_t shardMaps = 0;
   bool slurm = false, dryRun = false, quiet = false, rehash = false;
   SlurmOptions slurmOptions;
   std::string planPath;
@@ -45,6 +46,10 @@ void addBakeOptions(CLI::App& bake, Options& o) {
   bake.add_option("--glob", o.glob, "folder input: comma-separated patterns of the files to bake")->capture_default_str();
   bake.add_option("-j,--workers", o.workers, "local: vff-bake processes at a time (0: one per core)")->capture_default_str();
   bake.add_option("--threads", o.threads, "local: threads of each vff-bake (0: the cores shared among the workers)")
+      ->capture_default_str();
+  bake.add_option("--shard-maps", o.shardMaps,
+                  "bake an entry of more maps than this as ranges of at most this many (vff-bake --map-range), in "
+                  "parallel, merged into the same bytes (vff-bake --merge); 0: never (a manifest's shardMaps wins)")
       ->capture_default_str();
   bake.add_flag("--slurm", o.slurm, "bake as a Slurm job array (sbatch; the cache must be on a filesystem the nodes share)");
   SlurmOptions& s = o.slurmOptions;
@@ -112,6 +117,8 @@ int bakeLibrary(const Options& o) {
     return cli::kExitIo;
   }
   removeStalePrivateDirs(wo.cacheDir);
+  for (Entry& e : entries)
+    if (!e.shardMaps) e.shardMaps = o.shardMaps;
   computeKeys(entries, {.dir = wo.cacheDir, .threads = cores, .statNotes = !o.rehash});
 
   Report report;
@@ -136,15 +143,16 @@ int bakeLibrary(const Options& o) {
   }
 
   const bool progress = !o.quiet && !o.dryRun && isatty(2);
+  const std::vector<Unit> units = planUnits(entries, todo, wo.cacheDir);
   if (o.slurm) {
     SlurmOptions so = o.slurmOptions;
     so.dryRun = o.dryRun;
     so.progress = progress;
     if (so.stateDir.empty())
       so.stateDir = wo.cacheDir + "/slurm/" + std::to_string(std::time(nullptr)) + "-" + std::to_string(getpid());
-    if (!todo.empty()) {
+    if (!units.empty()) {
       int rc = 0;
-      if (auto p = runSlurm(entries, todo, wo, so, &report.outcomes, &report.slurmJobs, &rc)) {
+      if (auto p = runSlurm(entries, units, wo, so, &report.outcomes, &report.slurmJobs, &rc)) {
         cli::printError(kProg, *p);
         return rc;
       }
@@ -155,19 +163,24 @@ int bakeLibrary(const Options& o) {
     report.threadsPerWorker = o.threads ? o.threads : std::max(1u, cores / report.workers);
     wo.threads = report.threadsPerWorker;
     if (o.dryRun) {
-      for (size_t i : todo) {
-        std::printf("%s %s", wo.vffBake.c_str(), entries[i].mesh.c_str());
-        for (const auto& a : entries[i].args) std::printf(" %s", a.c_str());
-        std::printf(" -o %s -j %u  # -> %s\n", cachePath(wo.cacheDir, entries[i].key).c_str(), wo.threads,
-                    entries[i].output.c_str());
+      for (const Unit& u : units) {
+        const Entry& e = entries[u.entry];
+        std::printf("%s %s", wo.vffBake.c_str(), e.mesh.c_str());
+        for (const auto& a : e.args) std::printf(" %s", a.c_str());
+        if (u.part())
+          std::printf(" --map-range %u:%u -o %s -j %u  # part of %s\n", u.begin, u.end,
+                      partPath(wo.cacheDir, e.key, u.begin, u.end).c_str(), wo.threads, e.output.c_str());
+        else
+          std::printf(" -o %s -j %u  # -> %s\n", cachePath(wo.cacheDir, e.key).c_str(), wo.threads, e.output.c_str());
       }
     } else {
-      report.outcomes = runPool(entries, todo, wo, {.workers = report.workers, .threadsPerWorker = wo.threads,
+      report.outcomes = runPool(entries, units, wo, {.workers = report.workers, .threadsPerWorker = wo.threads,
                                                     .progress = progress});
     }
   }
   if (o.dryRun) return cli::kExitSuccess;
-  for (const EntryOutcome& out : report.outcomes) (out.result.ok ? report.baked : report.failed).push_back(out.entry);
+  report.entryOutcomes = finishEntries(entries, todo, report.outcomes, wo);
+  for (const EntryOutcome& out : report.entryOutcomes) (out.result.ok ? report.baked : report.failed).push_back(out.entry);
   std::sort(report.baked.begin(), report.baked.end());
   std::sort(report.failed.begin(), report.failed.end());
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -11,23 +11,29 @@
 
 namespace vff::library {
 
-std::vector<EntryOutcome> runPool(const std::vector<Entry>& entries, const std::vector<size_t>& todo,
+uint64_t unitRays(const std::vector<Entry>& entries, const Unit& u) {
+  const Entry& e = entries[u.entry];
+  return u.part() && e.maps ? e.rays / e.maps * (u.end - u.begin) : e.rays;
+}
+
+std::vector<EntryOutcome> runPool(const std::vector<Entry>& entries, const std::vector<Unit>& todo,
                                   const WorkerOptions& wo, const PoolOptions& po) {
   std::vector<EntryOutcome> outcomes(todo.size());
   std::atomic<size_t> next{0}, done{0};
   cli::Progress progress(kProg, po.progress, 0, "entries");
-  // The largest fields first, so that the last one to start is a small one.
-  std::vector<size_t> order(todo);
+  // The largest bakes first, so that the last one to start is a small one.
+  std::vector<Unit> order(todo);
   std::stable_sort(order.begin(), order.end(),
-                   [&](size_t a, size_t b) { return entries[a].rays > entries[b].rays; });
+                   [&](const Unit& a, const Unit& b) { return unitRays(entries, a) > unitRays(entries, b); });
   auto work = [&] {
     for (size_t i; (i = next++) < order.size();) {
-      const Entry& e = entries[order[i]];
+      const Entry& e = entries[order[i].entry];
       EntryOutcome& out = outcomes[i];
-      out.entry = order[i];
+      out.entry = order[i].entry;
+      out.unit = order[i];
       out.where = "local";
-      out.result = bakeEntry(e, wo);
-      if (out.result.ok)
+      out.result = bakeUnit(e, order[i], wo);
+      if (out.result.ok && !order[i].part())
         if (auto problem = installOutput(wo.cacheDir, e)) {
           out.result.ok = false;
           out.result.error = *problem;

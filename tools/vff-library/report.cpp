@@ -34,12 +34,13 @@ nlohmann::json reportJson(const std::vector<Entry>& entries, const Report& r) {
   for (size_t i : r.upToDate)
     j["upToDate"].push_back({{"mesh", entries[i].name}, {"output", entries[i].output}, {"key", entries[i].key}});
   for (const EntryOutcome& o : r.outcomes)
-    j["tasks"].push_back({{"mesh", entries[o.entry].name}, {"where", o.where}, {"ok", o.result.ok},
+    j["tasks"].push_back({{"mesh", entries[o.entry].name}, {"maps", o.unit.part() ? nlohmann::json::array({o.unit.begin, o.unit.end}) : nlohmann::json("all")},
+                          {"where", o.where}, {"ok", o.result.ok},
                           {"seconds", o.result.seconds}, {"rays", o.result.rays}});
   for (size_t i : r.failed) {
     std::string error = entries[i].error;
     int code = entries[i].exitCode;
-    for (const EntryOutcome& o : r.outcomes)
+    for (const EntryOutcome& o : r.entryOutcomes)
       if (o.entry == i) error = o.result.error, code = o.result.exitCode;
     j["failed"].push_back({{"mesh", entries[i].name}, {"output", entries[i].output}, {"error", error}, {"exitCode", code}});
   }
@@ -49,8 +50,10 @@ nlohmann::json reportJson(const std::vector<Entry>& entries, const Report& r) {
 void printReport(const std::vector<Entry>& entries, const Report& r, std::FILE* to) {
   const nlohmann::json j = reportJson(entries, r);
   for (const auto& t : j["tasks"])
-    std::fprintf(to, "  %-40s %8.2f s  %s%s\n", t["mesh"].get<std::string>().c_str(), t["seconds"].get<double>(),
-                 t["where"].get<std::string>().c_str(), t["ok"].get<bool>() ? "" : "  (failed)");
+    std::fprintf(to, "  %-40s %-14s %8.2f s  %s%s\n", t["mesh"].get<std::string>().c_str(),
+                 t["maps"].is_array() ? ("maps " + std::to_string(t["maps"][0].get<unsigned>()) + "-" +
+                                         std::to_string(t["maps"][1].get<unsigned>())).c_str() : "",
+                 t["seconds"].get<double>(), t["where"].get<std::string>().c_str(), t["ok"].get<bool>() ? "" : "  (failed)");
   for (const auto& f : j["failed"])
     std::fprintf(to, "%s: error: %s: %s (exit %d)\n", kProg, f["mesh"].get<std::string>().c_str(),
                  f["error"].get<std::string>().c_str(), f["exitCode"].get<int>());

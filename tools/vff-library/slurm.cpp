@@ -2,6 +2,7 @@
 // `sbatch --array` whose task K bakes its share of the plan (`vff-library run-shard PLAN K`) into
 // the shared cache, polling squeue until the array is gone, collecting the tasks' reports, and
 // resubmitting only the entries still missing from the cache.
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -40,16 +41,18 @@ std::string trim(std::string s) {
 }
 
 // The plan of one submission: which entries each array task bakes.
-nlohmann::json makePlan(const std::vector<Entry>& entries, const std::vector<size_t>& todo, const WorkerOptions& wo,
+nlohmann::json makePlan(const std::vector<Entry>& entries, const std::vector<Unit>& todo, const WorkerOptions& wo,
                         unsigned tasks) {
-  std::vector<size_t> order(todo);
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return entries[a].rays > entries[b].rays; });
+  std::vector<Unit> order(todo);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](const Unit& a, const Unit& b) { return unitRays(entries, a) > unitRays(entries, b); });
   nlohmann::json plan = {{"vffLibraryPlan", 1}, {"vffBake", wo.vffBake}, {"cache", wo.cacheDir},
                          {"tasks", tasks}, {"entries", nlohmann::json::array()}};
   for (size_t i = 0; i < order.size(); ++i) {
-    const Entry& e = entries[order[i]];
-    plan["entries"].push_back({{"index", order[i]}, {"task", i % tasks}, {"key", e.key}, {"mesh", e.mesh},
-                               {"args", e.args}, {"rays", e.rays}});
+    const Entry& e = entries[order[i].entry];
+    plan["entries"].push_back({{"index", order[i].entry}, {"begin", order[i].begin}, {"end", order[i].end},
+                               {"task", i % tasks}, {"key", e.key}, {"mesh", e.mesh}, {"args", e.args},
+                               {"rays", unitRays(entries, order[i])}});
   }
   return plan;
 }
@@ -74,7 +77,7 @@ bool jobActive(const std::string& jobId, const std::string& dir) {
 
 }  // namespace
 
-std::optional<std::string> runSlurm(const std::vector<Entry>& entries, const std::vector<size_t>& todo,
+std::optional<std::string> runSlurm(const std::vector<Entry>& entries, const std::vector<Unit>& todo,
                                     const WorkerOptions& wo, const SlurmOptions& so,
                                     std::vector<EntryOutcome>* outcomes, std::vector<std::string>* jobIds, int* rc) {
   std::error_code ec;
@@ -84,7 +87,15 @@ std::optional<std::string> runSlurm(const std::vector<Entry>& entries, const std
     return so.stateDir + ": " + ec.message();
   }
   const std::string state = fs::absolute(so.stateDir).string();
-  std::vector<size_t> pending = todo;
+  std::vector<Unit> pending = todo;
+  // A unit's file in the cache: the entry's field, or its part.
+  auto cached = [&](const Unit& u) {
+    const Entry& e = entries[u.entry];
+    if (!u.part()) return inCache(wo.cacheDir, e.key);
+    struct stat st{};
+    return ::stat(partPath(wo.cacheDir, e.key, u.begin, u.end).c_str(), &st) == 0;
+  };
+  auto unitId = [](const Unit& u) { return std::to_string(u.entry) + ":" + std::to_string(u.begin) + ":" + std::to_string(u.end); };
   cli::Progress progress(kProg, so.progress, 0, "entries");
   for (unsigned round = 0; !pending.empty(); ++round) {
     const unsigned tasks = so.tasks ? std::min<unsigned>(so.tasks, unsigned(pending.size()))
@@ -92,8 +103,10 @@ std::optional<std::string> runSlurm(const std::vector<Entry>& entries, const std
     const std::string stem = state + "/round-" + std::to_string(round);
     const std::string plan = stem + ".plan.json", script = stem + ".sh";
     const nlohmann::json planJson = makePlan(entries, pending, wo, tasks);
-    std::map<size_t, unsigned> taskOf;
-    for (const auto& j : planJson["entries"]) taskOf[j["index"].get<size_t>()] = j["task"].get<unsigned>();
+    std::map<std::string, unsigned> taskOf;
+    for (const auto& j : planJson["entries"])
+      taskOf[unitId({j["index"].get<size_t>(), j["begin"].get<uint32_t>(), j["end"].get<uint32_t>()})] =
+          j["task"].get<unsigned>();
     if (auto p = writeText(plan, planJson.dump(1))) return *rc = cli::kExitIo, *p;
     if (auto p = writeText(script, batchScript(so, plan, stem + ".task-%a.log"))) return *rc = cli::kExitIo, *p;
     std::string array = "--array=0-" + std::to_string(tasks - 1);
@@ -116,38 +129,40 @@ std::optional<std::string> runSlurm(const std::vector<Entry>& entries, const std
     jobIds->push_back(jobId);
     while (jobActive(jobId, state)) {
       size_t have = 0;
-      for (size_t i : todo) have += inCache(wo.cacheDir, entries[i].key);
+      for (const Unit& u : todo) have += cached(u);
       progress.update(have, todo.size());
       std::this_thread::sleep_for(std::chrono::duration<double>(so.pollSeconds));
     }
     // Collect what the tasks reported; whatever is in the cache is done.
-    std::map<size_t, EntryOutcome> reported;
+    std::map<std::string, EntryOutcome> reported;
     for (unsigned t = 0; t < tasks; ++t) {
       auto r = nlohmann::json::parse(readText(stem + ".report-" + std::to_string(t) + ".json"), nullptr, false);
       if (r.is_discarded() || !r.contains("entries")) continue;
       for (const auto& j : r["entries"]) {
         EntryOutcome o;
         o.entry = j.value("index", size_t{0});
+        o.unit = {o.entry, j.value("begin", 0u), j.value("end", 0u)};
         o.where = "slurm " + jobId + "_" + std::to_string(t);
         o.result.ok = j.value("ok", false);
         o.result.exitCode = j.value("exitCode", 0);
         o.result.error = j.value("error", std::string());
         o.result.rays = j.value("rays", uint64_t{0});
         o.result.seconds = j.value("seconds", 0.0);
-        reported[o.entry] = o;
+        reported[unitId(o.unit)] = o;
       }
     }
-    std::vector<size_t> missing;
-    for (size_t i : pending) {
-      const bool cached = inCache(wo.cacheDir, entries[i].key);
-      auto it = reported.find(i);
+    std::vector<Unit> missing;
+    for (const Unit& u : pending) {
+      auto it = reported.find(unitId(u));
       EntryOutcome o;
-      o.entry = i;
-      o.where = "slurm " + jobId + "_" + std::to_string(taskOf[i]);
+      o.entry = u.entry;
+      o.unit = u;
+      o.where = "slurm " + jobId + "_" + std::to_string(taskOf[unitId(u)]);
       if (it != reported.end()) o = it->second;
-      if (cached) {
+      if (cached(u)) {
         o.result.ok = true;
-        if (auto problem = installOutput(wo.cacheDir, entries[i])) {
+        if (!u.part())
+          if (auto problem = installOutput(wo.cacheDir, entries[u.entry])) {
           o.result.ok = false;
           o.result.error = *problem;
           o.result.exitCode = cli::kExitIo;
@@ -156,7 +171,7 @@ std::optional<std::string> runSlurm(const std::vector<Entry>& entries, const std
       } else if (it != reported.end() && it->second.result.exitCode > 0 && it->second.result.exitCode < 128) {
         outcomes->push_back(o);  // the bake itself failed: resubmitting would fail again
       } else if (round < so.retries) {
-        missing.push_back(i);
+        missing.push_back(u);
       } else {
         o.result.ok = false;
         o.result.exitCode = cli::kExitRuntime;
@@ -198,14 +213,16 @@ int runShard(const std::string& planPath, unsigned task) {
     e.key = j.value("key", std::string());
     e.mesh = j.value("mesh", std::string());
     e.args = j.value("args", std::vector<std::string>{});
+    const Unit u{0, j.value("begin", 0u), j.value("end", 0u)};
     BakeResult r;
-    if (inCache(wo.cacheDir, e.key)) {
+    struct stat st{};
+    if (::stat((u.part() ? partPath(wo.cacheDir, e.key, u.begin, u.end) : cachePath(wo.cacheDir, e.key)).c_str(), &st) == 0) {
       r.ok = true;  // an earlier or concurrent task baked it
     } else {
-      r = bakeEntry(e, wo);
+      r = bakeUnit(e, u, wo);
     }
     if (!r.ok) rc = cli::kExitRuntime;
-    out["entries"].push_back({{"index", j.value("index", size_t{0})}, {"ok", r.ok}, {"exitCode", r.exitCode},
+    out["entries"].push_back({{"index", j.value("index", size_t{0})}, {"begin", u.begin}, {"end", u.end}, {"ok", r.ok}, {"exitCode", r.exitCode},
                               {"error", r.error}, {"rays", r.rays}, {"seconds", r.seconds}});
     // Written after each entry: a task killed later still reports what it did.
     if (auto p = writeText(report, out.dump(1))) cli::printError(kProg, report + ": " + *p);

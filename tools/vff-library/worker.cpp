@@ -6,7 +6,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -69,22 +71,27 @@ int runProcess(const std::vector<std::string>& args, const std::string& out, con
   return -1;
 }
 
-BakeResult bakeEntry(const Entry& e, const WorkerOptions& o) {
+namespace {
+
+// Runs vff-bake with `args` (and -o DIR/NAME) in a private folder; on success moves the file to
+// `to` in the cache.
+BakeResult runVffBake(std::vector<std::string> args, const std::string& to, const WorkerOptions& o) {
   BakeResult r;
   const auto t0 = std::chrono::steady_clock::now();
   const std::string dir = makePrivateDir(o.cacheDir);
-  const std::string file = dir + "/" + e.key + ".vff";
-  std::vector<std::string> args = {o.vffBake, e.mesh};
-  args.insert(args.end(), e.args.begin(), e.args.end());
-  args.insert(args.end(), {"-o", file, "-j", std::to_string(o.threads), "--json", "-q"});
+  const std::string file = dir + "/" + fs::path(to).filename().string();
+  args.insert(args.end(), {"-o", file});
   const int rc = runProcess(args, dir + "/stdout.json", dir + "/stderr.txt");
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.exitCode = rc;
   if (rc == 0) {
     auto summary = nlohmann::json::parse(readText(dir + "/stdout.json"), nullptr, false);
     if (!summary.is_discarded()) r.rays = summary.value("rays", uint64_t{0});
-    if (auto problem = commitToCache(o.cacheDir, e.key, file)) {
-      r.error = *problem;
+    std::error_code ec;
+    fs::create_directories(fs::path(to).parent_path(), ec);
+    if (::rename(file.c_str(), to.c_str()) != 0) {
+      const std::string problem = to + ": " + std::strerror(errno);
+      r.error = problem;
       r.exitCode = cli::kExitIo;
     } else {
       r.ok = true;
@@ -99,6 +106,27 @@ BakeResult bakeEntry(const Entry& e, const WorkerOptions& o) {
   }
   std::error_code ec;
   fs::remove_all(dir, ec);
+  return r;
+}
+
+}  // namespace
+
+BakeResult bakeUnit(const Entry& e, const Unit& u, const WorkerOptions& o) {
+  std::vector<std::string> args = {o.vffBake, e.mesh};
+  args.insert(args.end(), e.args.begin(), e.args.end());
+  args.insert(args.end(), {"-j", std::to_string(o.threads), "--json", "-q"});
+  if (!u.part()) return runVffBake(args, cachePath(o.cacheDir, e.key), o);
+  args.insert(args.end(), {"--map-range", std::to_string(u.begin) + ":" + std::to_string(u.end)});
+  return runVffBake(args, partPath(o.cacheDir, e.key, u.begin, u.end), o);
+}
+
+BakeResult mergeParts(const Entry& e, const std::vector<Unit>& parts, const WorkerOptions& o) {
+  std::vector<std::string> args = {o.vffBake, "--merge"};
+  for (const Unit& u : parts) args.push_back(partPath(o.cacheDir, e.key, u.begin, u.end));
+  args.push_back("-q");
+  BakeResult r = runVffBake(args, cachePath(o.cacheDir, e.key), o);
+  if (r.ok)
+    for (const Unit& u : parts) ::unlink(partPath(o.cacheDir, e.key, u.begin, u.end).c_str());
   return r;
 }
 
