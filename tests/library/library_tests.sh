@@ -84,6 +84,15 @@ test_dry_run_bakes_nothing() {
   [[ -z $(find "$WORK/fields" -name '*.vff') ]] || fail "a dry run baked"
 }
 
+test_manifests_match_the_schema() {
+  [[ -n ${SCHEMA_CHECK:-} ]] || { echo "SKIP: vff_cli_schema_check is not built"; return 0; }
+  mkdir -p "$WORK/lib"
+  write_manifest 8
+  "$SCHEMA_CHECK" "$SCHEMA" "$WORK/lib/library.json" || fail "a manifest vff-library bakes does not match the schema"
+  echo '{"vffLibrary": 1, "entries": [{"mesh": "a.obj", "options": {"threads": 4}}]}' >"$WORK/lib/m.json"
+  ! "$SCHEMA_CHECK" "$SCHEMA" "$WORK/lib/m.json" || fail "the schema takes an option vff-library refuses"
+}
+
 test_manifest_errors() {
   mkdir -p "$WORK/lib"
   echo '{"vffLibrary": 1, "entries": [{"mesh": "a.obj", "options": {"threads": 4}}]}' >"$WORK/lib/m.json"
