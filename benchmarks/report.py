@@ -25,7 +25,10 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BEGIN = "<!-- benchmarks:begin: made by `python3 benchmarks/report.py readme`; do not edit -->"
 END = "<!-- benchmarks:end -->"
 STEPS = ["bake", "query", "accuracy-ao", "accuracy-intra-ao", "accuracy-shadows", "accuracy-reflections",
-         "compression", "gpu"]
+         "compression", "gpu", "library"]
+# Steps a results file may lack: the GPU bench (no headless OpenGL), the library bake (files from
+# before it existed).
+OPTIONAL_STEPS = ("gpu", "library")
 
 
 class ParseError(Exception):
@@ -156,7 +159,22 @@ def parse_gpu(text):
     return {"gpu": gpu.group(1), "queries": queries}
 
 
-PARSERS = {"bake": parse_bake, "query": parse_query, "compression": parse_compression, "gpu": parse_gpu}
+def parse_library(text):
+    """benchmarks/library.sh: its table of runs, and the up-to-date re-run's time."""
+    rows = [r for r in md_rows(text) if r and r[0] != "run"]
+    m = re.search(r"^up-to-date re-run of (\d+) entries: ([0-9.]+) s", text, re.M)
+    if not rows or not m:
+        raise ParseError("no library table or re-run time")
+    return {"rows": rows, "entries": int(m.group(1)), "rerun": float(m.group(2))}
+
+
+def library_table(lib):
+    lines = ["| run | seconds | Mrays/s | / one after another |", "|---|---:|---:|---:|"]
+    lines += ["| " + " | ".join(r) + " |" for r in lib["rows"]]
+    return lines + ["", f"Up-to-date re-run of {lib['entries']} entries: {lib['rerun']:.2f} s."]
+
+
+PARSERS = {"library": parse_library, "bake": parse_bake, "query": parse_query, "compression": parse_compression, "gpu": parse_gpu}
 
 
 def parse_step(name, text):
@@ -268,6 +286,9 @@ def sections(machine, steps, heading, queries=None, only=None):
         renderer = steps["gpu"]["gpu"]
         soft = ": Mesa's software rasteriser, on the CPU" if "llvmpipe" in renderer else ""
         out += [f"{heading} GPU query ({renderer}{soft})", "", *gpu_table(steps["gpu"]), ""]
+    if "library" in steps:
+        out += [f"{heading} Library bake (vff-library against the same bakes one after another)", "",
+                *library_table(steps["library"]), ""]
     return out
 
 
@@ -395,7 +416,7 @@ def main(argv):
         return 0
     if len(argv) == 3 and argv[1] == "check":
         machine, steps = read_results(argv[2])
-        missing = [n for n in STEPS if n != "gpu" and n not in steps]
+        missing = [n for n in STEPS if n not in OPTIONAL_STEPS and n not in steps]
         if missing:
             raise ParseError(f"{argv[2]}: no output of " + ", ".join(missing))
         print(f"report.py: {argv[2]}: {machine['cpu']}, {machine['date']}: " + ", ".join(steps))

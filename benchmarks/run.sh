@@ -72,6 +72,7 @@ step() {
   local name="$1"; shift
   local shown="${*//$build\//}"
   shown="${shown//$raw\//}"
+  shown="${shown//$root\//}"
   shown="${shown//$raw/.}"
   shown="${shown//$(dirname "$mesh")\//}"
   echo "== $name: $shown" >&2
@@ -106,6 +107,9 @@ if [[ -x $gpubench ]]; then
 else
   echo "vff-gpu-bench is not built (no OpenGL or EGL development files)" >"$raw/gpu.skip"
 fi
+
+# The library bake: the pool and Slurm against the same bakes one after another (benchmarks/library.sh).
+step library bash "$root/benchmarks/library.sh" --build "$build" $( ((quick)) && echo --quick)
 
 # The machine and the build.
 cpu="$(python3 "$root/benchmarks/report.py" cpu)"

@@ -159,7 +159,7 @@ int bakeLibrary(const Options& o) {
     }
   } else {
     report.workers = o.workers ? o.workers : cores;
-    report.workers = std::max<unsigned>(1, std::min<unsigned>(report.workers, unsigned(std::max<size_t>(1, todo.size()))));
+    report.workers = std::max<unsigned>(1, std::min<unsigned>(report.workers, unsigned(std::max<size_t>(1, units.size()))));
     report.threadsPerWorker = o.threads ? o.threads : std::max(1u, cores / report.workers);
     wo.threads = report.threadsPerWorker;
     if (o.dryRun) {
