@@ -56,7 +56,7 @@ void addBakeOptions(CLI::App& bake, Options& o) {
   bake.add_option("--partition", s.partition, "slurm: the partition");
   bake.add_option("--time", s.time, "slurm: each task's time limit");
   bake.add_option("--max-running", s.maxRunning, "slurm: the most array tasks at once (%N)");
-  bake.add_option("--tasks", s.tasks, "slurm: array tasks (0: one per entry, at most 1000)");
+  bake.add_option("--tasks", s.tasks, "slurm: array tasks (0: one per bake, at most 1000); fewer tasks spend less time in the scheduler");
   bake.add_option("--cpus-per-task", s.cpusPerTask, "slurm: CPUs of each task, and vff-bake's threads");
   bake.add_option("--sbatch-arg", s.sbatchArgs, "slurm: another sbatch option (repeatable), e.g. --sbatch-arg=--account=A")
       ->allow_extra_args(false);
