@@ -1,6 +1,8 @@
 // query_build.cpp - building a FieldQuery (vff/query.h): the tables of FieldQuery::Impl
 // (query_impl.h) from a field's maps, and the plain tables the group kernel reads (query_group.h),
 // taken from them for each batch.
+#include <nlohmann/json.hpp>
+
 #include <cstring>
 #include <string>
 
@@ -164,6 +166,13 @@ Result<FieldQuery> FieldQuery::fromMaps(const FieldDesc& field, std::span<const 
 
 Result<FieldQuery> FieldQuery::fromFile(const File& file) {
   const FieldDesc& field = file.field();
+  // A partial result (spec/partial.md) holds misses in place of the maps outside its range: it
+  // must not answer rays as if they were the field's.
+  if (const auto meta = nlohmann::json::parse(file.metadata(), nullptr, false);
+      meta.is_object() && meta.contains("vff.partial"))
+    return makeError(Code::kUnsupported, "the file is a partial result (META \"vff.partial\": " +
+                                             meta["vff.partial"].dump() +
+                                             "); only the whole field answers rays: merge the parts with vff-bake --merge");
   auto ps = PositionSet::fromField(field);
   if (!ps) return ps.error();
   auto impl = std::make_unique<Impl>();

@@ -9,11 +9,12 @@
 #   VFF_BAKE     the vff-bake executable
 #   VFF_INSPECT  the vff-inspect executable
 #   MESHGEN      the vff-procedural-mesh executable
+#   VFF_QUERY    the vff-query executable (a partial result answers no rays)
 #   EDIT         vff_shard_edit: a copy of a file with one META value changed (shard_edit.cpp)
 #   MESHES       the shared meshes' folder (test_shared_mesh skips without it)
 #   WORK         a scratch folder of this test (emptied first)
 set -euo pipefail
-: "${VFF_BAKE:?}" "${VFF_INSPECT:?}" "${MESHGEN:?}" "${EDIT:?}" "${WORK:?}"
+: "${VFF_BAKE:?}" "${VFF_INSPECT:?}" "${MESHGEN:?}" "${EDIT:?}" "${VFF_QUERY:?}" "${WORK:?}"
 
 here="$(dirname "${BASH_SOURCE[0]}")"
 source "$here/../common/cli_harness.sh"
@@ -104,17 +105,29 @@ test_partial_is_valid_and_says_so() {
   expect_out '"zstdLevel": 5'
   run "$VFF_INSPECT" "$WORK/p.vff"
   expect_out 'partial:    maps 10:30 of 82 only'
+  # a partial result answers no rays: its other maps are not the field's
+  run "$VFF_QUERY" "$WORK/p.vff" --ray 0 0 5 0 0 -1
+  expect_rc 5
+  expect_err "p.vff: unsupported (9005): the file is a partial result"
   # the maps outside the range are misses: the partial's hits are those of its range in the whole
   bake "$WORK/knot.obj" -o "$WORK/w.vff" "${small[@]}"
   bake "$WORK/knot.obj" -o "$WORK/r.vff" "${small[@]}" --map-range 0:82
   expect_rc 0
   run "$VFF_INSPECT" "$WORK/r.vff" --format json
   expect_out '"mapBegin": 0'
+  bake "$WORK/knot.obj" -o "$WORK/j.vff" "${small[@]}" --map-range 3:9 --json
+  expect_out '"mapRange": ['
+  expect_out '"rays": 1536'
   run "$VFF_INSPECT" "$WORK/w.vff" --format json
   local whole
   whole=$(grep -o '"hits": [0-9]*' "$WORK/out" | head -1)
   run "$VFF_INSPECT" "$WORK/r.vff" --format json
   expect_out "$whole"
+  # one part of every map merges to the whole bake
+  bake --merge "$WORK/r.vff" -o "$WORK/m.vff" --json
+  expect_rc 0
+  expect_out '"parts": 1'
+  cmp "$WORK/w.vff" "$WORK/m.vff" || fail "a part of every map merges to other bytes"
 }
 
 # ---- Usage errors ------------------------------------------------------------------------------------
@@ -123,7 +136,7 @@ test_bad_ranges_are_usage_errors() {
   bake "$WORK/knot.obj" -o "$WORK/x.vff" "${small[@]}" --map-range 80:83
   expect_rc 1
   expect_err "it has 82 maps"
-  for r in 5:5 9:3 a:4 4 :4 4: -1:4; do
+  for r in 5:5 9:3 a:4 4: -1:4; do
     bake "$WORK/knot.obj" -o "$WORK/x.vff" "${small[@]}" --map-range "$r"
     expect_rc 1
     expect_err "--map-range takes BEGIN:END"
@@ -133,14 +146,24 @@ test_bad_ranges_are_usage_errors() {
   expect_err "--benchmark"
   bake "$WORK/knot.obj" -o "$WORK/x.json" --split mesh --map-range 0:4
   expect_rc 1
+  bake "$WORK/shape.vdb" -o "$WORK/x.vff" --map-range 0:4
+  expect_rc 1
+  expect_err "--map-range applies to a mesh bake"
   bake "$WORK/knot.obj" --merge "$WORK/a.vff" -o "$WORK/x.vff"
   expect_rc 1
   expect_err "--merge takes partial results, not a mesh"
   bake --merge "$WORK/a.vff" "$WORK/b.vff" -o "$WORK/x.vff" --codec zstd
   expect_rc 1
   expect_err "--codec does not apply"
+  bake "$WORK/knot.obj" -o "$WORK/a.vff" "${small[@]}" --map-range 0:82
+  expect_rc 0
+  cp "$WORK/a.vff" "$WORK/a.copy"
   bake --merge "$WORK/a.vff" -o "$WORK/a.vff"
   expect_rc 1
+  expect_err "is also a part to merge"
+  bake --merge "$WORK/a.vff" -o "$WORK/../$(basename "$WORK")/a.vff"
+  expect_rc 1
+  cmp "$WORK/a.vff" "$WORK/a.copy" || fail "the part was changed"
   bake --merge "$WORK/a.vff"
   expect_rc 1
   expect_err "-o FILE"

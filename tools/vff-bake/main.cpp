@@ -20,7 +20,10 @@ int main(int argc, char** argv) {
                "OpenVDB level set (rays intersected with its zero crossing, normals from its gradient).\n"
                "Inputs: .obj .ply .off .stl (OpenMesh), .gltf .glb (tinygltf), .vdb (OpenVDB: the first float\n"
                "grid of class level set by name, as vdb_print lists them, or --grid NAME; default sphere: the\n"
-               "one around the active voxels' bounding box).\n" +
+               "one around the active voxels' bounding box).\n"
+               "One field across tasks: --map-range BEGIN:END bakes those maps into a partial result; --merge\n"
+               "PART... -o OUT assembles the parts into the whole bake's bytes (spec/partial.md). Merge refusals:\n"
+               "gaps, overlaps, other geometry, options or version, a corrupt part: exit 3.\n" +
                vff::cli::exitCodeHelp()};
   addOptions(app, o);
   if (auto rc = vff::cli::parse(app, kProg, argc, argv)) return *rc;

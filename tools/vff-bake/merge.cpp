@@ -3,7 +3,7 @@
 // and META as the whole bake, so the bytes are the whole bake's by construction.
 #include <algorithm>
 #include <cstdio>
-#include <cstring>
+#include <filesystem>
 
 #include "bake.h"
 #include "cli.h"
@@ -70,7 +70,8 @@ std::optional<int> openPart(const std::string& path, std::vector<Part>* parts) {
 
 // The field description and layout, item by item, for comparing parts and saying how they differ.
 std::vector<std::pair<std::string, std::string>> describe(const FieldDesc& f, const LayoutDesc& l) {
-  char sphere[128], exact[128];  // 9 digits tell a float apart; %a shows every bit
+  // %.9g reads well and tells floats apart, but not -0 from +0; %a tells every bit apart.
+  char sphere[128], exact[128];
   std::snprintf(sphere, sizeof sphere, "centre %.9g %.9g %.9g radius %.9g", double(f.sphere.center[0]),
                 double(f.sphere.center[1]), double(f.sphere.center[2]), double(f.sphere.radius));
   std::snprintf(exact, sizeof exact, "centre %a %a %a radius %a", double(f.sphere.center[0]),
@@ -177,8 +178,9 @@ Status copyMaps(const Part& p, Plane plane, Writer& w) {
 }  // namespace
 
 int mergeParts(const Options& o) {
+  std::error_code ec;
   for (const std::string& path : o.merge)
-    if (path == o.output) {
+    if (path == o.output || std::filesystem::equivalent(path, o.output, ec)) {
       cli::usageError(kProg, "-o " + o.output + " is also a part to merge: write the whole field elsewhere");
       return cli::kExitUsage;
     }

@@ -92,6 +92,7 @@ void reportMeshBake(const Options& o, const bake::BakeOptions& bo, const bake::M
                   {"seconds", {{"load", m.load}, {"build", m.build}, {"bake", m.bake}, {"write", m.write}}},
                   {"meshMiB", meshMiB},
                   {"bvhMiB", bvhMiB}});
+  if (!o.mapRange.empty()) summary["mapRange"] = {bo.mapBegin, bo.mapEnd};  // the maps baked, [begin, end)
   if (wrote) {
     summary["output"] = o.output;
     summary["fileBytes"] = m.fileBytes;
@@ -107,8 +108,11 @@ void reportMeshBake(const Options& o, const bake::BakeOptions& bo, const bake::M
   } else if (o.benchmark) {
     printBenchmark(o, mesh, field, rays, m, payloadMiB, meshMiB, bvhMiB);
   } else if (!o.quiet) {
-    std::fprintf(stderr, "%s: %s: %u maps of %ux%u (%.0f rays, %.1f%% hits) in %.2f s (%.1f Mrays/s), %.3f MiB payload -> %s\n",
-                 kProg, o.mesh.c_str(), field.mapCount, field.mapResolution, field.mapResolution, rays,
+    const std::string maps = o.mapRange.empty() ? std::to_string(field.mapCount)
+                                                : std::to_string(bo.mapEnd - bo.mapBegin) + " (" + o.mapRange + " of " +
+                                                      std::to_string(field.mapCount) + ")";
+    std::fprintf(stderr, "%s: %s: %s maps of %ux%u (%.0f rays, %.1f%% hits) in %.2f s (%.1f Mrays/s), %.3f MiB payload -> %s\n",
+                 kProg, o.mesh.c_str(), maps.c_str(), field.mapResolution, field.mapResolution, rays,
                  100.0 * double(s.hits) / rays, m.bake, rays / m.bake / 1e6, payloadMiB, o.output.c_str());
   }
 }

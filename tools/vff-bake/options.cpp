@@ -64,7 +64,7 @@ void addOptions(CLI::App& app, Options& o) {
   app.add_option("--merge", o.merge,
                  "assemble partial results (any order; together exactly the field's maps) into -o: the same "
                  "bytes as the whole bake with their options, which they carry (no mesh, no bake options)")
-      ->type_name("PART...");
+      ->type_name("PART");
 }
 
 std::optional<std::string> checkMergeOptions(const CLI::App& app) {

@@ -139,7 +139,9 @@ class FieldQuery {
 
   // Decodes every block of the file's distance (and normal) plane into the file's cache once, so
   // that queries never fail or allocate. Errors: those of File::mapData (kBlockChecksum,
-  // kBlockDecode...), kPositionScheme for a scheme this library cannot evaluate.
+  // kBlockDecode...), kPositionScheme for a scheme this library cannot evaluate, kUnsupported for a
+  // partial result of vff-bake --map-range (META "vff.partial", spec/partial.md), whose maps outside
+  // its range are not the field's.
   static Result<FieldQuery> fromFile(const File& file);
   // Borrows map-major planes laid out as in a file (mapCount * mapBytes each; normals may be empty).
   // Errors: kInvalidArgument when a size does not match the description; the checks of
