@@ -25,8 +25,10 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BEGIN = "<!-- benchmarks:begin: made by `python3 benchmarks/report.py readme`; do not edit -->"
 END = "<!-- benchmarks:end -->"
 STEPS = ["bake", "query", "accuracy-ao", "accuracy-intra-ao", "accuracy-shadows", "accuracy-reflections",
-         "scene", "triangles", "compression", "gpu", "python"]
-OPTIONAL = ("gpu", "python")  # steps a run leaves out where the machine or the build lacks them
+         "scene", "triangles", "compression", "gpu", "python", "library"]
+# Steps a results file may lack: the GPU bench (no headless OpenGL), the Python module (not built),
+# the library bake (files from before it existed).
+OPTIONAL = ("gpu", "python", "library")
 
 
 class ParseError(Exception):
@@ -199,7 +201,22 @@ def parse_python(text):
                      for r in rows]}
 
 
-PARSERS = {"bake": parse_bake, "scene": parse_scene, "triangles": parse_triangles, "query": parse_query,
+def parse_library(text):
+    """benchmarks/library.sh: its table of runs, and the up-to-date re-run's time."""
+    rows = [r for r in md_rows(text) if r and r[0] != "run"]
+    m = re.search(r"^up-to-date re-run of (\d+) entries: ([0-9.]+) s", text, re.M)
+    if not rows or not m:
+        raise ParseError("no library table or re-run time")
+    return {"rows": rows, "entries": int(m.group(1)), "rerun": float(m.group(2))}
+
+
+def library_table(lib):
+    lines = ["| run | seconds | Mrays/s | / one after another |", "|---|---:|---:|---:|"]
+    lines += ["| " + " | ".join(r) + " |" for r in lib["rows"]]
+    return lines + ["", f"Up-to-date re-run of {lib['entries']} entries: {lib['rerun']:.2f} s."]
+
+
+PARSERS = {"library": parse_library, "bake": parse_bake, "scene": parse_scene, "triangles": parse_triangles, "query": parse_query,
            "compression": parse_compression, "gpu": parse_gpu, "python": parse_python}
 
 
@@ -360,6 +377,9 @@ def sections(machine, steps, heading, queries=None, only=None):
                 f"{p['threads']} threads)", "", *python_table(p), "",
                 "Each ratio: the path's rate over the C++ batch's (FieldQuery::intersect on the same rays and field, "
                 "warm, answers dropped), each the best of its runs, taken alternately in the same run.", ""]
+    if "library" in steps:
+        out += [f"{heading} Library bake (vff-library against the same bakes one after another)", "",
+                *library_table(steps["library"]), ""]
     return out
 
 

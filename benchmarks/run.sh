@@ -80,9 +80,9 @@ step() {
   local name="$1"; shift
   local shown="${*//$build\//}"
   shown="${shown//$raw\//}"
+  shown="${shown//$root\//}"
   shown="${shown//$raw/.}"
   shown="${shown//$(dirname "$mesh")\//}"
-  shown="${shown//$root\//}"
   echo "== $name: $shown" >&2
   local t0=$SECONDS
   if ! "$@" >"$raw/$name.txt" 2>"$raw/$name.err"; then
@@ -127,6 +127,8 @@ if compgen -G "$build/python/vff/_vff*.so" >/dev/null && [[ -x $python && -x $bu
 else
   echo "the Python module is not built (VFF_PYTHON=OFF: pybind11-dev, python3-dev or python3-numpy missing)" >"$raw/python.skip"
 fi
+# The library bake: the pool and Slurm against the same bakes one after another (benchmarks/library.sh).
+step library bash "$root/benchmarks/library.sh" --build "$build" $( ((quick)) && echo --quick)
 
 # The machine and the build.
 cpu="$(python3 "$root/benchmarks/report.py" cpu)"

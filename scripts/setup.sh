@@ -14,6 +14,7 @@ packages=(
   glmark2-data zstd xz-utils python3
   python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-matplotlib
   chromium nodejs
+  slurm-wlm munge
 )
 # npm ships inside some nodejs builds; Debian packages it apart.
 command -v npm >/dev/null 2>&1 || packages+=(npm)

@@ -15,6 +15,16 @@ bash scripts/setup.sh
 
 jobs="$(nproc)"
 start=$SECONDS
+
+# A one-node Slurm cluster for the library.slurm cases (scripts/slurm-cluster.sh), stopped however
+# this script ends; without it those cases are skipped with the reason.
+slurm_dir="$(mktemp -d /tmp/vff-slurm.XXXXXX)"
+trap 'bash scripts/slurm-cluster.sh stop "$slurm_dir" || true; rm -rf "$slurm_dir"' EXIT
+if slurm_conf="$(bash scripts/slurm-cluster.sh start "$slurm_dir")"; then
+  export VFF_TEST_SLURM_CONF="${slurm_conf#SLURM_CONF=}"
+else
+  echo "test: no Slurm cluster (see $slurm_dir/log): the library.slurm cases are skipped"
+fi
 stage() {
   echo "== $1 (at $((SECONDS - start)) s)"
 }

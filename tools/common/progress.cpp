@@ -13,7 +13,7 @@ void Progress::update(uint64_t done, uint64_t total) {
   last_ = now;
   const double secs = std::chrono::duration<double>(now - start_).count();
   const double eta = done ? secs * double(total - done) / double(done) : 0;
-  std::fprintf(stderr, "\r%s: %" PRIu64 "/%" PRIu64 " maps", prog_.c_str(), done, total);
+  std::fprintf(stderr, "\r%s: %" PRIu64 "/%" PRIu64 " %s", prog_.c_str(), done, total, unit_.c_str());
   if (raysPerMap_) std::fprintf(stderr, ", %.1f Mrays/s", secs > 0 ? double(done * raysPerMap_) / secs / 1e6 : 0.0);
   std::fprintf(stderr, ", ETA %.1f s   ", eta);
   if (done == total) std::fputc('\n', stderr);

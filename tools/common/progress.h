@@ -12,14 +12,16 @@ namespace vff::cli {
 
 class Progress {
  public:
-  // `raysPerMap` > 0 adds the rate in rays per second (bakes); 0 leaves it out.
-  Progress(std::string prog, bool enabled, uint64_t raysPerMap = 0)
-      : prog_(std::move(prog)), enabled_(enabled), raysPerMap_(raysPerMap) {}
-  // `done` of `total` maps; the line ends when done == total.
+  // `raysPerMap` > 0 adds the rate in rays per second (bakes); 0 leaves it out. `unit` names what
+  // is counted.
+  Progress(std::string prog, bool enabled, uint64_t raysPerMap = 0, std::string unit = "maps")
+      : prog_(std::move(prog)), unit_(std::move(unit)), enabled_(enabled), raysPerMap_(raysPerMap) {}
+  // `done` of `total` units; the line ends when done == total.
   void update(uint64_t done, uint64_t total);
 
  private:
   std::string prog_;
+  std::string unit_;
   bool enabled_;
   uint64_t raysPerMap_;
   std::mutex mu_;

@@ -1,0 +1,117 @@
+#!/usr/bin/env bash
+# library_tests.sh - vff-library with the local pool (cases library.*): every output byte-identical to
+# a plain vff-bake of its entry, a re-run bakes nothing, a changed option re-bakes only what it
+# affects, a killed pool loses nothing and the next run completes it, the broken entry reported while
+# the others finish; manifests, dry runs and the Slurm batch script (printed, not submitted).
+MODE=local
+source "$(dirname "${BASH_SOURCE[0]}")/library_harness.sh"
+
+test_outputs_match_plain_bake() { case_outputs_match_plain_bake; }
+test_rerun_bakes_nothing() { case_rerun_bakes_nothing; }
+test_changed_option_rebakes_only_affected() { case_changed_option_rebakes_only_affected; }
+test_sharded_bake_merges_to_whole() { case_sharded_bake_merges_to_whole; }
+
+test_killed_pool_loses_nothing_and_resumes() {
+  make_library "$WORK/lib" shared
+  local opts=(-n 8 -m 24) good
+  good=$(good_count)
+  "$VFF_LIBRARY" bake "$WORK/lib" --out "$WORK/fields" -j 1 -q -- "${opts[@]}" >/dev/null 2>&1 &
+  local pid=$! i
+  for i in $(seq 600); do
+    [[ $(outputs) -ge 1 ]] && break
+    sleep 0.05
+  done
+  kill -9 $pid
+  wait $pid || true
+  local done
+  done=$(outputs)
+  [[ $done -ge 1 && $done -lt $good ]] || fail "the kill came at $done of $good outputs: cannot show a resume"
+  # No bake outlives the pool, and nothing partial is left at an output.
+  sleep 0.2
+  ! pgrep -f "$WORK/fields/.vff-cache/tmp" >/dev/null || fail "a vff-bake outlived the killed pool"
+  [[ -z $(find "$WORK/fields" -maxdepth 1 -name '.*tmp*') ]] || fail "a temporary output left"
+  for f in "$WORK"/fields/*.vff; do expect_matches_plain_bake "$(basename "$f" .vff)" "${opts[@]}"; done
+  lib_bake "$WORK/lib" -- "${opts[@]}"
+  expect_rc 3
+  [[ $(json 'len(r["baked"]) + len(r["upToDate"])') == "$good" ]] || { show; fail "the next run did not complete"; }
+  [[ $(json 'len(r["upToDate"])') -ge $done ]] || fail "finished entries were baked again"
+  for f in "$WORK"/fields/*.vff; do expect_matches_plain_bake "$(basename "$f" .vff)" "${opts[@]}"; done
+  [[ -z $(ls -A "$WORK/fields/.vff-cache/tmp") ]] || fail "the killed run's private folders were not removed"
+}
+
+test_all_good_exits_zero_and_reports() {
+  mkdir -p "$WORK/lib"
+  "$MESHGEN" box "$WORK/lib/a.obj"
+  "$MESHGEN" rod "$WORK/lib/b.obj"
+  lib_bake "$WORK/lib" --cache "$WORK/cache" -- -n 4 -m 8
+  expect_rc 0
+  expect_err "2 entries: 2 baked, 0 up to date, 0 failed"
+  [[ $(json 'r["rays"]') == $((2 * 82 * 64)) ]] || fail "rays: $(json 'r["rays"]')"
+  [[ $(json 'len(r["tasks"])') == 2 ]] || fail "a time per task"
+  [[ $(find "$WORK/cache" -name '*.vff' -not -path '*/tmp/*' | wc -l) == 2 ]] || fail "two fields in the cache"
+  # The same geometry under another name is another field (its name is in the file's metadata).
+  cp "$WORK/lib/a.obj" "$WORK/lib/c.obj"
+  lib_bake "$WORK/lib" --cache "$WORK/cache" -- -n 4 -m 8
+  [[ $(json '[b["mesh"] for b in r["baked"]]') == "['c.obj']" ]] || fail "c.obj"
+}
+
+test_changed_mesh_rebakes_only_it() {
+  make_library "$WORK/lib"
+  lib_bake "$WORK/lib" -- "${OPTS[@]}"
+  # Another shape in box.obj: baked again; the same bytes written anew: read again, not baked.
+  "$MESHGEN" rod "$WORK/lib/box.obj"
+  touch "$WORK/lib/bowl.obj"
+  lib_bake "$WORK/lib" -- "${OPTS[@]}"
+  [[ $(json '[b["mesh"] for b in r["baked"]]') == "['box.obj']" ]] || { show; fail "only box.obj re-baked"; }
+  expect_matches_plain_bake box "${OPTS[@]}"
+  lib_bake "$WORK/lib" --rehash -- "${OPTS[@]}"
+  [[ $(json 'len(r["baked"])') == 0 ]] || fail "--rehash re-baked an unchanged mesh"
+}
+
+test_dry_run_bakes_nothing() {
+  make_library "$WORK/lib"
+  run "$VFF_LIBRARY" bake "$WORK/lib" --out "$WORK/fields" --dry-run -- -m 8
+  expect_rc 0
+  expect_out "box.obj -m 8 -o"
+  run "$VFF_LIBRARY" bake "$WORK/lib" --out "$WORK/fields" --dry-run --slurm --partition gpu --time 10:00 \
+    --max-running 3 --sbatch-arg=--account=vff -- -m 8
+  expect_rc 0
+  expect_out "'--array=0-4%3'"  # five good meshes
+  expect_out "#SBATCH --partition=gpu"
+  expect_out "#SBATCH --time=10:00"
+  expect_out "#SBATCH --account=vff"
+  expect_out "run-shard"
+  [[ -z $(find "$WORK/fields" -name '*.vff') ]] || fail "a dry run baked"
+}
+
+test_manifests_match_the_schema() {
+  [[ -n ${SCHEMA_CHECK:-} ]] || { echo "SKIP: vff_cli_schema_check is not built"; return 0; }
+  mkdir -p "$WORK/lib"
+  write_manifest 8
+  "$SCHEMA_CHECK" "$SCHEMA" "$WORK/lib/library.json" || fail "a manifest vff-library bakes does not match the schema"
+  echo '{"vffLibrary": 1, "entries": [{"mesh": "a.obj", "options": {"threads": 4}}]}' >"$WORK/lib/m.json"
+  ! "$SCHEMA_CHECK" "$SCHEMA" "$WORK/lib/m.json" || fail "the schema takes an option vff-library refuses"
+}
+
+test_manifest_errors() {
+  mkdir -p "$WORK/lib"
+  echo '{"vffLibrary": 1, "entries": [{"mesh": "a.obj", "options": {"threads": 4}}]}' >"$WORK/lib/m.json"
+  run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields"
+  expect_rc 3
+  expect_err "vff-library: error: $WORK/lib/m.json: entries[0].options: \"threads\" is not a vff-bake option"
+  echo '{"entries": []}' >"$WORK/lib/m.json"
+  run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields"
+  expect_rc 3
+  expect_err "not a vff library manifest"
+  run "$VFF_LIBRARY" bake "$WORK/lib/none.json" --out "$WORK/fields"
+  expect_rc 2
+  echo '{"vffLibrary": 1, "entries": [{"mesh": "a.obj", "options": {"map-size": 0}}]}' >"$WORK/lib/m.json"
+  "$MESHGEN" box "$WORK/lib/a.obj"
+  run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields"
+  expect_rc 1
+  expect_err "a.obj: options: --map-size"
+  run "$VFF_LIBRARY" bake "$WORK/lib" --out "$WORK/fields" --no-such-option
+  expect_rc 1
+}
+
+run_test "$1"

@@ -1,0 +1,270 @@
+// cache.cpp - the content-addressed cache: an entry's key (its geometry as vff-bake reads it, its
+// options as vff-bake resolves them, the baker's and format's versions), the cached fields at
+// CACHE/ab/KEY.vff, and installing them at their outputs.
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <xxhash.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "../vff-bake/bake.h"
+#include "cli.h"
+#include "library.h"
+#include "vff/bake/mesh.h"
+#include "vff/version.h"
+
+namespace fs = std::filesystem;
+
+namespace vff::library {
+
+namespace {
+
+std::string hex128(XXH128_hash_t h) {
+  char s[33];
+  std::snprintf(s, sizeof s, "%016llx%016llx", static_cast<unsigned long long>(h.high64),
+                static_cast<unsigned long long>(h.low64));
+  return s;
+}
+
+// XXH3-128 of a file's bytes (level sets: their voxels are what vff-bake reads).
+std::optional<std::string> fileHash(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::nullopt;
+  XXH3_state_t* s = XXH3_createState();
+  XXH3_128bits_reset(s);
+  std::vector<char> buf(1 << 20);
+  while (in) {
+    in.read(buf.data(), std::streamsize(buf.size()));
+    XXH3_128bits_update(s, buf.data(), size_t(in.gcount()));
+  }
+  const XXH128_hash_t h = XXH3_128bits_digest(s);
+  XXH3_freeState(s);
+  return hex128(h);
+}
+
+// The options as vff-bake resolves them (its own parser), one canonical line: two spellings of
+// the same bake (a default given or left out, -m or --map-size) share a key.
+std::optional<std::string> canonicalOptions(const Entry& e, bake_tool::Options* o, std::string* error) {
+  CLI::App app;
+  bake_tool::addOptions(app, *o);
+  std::vector<std::string> argv = {"vff-bake", e.mesh};
+  argv.insert(argv.end(), e.args.begin(), e.args.end());
+  argv.insert(argv.end(), {"-o", "library.vff"});
+  std::vector<std::string> rev(argv.rbegin(), argv.rend() - 1);
+  try {
+    app.parse(rev);
+  } catch (const CLI::ParseError& pe) {
+    *error = std::string("options: ") + pe.what();
+    return std::nullopt;
+  }
+  if (auto problem = bake_tool::checkOptions(*o)) {
+    *error = "options: " + *problem;
+    return std::nullopt;
+  }
+  const bake::BakeOptions bo = bake_tool::bakeOptions(*o);
+  const WriteOptions wo = bake_tool::writeOptions(*o);
+  nlohmann::json c = {{"positions", positionSchemeName(bo.positionScheme)},
+                      {"n", bo.positionParam},
+                      {"directions", directionSchemeName(bo.directionScheme)},
+                      {"m", bo.mapResolution},
+                      {"encoding", distanceEncodingName(bo.encoding)},
+                      {"normals", bo.normals},
+                      {"codec", codecName(wo.codec)},
+                      {"zstdLevel", wo.codec == Codec::kZstd ? wo.zstdLevel : 0},
+                      {"mapsPerBlock", wo.mapsPerBlock},
+                      {"layout", {layoutTargetName(wo.layout.target), wo.layout.maxTextureSize, wo.layout.maxLayers,
+                                  wo.layout.gutter}},
+                      {"scene", o->scene},
+                      {"grid", o->grid},
+                      {"allowClippedSphere", o->allowClippedSphere}};
+  if (bo.sphere) {
+    char s[96];
+    std::snprintf(s, sizeof s, "%a %a %a %a", double(bo.sphere->center[0]), double(bo.sphere->center[1]),
+                  double(bo.sphere->center[2]), double(bo.sphere->radius));
+    c["sphere"] = s;
+  }
+  return c.dump();
+}
+
+// What the bake reads of a mesh and records of it, as one line; read from the mesh, or from the
+// note CACHE/sources/ab/ID.txt an earlier run left for the same file (path, device, inode, size and
+// modification time in nanoseconds unchanged), so that an up-to-date run reads no mesh.
+// *error: why the mesh could not be read.
+std::optional<std::string> meshGeometry(const Entry& e, const bake_tool::Options& o, const CacheOptions& c,
+                                        Error* error) {
+  struct stat st{};
+  std::string note;
+  if (c.statNotes && ::stat(e.mesh.c_str(), &st) == 0) {
+    const std::string id = e.mesh + "\n" + std::to_string(st.st_dev) + " " + std::to_string(st.st_ino) + " " +
+                           std::to_string(st.st_size) + " " + std::to_string(st.st_mtim.tv_sec) + "." +
+                           std::to_string(st.st_mtim.tv_nsec) + "\nscene " + std::to_string(o.scene);
+    const std::string key = hex128(XXH3_128bits(id.data(), id.size()));
+    note = c.dir + "/sources/" + key.substr(0, 2) + "/" + key + ".txt";
+    std::ifstream in(note, std::ios::binary);
+    std::string line;
+    if (in && std::getline(in, line) && line.rfind("mesh ", 0) == 0) return line;
+  }
+  bake::MeshInfo info;
+  auto mesh = bake::loadMesh(e.mesh, &info, {.gltfScene = o.scene});
+  if (!mesh) {
+    *error = mesh.error();
+    return std::nullopt;
+  }
+  const std::string geometry = "mesh " + info.format + " " + cli::hexDigits64(bake::geometryHash(*mesh)) + " " +
+                               cli::hexDigits64(bake::meshHash(*mesh)) + " " + std::to_string(mesh->droppedDegenerate) +
+                               " " + std::to_string(info.gltfScene);
+  if (!note.empty()) {
+    std::error_code ec;
+    fs::create_directories(fs::path(note).parent_path(), ec);
+    const std::string text = geometry + "\n";
+    (void)cli::writeFileAtomic(note, {reinterpret_cast<const uint8_t*>(text.data()), text.size()});
+  }
+  return geometry;
+}
+
+// The key of one entry, or its error.
+void computeKey(Entry& e, const CacheOptions& c) {
+  bake_tool::Options o;
+  std::string error;
+  auto options = canonicalOptions(e, &o, &error);
+  if (!options) {
+    e.error = error;
+    e.exitCode = cli::kExitUsage;
+    return;
+  }
+  // What the bake reads and what it records of it: the output's META names the source file and
+  // format and holds both of its hashes (vff.source), so each is part of the key.
+  std::string geometry;
+  if (bake_tool::isVdbPath(e.mesh)) {
+    auto h = fileHash(e.mesh);
+    if (!h) {
+      e.error = e.mesh + ": cannot be read";
+      e.exitCode = cli::kExitIo;
+      return;
+    }
+    geometry = "vdb " + *h;
+  } else if (Error err; auto g = meshGeometry(e, o, c, &err)) {
+    geometry = *g;
+  } else {
+    e.error = cli::formatDiagnostic("vff-bake", "error", e.mesh, err);
+    e.exitCode = cli::exitCodeFor(err.code);
+    return;
+  }
+  const bake::BakeOptions bo = bake_tool::bakeOptions(o);
+  if (auto maps = positionCount(bo.positionScheme, bo.positionParam)) {
+    e.maps = *maps;
+    e.rays = uint64_t(*maps) * bo.mapResolution * bo.mapResolution;
+  }
+  const std::string text = std::string("vff-library key 1\nbaker vff-bake ") + kLibraryVersion + "\nformat " +
+                           std::to_string(kVersionMajor) + "\nsource " + fs::path(e.mesh).filename().string() +
+                           "\ngeometry " + geometry + "\noptions " + *options + "\n";
+  e.key = hex128(XXH3_128bits(text.data(), text.size()));
+}
+
+std::string hostName() {
+  char h[256] = {};
+  gethostname(h, sizeof h - 1);
+  return h[0] ? h : "host";
+}
+
+}  // namespace
+
+void computeKeys(std::vector<Entry>& entries, const CacheOptions& o) {
+  std::atomic<size_t> next{0};
+  auto work = [&] {
+    for (size_t i; (i = next++) < entries.size();) computeKey(entries[i], o);
+  };
+  std::vector<std::thread> pool;
+  const unsigned n = std::max(1u, std::min<unsigned>(o.threads, unsigned(entries.size())));
+  for (unsigned t = 1; t < n; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+}
+
+std::string cachePath(const std::string& cacheDir, const std::string& key) {
+  return cacheDir + "/" + key.substr(0, 2) + "/" + key + ".vff";
+}
+
+std::string partPath(const std::string& cacheDir, const std::string& key, uint32_t begin, uint32_t end) {
+  return cacheDir + "/" + key.substr(0, 2) + "/" + key + ".maps-" + std::to_string(begin) + "-" + std::to_string(end) +
+         ".vff";
+}
+
+bool inCache(const std::string& cacheDir, const std::string& key) {
+  struct stat st{};
+  return ::stat(cachePath(cacheDir, key).c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+bool outputUpToDate(const std::string& cacheDir, const Entry& e) {
+  struct stat c{}, o{};
+  if (::stat(cachePath(cacheDir, e.key).c_str(), &c) != 0 || ::stat(e.output.c_str(), &o) != 0) return false;
+  if (c.st_dev == o.st_dev && c.st_ino == o.st_ino) return true;
+  return c.st_size == o.st_size && c.st_mtim.tv_sec == o.st_mtim.tv_sec && c.st_mtim.tv_nsec == o.st_mtim.tv_nsec;
+}
+
+std::optional<std::string> installOutput(const std::string& cacheDir, const Entry& e) {
+  const std::string from = cachePath(cacheDir, e.key);
+  std::error_code ec;
+  fs::create_directories(fs::path(e.output).parent_path(), ec);
+  if (ec) return fs::path(e.output).parent_path().string() + ": " + ec.message();
+  static std::atomic<unsigned> counter{0};
+  const std::string tmp = fs::path(e.output).parent_path().string() + "/." + fs::path(e.output).filename().string() +
+                          ".tmp-" + std::to_string(getpid()) + "-" + std::to_string(counter++);
+  if (::link(from.c_str(), tmp.c_str()) != 0) {
+    if (errno != EXDEV && errno != EPERM) return tmp + ": " + std::strerror(errno);
+    // Another filesystem: a copy with the cached file's time, which outputUpToDate compares.
+    fs::copy_file(from, tmp, fs::copy_options::overwrite_existing, ec);
+    struct stat st{};
+    if (!ec && ::stat(from.c_str(), &st) == 0) {
+      const timespec times[2] = {st.st_atim, st.st_mtim};
+      ::utimensat(AT_FDCWD, tmp.c_str(), times, 0);
+    }
+    if (ec) {
+      ::unlink(tmp.c_str());
+      return e.output + ": " + ec.message();
+    }
+  }
+  if (::rename(tmp.c_str(), e.output.c_str()) != 0) {
+    const std::string why = std::strerror(errno);
+    ::unlink(tmp.c_str());
+    return e.output + ": " + why;
+  }
+  return std::nullopt;
+}
+
+std::string makePrivateDir(const std::string& cacheDir) {
+  static std::atomic<unsigned> counter{0};
+  const std::string dir = cacheDir + "/tmp/" + hostName() + "." + std::to_string(getpid()) + "." +
+                          std::to_string(counter++);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  return dir;
+}
+
+void removeStalePrivateDirs(const std::string& cacheDir) {
+  const std::string prefix = hostName() + ".";
+  std::error_code ec;
+  for (fs::directory_iterator it(cacheDir + "/tmp", ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string n = it->path().filename().string();
+    if (n.compare(0, prefix.size(), prefix) != 0) continue;  // another machine's
+    const long pid = std::strtol(n.c_str() + prefix.size(), nullptr, 10);
+    if (pid > 0 && ::kill(pid_t(pid), 0) != 0 && errno == ESRCH) fs::remove_all(it->path(), ec);
+  }
+}
+
+std::optional<std::string> commitToCache(const std::string& cacheDir, const std::string& key, const std::string& file) {
+  const std::string to = cachePath(cacheDir, key);
+  std::error_code ec;
+  fs::create_directories(fs::path(to).parent_path(), ec);
+  if (::rename(file.c_str(), to.c_str()) != 0) return to + ": " + std::strerror(errno);
+  return std::nullopt;
+}
+
+}  // namespace vff::library

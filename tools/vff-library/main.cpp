@@ -1,0 +1,222 @@
+// vff-library: bakes an asset library, every entry whose output is missing or stale and nothing
+// else, through a content-addressed cache, with a local pool of vff-bake processes or a Slurm job
+// array.
+//
+//   vff-library bake assets/ --out fields/ -- -m 32          every mesh of a folder, vff-bake's options after --
+//   vff-library bake library.json --out fields/ --json r.json   a manifest (spec/library.md)
+//   vff-library bake library.json --out fields/ --cache /shared/vff-cache --slurm --partition cpu --max-running 50
+//   vff-library run-shard PLAN TASK                          one array task (what the batch script runs)
+//
+// manifest.cpp reads the entries, cache.cpp keys and stores them, worker.cpp runs vff-bake for one,
+// pool.cpp and slurm.cpp run many, report.cpp tells what happened (library.h).
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <map>
+#include <set>
+#include <thread>
+
+#include "cli.h"
+#include "library.h"
+
+namespace fs = std::filesystem;
+using namespace vff;
+using namespace vff::library;
+
+namespace {
+
+struct Options {
+  std::string input, out, cache, glob = "*.obj,*.ply,*.off,*.stl,*.gltf,*.glb", json;
+  std::vector<std::string> bakeArgs;
+  unsigned workers = 0, threads = 0;
+  uint64_t shardMaps = 0;
+  bool slurm = false, dryRun = false, quiet = false, rehash = false;
+  SlurmOptions slurmOptions;
+  std::string planPath;
+  unsigned task = 0;
+};
+
+void addBakeOptions(CLI::App& bake, Options& o) {
+  bake.add_option("input", o.input, "a manifest (.json, spec/library.md) or a folder of meshes")->required();
+  bake.add_option("bake-options", o.bakeArgs,
+                  "folder input: vff-bake's options for every mesh, after -- (e.g. -- -m 32 --normals)");
+  bake.add_option("--out", o.out, "output folder: each entry's field at its name")->required();
+  bake.add_option("--cache", o.cache, "the cache folder, shareable between machines (default: OUT/.vff-cache)");
+  bake.add_option("--glob", o.glob, "folder input: comma-separated patterns of the files to bake")->capture_default_str();
+  bake.add_option("-j,--workers", o.workers, "local: vff-bake processes at a time (0: one per core)")->capture_default_str();
+  bake.add_option("--threads", o.threads, "local: threads of each vff-bake (0: the cores shared among the workers)")
+      ->capture_default_str();
+  bake.add_option("--shard-maps", o.shardMaps,
+                  "bake an entry of more maps than this as ranges of at most this many (vff-bake --map-range), in "
+                  "parallel, merged into the same bytes (vff-bake --merge); 0: never (a manifest's shardMaps wins)")
+      ->capture_default_str();
+  bake.add_flag("--slurm", o.slurm, "bake as a Slurm job array (sbatch; the cache must be on a filesystem the nodes share)");
+  SlurmOptions& s = o.slurmOptions;
+  bake.add_option("--partition", s.partition, "slurm: the partition");
+  bake.add_option("--time", s.time, "slurm: each task's time limit");
+  bake.add_option("--max-running", s.maxRunning, "slurm: the most array tasks at once (%N)");
+  bake.add_option("--tasks", s.tasks, "slurm: array tasks (0: one per bake, at most 1000); fewer tasks spend less time in the scheduler");
+  bake.add_option("--cpus-per-task", s.cpusPerTask, "slurm: CPUs of each task, and vff-bake's threads");
+  bake.add_option("--sbatch-arg", s.sbatchArgs, "slurm: another sbatch option (repeatable), e.g. --sbatch-arg=--account=A")
+      ->allow_extra_args(false);
+  bake.add_option("--state", s.stateDir, "slurm: plans, scripts, logs and reports (default: CACHE/slurm/TIME-PID)");
+  bake.add_option("--retries", s.retries, "slurm: resubmissions of what an array left missing")->capture_default_str();
+  bake.add_option("--poll", s.pollSeconds, "slurm: seconds between squeue polls")->capture_default_str();
+  bake.add_flag("--rehash", o.rehash,
+                "read every mesh again, even those whose path, size and time are unchanged since a run noted them");
+  bake.add_flag("--dry-run", o.dryRun, "print what would be baked (with --slurm: the batch script) and bake nothing");
+  bake.add_option("--json", o.json, "also write the report as JSON to this file (- for stdout)");
+  bake.add_flag("-q,--quiet", o.quiet, "no progress line, no report on stderr (errors still)");
+}
+
+// The exit code of a run with failures: theirs when they share one, else a runtime error.
+int failureExitCode(const std::vector<Entry>& entries, const Report& r) {
+  std::set<int> codes;
+  const nlohmann::json j = reportJson(entries, r);
+  for (const auto& f : j["failed"]) codes.insert(f["exitCode"].get<int>());
+  if (codes.size() == 1 && *codes.begin() > 0 && *codes.begin() < 6) return *codes.begin();
+  return cli::kExitRuntime;
+}
+
+int bakeLibrary(const Options& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<Entry> entries;
+  std::error_code ec;
+  if (fs::is_directory(o.input, ec)) {
+    if (auto p = readFolder(o.input, o.glob, o.bakeArgs, o.out, &entries)) {
+      cli::printError(kProg, *p);
+      return cli::kExitIo;
+    }
+  } else {
+    if (!o.bakeArgs.empty()) {
+      cli::usageError(kProg, "vff-bake options after -- apply to a folder; a manifest sets them in \"defaults\"");
+      return cli::kExitUsage;
+    }
+    int rc = 0;
+    if (auto p = readManifest(o.input, o.out, &entries, &rc)) {
+      cli::printError(kProg, *p);
+      return rc;
+    }
+  }
+  std::map<std::string, std::string> outputs;
+  for (const Entry& e : entries)
+    if (auto [it, fresh] = outputs.emplace(e.output, e.name); !fresh) {
+      cli::printError(kProg, e.name + " and " + it->second + " would both be baked to " + e.output +
+                                 " (name outputs in a manifest)");
+      return cli::kExitUsage;
+    }
+
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  WorkerOptions wo;
+  wo.vffBake = findVffBake();
+  wo.cacheDir = fs::absolute(o.cache.empty() ? o.out + "/.vff-cache" : o.cache).lexically_normal().string();
+  fs::create_directories(wo.cacheDir + "/tmp", ec);
+  if (ec) {
+    cli::printError(kProg, wo.cacheDir + ": " + ec.message());
+    return cli::kExitIo;
+  }
+  removeStalePrivateDirs(wo.cacheDir);
+  for (Entry& e : entries)
+    if (!e.shardMaps) e.shardMaps = o.shardMaps;
+  computeKeys(entries, {.dir = wo.cacheDir, .threads = cores, .statNotes = !o.rehash});
+
+  Report report;
+  report.mode = o.slurm ? "slurm" : "local";
+  std::vector<size_t> todo;
+  for (size_t i = 0; i < entries.size(); ++i) {
+    const Entry& e = entries[i];
+    if (!e.error.empty()) {
+      report.failed.push_back(i);
+    } else if (inCache(wo.cacheDir, e.key)) {
+      if (!outputUpToDate(wo.cacheDir, e) && !o.dryRun)
+        if (auto p = installOutput(wo.cacheDir, e)) {
+          entries[i].error = *p;
+          entries[i].exitCode = cli::kExitIo;
+          report.failed.push_back(i);
+          continue;
+        }
+      report.upToDate.push_back(i);
+    } else {
+      todo.push_back(i);
+    }
+  }
+
+  const bool progress = !o.quiet && !o.dryRun && isatty(2);
+  const std::vector<Unit> units = planUnits(entries, todo, wo.cacheDir);
+  if (o.slurm) {
+    SlurmOptions so = o.slurmOptions;
+    so.dryRun = o.dryRun;
+    so.progress = progress;
+    if (so.stateDir.empty())
+      so.stateDir = wo.cacheDir + "/slurm/" + std::to_string(std::time(nullptr)) + "-" + std::to_string(getpid());
+    if (!units.empty()) {
+      int rc = 0;
+      if (auto p = runSlurm(entries, units, wo, so, &report.outcomes, &report.slurmJobs, &rc)) {
+        cli::printError(kProg, *p);
+        return rc;
+      }
+    }
+  } else {
+    report.workers = o.workers ? o.workers : cores;
+    report.workers = std::max<unsigned>(1, std::min<unsigned>(report.workers, unsigned(std::max<size_t>(1, units.size()))));
+    report.threadsPerWorker = o.threads ? o.threads : std::max(1u, cores / report.workers);
+    wo.threads = report.threadsPerWorker;
+    if (o.dryRun) {
+      for (const Unit& u : units) {
+        const Entry& e = entries[u.entry];
+        std::printf("%s %s", wo.vffBake.c_str(), e.mesh.c_str());
+        for (const auto& a : e.args) std::printf(" %s", a.c_str());
+        if (u.part())
+          std::printf(" --map-range %u:%u -o %s -j %u  # part of %s\n", u.begin, u.end,
+                      partPath(wo.cacheDir, e.key, u.begin, u.end).c_str(), wo.threads, e.output.c_str());
+        else
+          std::printf(" -o %s -j %u  # -> %s\n", cachePath(wo.cacheDir, e.key).c_str(), wo.threads, e.output.c_str());
+      }
+    } else {
+      report.outcomes = runPool(entries, units, wo, {.workers = report.workers, .threadsPerWorker = wo.threads,
+                                                    .progress = progress});
+    }
+  }
+  if (o.dryRun) return cli::kExitSuccess;
+  report.entryOutcomes = finishEntries(entries, todo, report.outcomes, wo);
+  for (const EntryOutcome& out : report.entryOutcomes) (out.result.ok ? report.baked : report.failed).push_back(out.entry);
+  std::sort(report.baked.begin(), report.baked.end());
+  std::sort(report.failed.begin(), report.failed.end());
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  if (!o.json.empty()) {
+    const std::string text = reportJson(entries, report).dump(2) + "\n";
+    if (auto st = cli::writeFileAtomic(o.json, {reinterpret_cast<const uint8_t*>(text.data()), text.size()}); !st)
+      return cli::reportError(kProg, o.json, st.error());
+  }
+  if (!o.quiet) printReport(entries, report, stderr);
+  else
+    for (const nlohmann::json j = reportJson(entries, report); const auto& f : j["failed"])
+      std::fprintf(stderr, "%s: error: %s: %s\n", kProg, f["mesh"].get<std::string>().c_str(),
+                   f["error"].get<std::string>().c_str());
+  return report.failed.empty() ? cli::kExitSuccess : failureExitCode(entries, report);
+}
+
+int run(int argc, char** argv) {
+  Options o;
+  CLI::App app{"Bakes an asset library (a manifest, or a folder and a glob) into visibility fields through a\n"
+               "content-addressed cache: only entries whose output is missing or stale are baked, by a local pool\n"
+               "of vff-bake processes or as a Slurm job array. Exits non-zero when any entry failed: with the\n"
+               "failures' exit code when they share one, else 4; the others are baked all the same.\n" +
+               cli::exitCodeHelp()};
+  cli::addVersionFlag(app, kProg);
+  app.require_subcommand(1);
+  CLI::App* bake = app.add_subcommand("bake", "bake every entry whose output is missing or stale");
+  addBakeOptions(*bake, o);
+  CLI::App* shard = app.add_subcommand("run-shard", "bake one Slurm array task's share of a plan (the batch script runs it)");
+  shard->add_option("plan", o.planPath, "the plan (STATE/round-N.plan.json)")->required();
+  shard->add_option("task", o.task, "the array task (SLURM_ARRAY_TASK_ID)")->required();
+  if (auto rc = cli::parse(app, kProg, argc, argv)) return *rc;
+  if (shard->parsed()) return runShard(o.planPath, o.task);
+  return bakeLibrary(o);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) { return cli::runGuarded(kProg, run, argc, argv); }
