@@ -8,6 +8,7 @@
 //   vff-experiments scene                  a room (exact) and moving objects through their fields (Fig. 6)
 //   vff-experiments scene-bench            N moving instances: Embree instancing vs vff::Scene vs hybrid
 //   vff-experiments ao --field lod.vff     also (or only) evaluate field files of the same mesh
+//   vff-experiments ao --no-sdf            without the signed-distance-field rows (on by default)
 //
 // Images (PNG, EXR, error heat maps) and OUT/NAME-table.md go to --out (default out/experiments);
 // the table is printed on stdout, progress on stderr. Fields are baked in memory, never written.
@@ -57,6 +58,13 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1u, 1u << 26));
   app.add_option("--repeat", o.repeat, "bench: repetitions (best is reported)")->capture_default_str()
       ->check(CLI::Range(1, 100));
+  app.add_flag("--sdf,!--no-sdf", o.sdf,
+               "image experiments: also render the signed distance field (OpenVDB level set, NanoVDB, sphere "
+               "tracing) at each field's memory (default: on)");
+  app.add_option("--sdf-values", o.sdfValues, "the distance field's values: fp8 (one byte a voxel) or float")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, SdfValues>{{"fp8", SdfValues::kFp8},
+                                                                           {"float", SdfValues::kFloat}}))
+      ->capture_default_str();
   app.add_option("--object", o.objects, "scene: a moving object's mesh besides --mesh (repeatable; none: four "
                  "procedural shapes)");
   app.add_option("--instances", o.instanceCounts, "scene-bench: instance counts (one table row each)")

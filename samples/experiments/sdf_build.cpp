@@ -131,6 +131,7 @@ vff::Result<SdfField> SdfField::build(const vff::bake::Mesh& objectMesh, const S
                           "no distance grid of this mesh fits in " + std::to_string(options.budgetBytes) + " bytes");
   Impl& s = *out.impl_;
   s.values = options.values;
+  s.band = options.bandVoxels;
   s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }

@@ -23,8 +23,8 @@ class Tracer {
   using Grid = nanovdb::NanoGrid<BuildT>;
   using Accessor = typename Grid::AccessorType;
 
-  Tracer(const Grid* grid, float voxel, const vff::RigidTransform& transform)
-      : grid_(grid), acc_(grid->getAccessor()), voxel_(voxel), transform_(transform) {
+  Tracer(const Grid* grid, float voxel, float band, const vff::RigidTransform& transform)
+      : grid_(grid), acc_(grid->getAccessor()), voxel_(voxel), band_(band), transform_(transform) {
     const nanovdb::CoordBBox box = grid->indexBBox();
     // Beyond the active voxels every value is the band's (a tile): a sample there needs its
     // neighbour inside, so the box is one voxel wider than the active one.
@@ -77,6 +77,21 @@ class Tracer {
       const nanovdb::Vec3f p = org + dir * t;
       const float d = sample(p);
       h.steps = step + 1;
+      if (cone > 0) {
+        // The share of the cone's disc left open, as a ramp over its radius at t: a half when the
+        // axis grazes the surface; the trace goes on inside until the disc is covered.
+        *visibility = std::min(*visibility, 0.5f + 0.5f * d / (std::max(t * len, 1e-6f) * cone));
+        // Deeper inside than the band reaches: the depth is unknown, and the disc taken as covered.
+        if (*visibility <= 0.0f || d <= -0.9f * band_) {
+          h.hit = true;
+          h.t = t;
+          *visibility = 0.0f;
+          return h;
+        }
+        t += std::max(std::fabs(d) / len, minStep);
+        if (t > t1) break;
+        continue;
+      }
       if (d < o.hitVoxels) {
         h.hit = true;
         h.t = t;
@@ -84,7 +99,6 @@ class Tracer {
         *visibility = 0.0f;
         return h;
       }
-      if (cone > 0) *visibility = std::min(*visibility, d / (std::max(t * len, 1e-6f) * cone));
       t += std::max(d / len, minStep);
       if (t > t1) break;
     }
@@ -106,7 +120,7 @@ class Tracer {
  private:
   const Grid* grid_;
   Accessor acc_;
-  float voxel_;
+  float voxel_, band_;
   const vff::RigidTransform& transform_;
   float lo_[3], hi_[3];
 };
@@ -125,9 +139,9 @@ float coneTan(const vff::Ray& ray, const SdfTraceOptions& o) {
 template <class Fn>
 void withTracer(const SdfField::Impl& s, const vff::RigidTransform& transform, Fn&& fn) {
   if (s.values == SdfValues::kFp8)
-    fn(Tracer<nanovdb::Fp8>(s.handle.grid<nanovdb::Fp8>(), s.voxel, transform));
+    fn(Tracer<nanovdb::Fp8>(s.handle.grid<nanovdb::Fp8>(), s.voxel, s.band, transform));
   else
-    fn(Tracer<float>(s.handle.grid<float>(), s.voxel, transform));
+    fn(Tracer<float>(s.handle.grid<float>(), s.voxel, s.band, transform));
 }
 
 }  // namespace

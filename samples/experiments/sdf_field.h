@@ -26,8 +26,12 @@
 // trilinearly sampled distance: a step is at least `minStepVoxels`, a hit is a sample below
 // `hitVoxels` (both in voxels), and a ray that takes `maxSteps` steps without either is a miss (as
 // a shader that runs out of steps leaves the pixel lit). The cone estimate for soft shadows and AO
-// keeps min over the steps of d / (t * tan(half-angle)) (Unreal's distance-field shadows; Quilez's
-// penumbra), clamped to [0, 1], 0 at a hit. Rays starting on the object's own surface skip
+// (Unreal's distance-field shadows, Quilez's penumbra) keeps the minimum over the steps of
+// 0.5 + 0.5 d / (t tan(half-angle)), clamped to [0, 1]: the open share of the cone's disc at t as a
+// ramp over its radius, a half where the axis grazes the surface (the form without the half, d / (t
+// tan), takes a cone whose axis touches the surface for fully covered, which darkens every
+// penumbra by half a cone), the trace going on inside until the disc is covered (0), or until it
+// is deeper inside than the band reaches (then taken as covered: the depth is unknown there). Rays starting on the object's own surface skip
 // `startVoxels` first (the engine's self-shadow bias: the distance there is off by about a voxel).
 #pragma once
 

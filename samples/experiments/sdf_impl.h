@@ -14,6 +14,7 @@ struct SdfField::Impl {
   nanovdb::GridHandle<nanovdb::HostBuffer> handle;
   SdfValues values = SdfValues::kFp8;
   float voxel = 0;               // object units
+  float band = 0;                // half-width of the band, voxels
   uint32_t dims[3] = {0, 0, 0};  // of the active index box
   uint64_t bricks = 0;  // what the budget counts
   uint64_t dense = 0;

@@ -77,6 +77,30 @@ case "$case" in
     awk -F'|' '/^\| [0-9]+ \|/ { if ($3 + 0 >= 32) bad = 1 } END { exit bad }' out/scene-table.md \
       || { cat out/scene-table.md; fail "scene: RMS error too large"; }
     ;;
+  sdf_rows_beside_the_fields)
+    # Every image experiment renders the distance field at each field's memory: its rows (trace and,
+    # but for reflections, cone), its images and error maps; never more memory than the field's.
+    for e in ao intra-ao shadows reflections; do
+      "$exp" "$e" "${small[@]}" --rays 4 -o out >stdout.txt 2>stderr.txt || { cat stderr.txt; fail "$e failed"; }
+      modes="sphere trace cone"; [ "$e" = reflections ] && modes="sphere trace"
+      for m in "sphere trace" cone; do
+        n=$(grep -c "^| distance field, 1090x16x16's memory .* | $m |" stdout.txt)
+        case " $modes " in *" $m "*) want=1 ;; *) want=0 ;; esac
+        [ "$n" -eq "$want" ] || { cat stdout.txt; fail "$e: $n '$m' rows, expected $want"; }
+      done
+      [ -s "out/$e-sdf-1090x16x16-trace.png" ] && [ -s "out/$e-sdf-1090x16x16-trace-error.png" ] \
+        || { ls out; fail "$e: missing the distance field's image or error map"; }
+      field=$(awk -F'|' '$2 ~ /^ 1090x16x16 $/ {print $4; exit}' stdout.txt)
+      awk -F'|' -v f="$field" '$2 ~ /distance field/ { if ($4 + 0 > f + 0 || $4 + 0 < 0.8 * f) bad = 1 } END { exit bad }' stdout.txt \
+        || { cat stdout.txt; fail "$e: the distance field's memory is not the field's ($field MiB)"; }
+    done
+    # The distance field's RMS is a real error: its ao image differs from the exact one.
+    awk -F'|' '$2 ~ /distance field/ && $3 ~ /sphere trace/ { if ($5 + 0 <= 0 || $5 + 0 >= 40) bad = 1 } END { exit bad }' stdout.txt \
+      || { cat stdout.txt; fail "an implausible RMS for the distance field"; }
+    "$exp" ao "${small[@]}" --rays 4 --no-sdf -o none >stdout.txt 2>stderr.txt || { cat stderr.txt; fail "ao --no-sdf failed"; }
+    ! grep -q "^| distance field" stdout.txt || { cat stdout.txt; fail "--no-sdf still renders the distance field"; }
+    ! ls none | grep -q sdf || { ls none; fail "--no-sdf still writes the distance field's images"; }
+    ;;
   images_do_not_depend_on_threads)
     "$exp" ao "${small[@]}" --rays 8 -j 1 -o one >/dev/null 2>&1 || fail "ao -j 1 failed"
     "$exp" ao "${small[@]}" --rays 8 -j 2 -o two >/dev/null 2>&1 || fail "ao -j 2 failed"

@@ -210,17 +210,21 @@ TEST(Sdf, ConeEstimateFollowsClearanceOverDistance) {
   const vff::bake::Mesh m = vff::bake::makeSphere(1.0f, 64, 128);
   const SdfField sdf = build(m, 512 << 10, vffx::SdfValues::kFloat);
   // A ray passing the unit sphere at clearance c, its closest approach a distance D from the
-  // origin: min over t of d(t) / (t tan) is about c / (D tan) (a little less, past the closest
-  // point), for clearances within the band (3 voxels); beyond it the grid knows of no surface.
+  // origin: min over t of 0.5 + 0.5 d(t) / (t tan) is about 0.5 + 0.5 c / (D tan) (a little less,
+  // past the closest point), for clearances within the band (3 voxels); beyond it the grid knows of
+  // no surface. A ray through the sphere: the disc is covered, 0.
   const float h = sdf.voxelSize(), D = 2.0f, tan = 0.05f;
   for (float c : {0.8f * h, 1.6f * h, 2.4f * h}) {
     const vff::Ray ray{{1.0f + c, 0, -D}, {0, 0, 1}, 0.0f, 4.0f};
     const float v = sdf.visibility(ray, {.coneTan = tan});
-    const float expected = std::min(1.0f, c / (D * tan));
-    EXPECT_NEAR(v, expected, 0.15f * expected + 0.3f * h / (D * tan)) << "clearance " << c / h << " voxels";
+    const float expected = std::min(1.0f, 0.5f + 0.5f * c / (D * tan));
+    EXPECT_NEAR(v, expected, 0.1f * expected + 0.15f * h / (D * tan)) << "clearance " << c / h << " voxels";
     EXPECT_FALSE(sdf.occluded(ray));
   }
   EXPECT_EQ(sdf.visibility({{1.0f + 5.0f * h, 0, -D}, {0, 0, 1}, 0.0f, 4.0f}, {.coneTan = tan}), 1.0f);
+  // The axis inside the surface by a quarter of the cone's radius there: 0.5 - 0.125.
+  const float r = D * tan;
+  EXPECT_NEAR(sdf.visibility({{1.0f - 0.25f * r, 0, -D}, {0, 0, 1}, 0.0f, 2.0f}, {.coneTan = tan}), 0.375f, 0.06f);
   // A hit: 0; far from the object: 1; the light's disc of radius r at tmax: tan = r / (tmax |d|).
   EXPECT_EQ(sdf.visibility({{0, 0, -3}, {0, 0, 1}, 0.0f, 6.0f}, {.coneTan = 0.1f}), 0.0f);
   EXPECT_EQ(sdf.visibility({{3, 3, -3}, {0, 0, 1}, 0.0f, 6.0f}, {.coneTan = 0.1f}), 1.0f);
