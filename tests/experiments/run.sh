@@ -73,6 +73,10 @@ case "$case" in
       [ -s "out/scene-f$f-$k.png" ] || { ls out; fail "missing out/scene-f$f-$k.png"; }
     done; done
     [ "$(grep -cE '^\| [0-9]+ \|' out/scene-table.md)" -eq 2 ] || { cat out/scene-table.md; fail "scene: not one row per frame"; }
+    # The distance fields' rows and images, one per frame.
+    [ "$(grep -cE '^\| [0-9]+, distance fields \|' out/scene-table.md)" -eq 2 ] \
+      || { cat out/scene-table.md; fail "scene: not one distance-field row per frame"; }
+    for f in 0 1; do [ -s "out/scene-f$f-sdf.png" ] && [ -s "out/scene-f$f-sdf-error.png" ] || { ls out; fail "scene: no distance-field image"; }; done
     # The fields answer most AO rays as the exact trace: RMS well under 32 on the 8-bit scale.
     awk -F'|' '/^\| [0-9]+ \|/ { if ($3 + 0 >= 32) bad = 1 } END { exit bad }' out/scene-table.md \
       || { cat out/scene-table.md; fail "scene: RMS error too large"; }
