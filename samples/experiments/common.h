@@ -276,6 +276,8 @@ struct Options {
   std::vector<uint32_t> instanceCounts{1, 10, 100, 1000, 10000};
   uint32_t sceneRays = 1u << 18;  // AO rays per frame
   int frames = 3;
+  // sdf-bench: memory per object, MiB (each the nearest field configuration's payload)
+  std::vector<double> sdfMemory{1, 4, 16, 64};
   // the distance-field peer's rows (sdf_field.h): on by default
   bool sdf = true;
   SdfValues sdfValues = SdfValues::kFp8;
@@ -309,6 +311,16 @@ int runReflections(const Options& o);
 int runBench(const Options& o);
 int runSceneBench(const Options& o);
 int runScene(const Options& o);
+int runSdfBench(const Options& o);
+
+// The benchmarks' incoherent ray sets (bench.cpp, where they are described), in world space; object
+// is left for the caller to fill.
+struct RaySet {
+  std::string name;
+  std::vector<vff::Ray> world, object;
+};
+RaySet makeAoRays(const World& w, uint32_t count, float range);
+RaySet makeAimedRays(const World& w, uint32_t count);
 
 // The CPU as Linux names it ("model name", family and model from /proc/cpuinfo), or "unknown CPU".
 std::string cpuName();

@@ -7,6 +7,7 @@
 //   vff-experiments bench                  Embree vs FieldQuery throughput on the same rays
 //   vff-experiments scene                  a room (exact) and moving objects through their fields (Fig. 6)
 //   vff-experiments scene-bench            N moving instances: Embree instancing vs vff::Scene vs hybrid
+//   vff-experiments sdf-bench              field vs signed distance field vs Embree at equal memory, a sweep
 //   vff-experiments ao --field lod.vff     also (or only) evaluate field files of the same mesh
 //   vff-experiments ao --no-sdf            without the signed-distance-field rows (on by default)
 //
@@ -28,12 +29,13 @@ int main(int argc, char** argv) {
   vff::cli::addVersionFlag(app, kProg);
   const std::map<std::string, int (*)(const Options&)> experiments = {
       {"ao", runAo}, {"intra-ao", runIntraAo}, {"shadows", runShadows}, {"reflections", runReflections},
-      {"bench", runBench}, {"scene-bench", runSceneBench}, {"scene", runScene}};
+      {"bench", runBench}, {"scene-bench", runSceneBench}, {"scene", runScene}, {"sdf-bench", runSdfBench}};
   // One option under two names: CLI11 would mark each REQUIRED, as if both were; the check after
   // parsing asks for one of them.
   app.add_option("experiment,--experiment", o.experiment,
-                 "ao | intra-ao | shadows | reflections | bench | scene | scene-bench (required: as the positional or --experiment)")
-      ->check(CLI::IsMember({"ao", "intra-ao", "shadows", "reflections", "bench", "scene", "scene-bench"}));
+                 "ao | intra-ao | shadows | reflections | bench | scene | scene-bench | sdf-bench (required: as the positional "
+                 "or --experiment)")
+      ->check(CLI::IsMember({"ao", "intra-ao", "shadows", "reflections", "bench", "scene", "scene-bench", "sdf-bench"}));
   app.add_option("--mesh", o.mesh, "object mesh (.obj .ply .off .stl .gltf .glb)")->capture_default_str();
   app.add_option("-o,--out", o.out, "output folder for images and tables")->capture_default_str();
   app.add_option("--size", o.size, "image width and height in pixels")->capture_default_str()->check(CLI::Range(1, 8192));
@@ -66,7 +68,11 @@ int main(int argc, char** argv) {
                                                                            {"float", SdfValues::kFloat}}))
       ->capture_default_str();
   app.add_option("--object", o.objects, "scene: a moving object's mesh besides --mesh (repeatable; none: four "
-                 "procedural shapes)");
+                 "procedural shapes); sdf-bench: a mesh besides --mesh (repeatable)");
+  app.add_option("--sdf-memory", o.sdfMemory, "sdf-bench: memory per object in MiB (the field configuration of "
+                 "nearest payload; --config instead names them)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.01, 4096.0));
   app.add_option("--instances", o.instanceCounts, "scene-bench: instance counts (one table row each)")
       ->capture_default_str()
       ->check(CLI::Range(1u, 1u << 20));
@@ -80,7 +86,7 @@ int main(int argc, char** argv) {
                                 "positional EXPERIMENT or --experiment)");
     return vff::cli::kExitUsage;
   }
-  if ((o.experiment == "bench" || o.experiment == "scene-bench") && !o.fields.empty()) {
+  if ((o.experiment == "bench" || o.experiment == "scene-bench" || o.experiment == "sdf-bench") && !o.fields.empty()) {
     vff::cli::usageError(kProg, "--field applies to the image experiments, not to " + o.experiment);
     return vff::cli::kExitUsage;
   }

@@ -105,6 +105,18 @@ case "$case" in
     ! grep -q "^| distance field" stdout.txt || { cat stdout.txt; fail "--no-sdf still renders the distance field"; }
     ! ls none | grep -q sdf || { ls none; fail "--no-sdf still writes the distance field's images"; }
     ;;
+  sdf_bench_prints_three_way_rows)
+    # Field, distance field and Embree on the same rays: a row per mesh, configuration and ray set.
+    "$meshgen" bowl bowl.obj || fail "mesh generator"
+    "$exp" sdf-bench --mesh knot.obj --object bowl.obj --config 290x16x16 --bench-rays 5000 --repeat 1 -j 2 \
+      >stdout.txt 2>stderr.txt || { cat stderr.txt; fail "sdf-bench failed"; }
+    grep -q "^Distance-field benchmark: .* $(sed -n 's/^model name[[:space:]]*: *//p' /proc/cpuinfo | head -1)" stdout.txt \
+      || { head -1 stdout.txt; fail "sdf-bench header names no CPU"; }
+    [ "$(grep -cE '^\| (knot|bowl)\.obj \| 290x16x16 \|' stdout.txt)" -eq 4 ] || { cat stdout.txt; fail "sdf-bench: not four rows"; }
+    # Every rate positive; the share of wrong answers a percentage under 50 for both.
+    awk -F'|' '/^\| (knot|bowl)\.obj/ { if ($7 + 0 <= 0 || $8 + 0 <= 0 || $9 + 0 <= 0 || $11 + 0 >= 50 || $12 + 0 >= 50) bad = 1 }
+               END { exit bad }' stdout.txt || { cat stdout.txt; fail "sdf-bench: implausible figures"; }
+    ;;
   images_do_not_depend_on_threads)
     "$exp" ao "${small[@]}" --rays 8 -j 1 -o one >/dev/null 2>&1 || fail "ao -j 1 failed"
     "$exp" ao "${small[@]}" --rays 8 -j 2 -o two >/dev/null 2>&1 || fail "ao -j 2 failed"
