@@ -39,10 +39,17 @@ class Tracer {
     const float fx = std::floor(p[0]), fy = std::floor(p[1]), fz = std::floor(p[2]);
     const float u = p[0] - fx, v = p[1] - fy, w = p[2] - fz;
     const int32_t x = int32_t(fx), y = int32_t(fy), z = int32_t(fz);
-    auto at = [&](int32_t i, int32_t j, int32_t k) { return acc_.getValue(nanovdb::Coord(x + i, y + j, z + k)); };
+    float c[2][2][2];
+    // The eight values from one leaf when they all lie in it (most cells), else through the accessor.
+    const auto* leaf = ((x & 7) < 7 && (y & 7) < 7 && (z & 7) < 7) ? acc_.probeLeaf(nanovdb::Coord(x, y, z)) : nullptr;
+    for (int32_t i = 0; i < 2; ++i)
+      for (int32_t j = 0; j < 2; ++j)
+        for (int32_t k = 0; k < 2; ++k)
+          c[i][j][k] = leaf ? leaf->getValue(nanovdb::Coord(x + i, y + j, z + k))
+                            : acc_.getValue(nanovdb::Coord(x + i, y + j, z + k));
     auto lerp = [](float a, float b, float t) { return a + t * (b - a); };
-    const float x00 = lerp(at(0, 0, 0), at(1, 0, 0), u), x10 = lerp(at(0, 1, 0), at(1, 1, 0), u);
-    const float x01 = lerp(at(0, 0, 1), at(1, 0, 1), u), x11 = lerp(at(0, 1, 1), at(1, 1, 1), u);
+    const float x00 = lerp(c[0][0][0], c[1][0][0], u), x10 = lerp(c[0][1][0], c[1][1][0], u);
+    const float x01 = lerp(c[0][0][1], c[1][0][1], u), x11 = lerp(c[0][1][1], c[1][1][1], u);
     return lerp(lerp(x00, x10, v), lerp(x01, x11, v), w) / voxel_;
   }
 
@@ -77,6 +84,8 @@ class Tracer {
       const nanovdb::Vec3f p = org + dir * t;
       const float d = sample(p);
       h.steps = step + 1;
+      // Empty-space skipping: the next step reaches at least the end of the empty block around p.
+      const float skip = o.skipEmpty ? emptyExit(p, org, dir) : 0.0f;
       if (cone > 0) {
         // The share of the cone's disc left open, as a ramp over its radius at t: a half when the
         // axis grazes the surface; the trace goes on inside until the disc is covered.
@@ -88,7 +97,7 @@ class Tracer {
           *visibility = 0.0f;
           return h;
         }
-        t += std::max(std::fabs(d) / len, minStep);
+        t = std::max(t + std::max(std::fabs(d) / len, minStep), skip);
         if (t > t1) break;
         continue;
       }
@@ -99,11 +108,29 @@ class Tracer {
         *visibility = 0.0f;
         return h;
       }
-      t += std::max(d / len, minStep);
+      t = std::max(t + std::max(d / len, minStep), skip);
       if (t > t1) break;
     }
     *visibility = std::clamp(*visibility, 0.0f, 1.0f);
     return h;
+  }
+
+  // When the voxel nearest p lies in a block of the tree with no leaf (a tile: 8^3, 128^3 or 4096^3
+  // voxels with no surface voxel), the t where the ray leaves the points whose nearest voxel is in
+  // that block: no surface lies there (a surface there would have made the voxels around it active,
+  // the band being a voxel wide at least). Else 0.
+  float emptyExit(const nanovdb::Vec3f& p, const nanovdb::Vec3f& org, const nanovdb::Vec3f& dir) const {
+    const nanovdb::Coord ijk(int32_t(std::lround(p[0])), int32_t(std::lround(p[1])), int32_t(std::lround(p[2])));
+    const int32_t dim = int32_t(acc_.getDim(ijk, 0));
+    if (dim <= 1) return 0.0f;
+    float exit = std::numeric_limits<float>::infinity();
+    for (int a = 0; a < 3; ++a) {
+      if (dir[a] == 0) continue;
+      const float base = float(ijk[a] & ~(dim - 1));
+      const float bound = dir[a] > 0 ? base + float(dim) - 0.5f : base - 0.5f;
+      exit = std::min(exit, (bound - org[a]) / dir[a]);
+    }
+    return std::isfinite(exit) ? exit * (1.0f + 1e-6f) + 1e-6f : 0.0f;
   }
 
   // The unit world-space normal at index point p: the distance's central differences.

@@ -23,7 +23,10 @@
 //
 // Tracing (sdf_field.cpp). A ray is taken to object space (the transform, as vff::Instance does),
 // clipped to the grid's box (outside it, the trace starts at the box), and stepped along by the
-// trilinearly sampled distance: a step is at least `minStepVoxels`, a hit is a sample below
+// trilinearly sampled distance, or over a whole block of the tree with no surface voxel when it is
+// in one (the empty-space skipping of NanoVDB's own ray marcher and of an engine's sparse bricks:
+// without it, a narrow band's clamped distance makes the steps a few voxels long far from the
+// surface): a step is at least `minStepVoxels`, a hit is a sample below
 // `hitVoxels` (both in voxels), and a ray that takes `maxSteps` steps without either is a miss (as
 // a shader that runs out of steps leaves the pixel lit). The cone estimate for soft shadows and AO
 // (Unreal's distance-field shadows, Quilez's penumbra) keeps the minimum over the steps of
@@ -58,6 +61,7 @@ struct SdfTraceOptions {
   float minStepVoxels = 0.1f;   // no step is shorter
   int maxSteps = 256;           // then: a miss
   float startVoxels = 0.0f;     // skipped at the ray's start (rays leaving the object's surface)
+  bool skipEmpty = true;        // step over the tree's empty blocks at once (see above)
   // The cone estimate, when one of these is positive (visibility() then returns it; intersect() and
   // occluded() do not use it): tan(half-angle) = coneTan, or coneRadiusAtEnd / (tmax * |direction|)
   // (a cone reaching a disc of that radius, world units, at tmax: a spherical light's).
