@@ -262,6 +262,21 @@ def sdf_table(d):
     return lines
 
 
+def sdf_summary(d):
+    """The README's short form: a row per mesh and memory, both ray sets in each cell (ao / aimed)."""
+    lines = ["| mesh | memory MiB | field / SDF speed (ao / aimed) | wrong answers, field (ao / aimed) | "
+             "wrong answers, SDF (ao / aimed) |", "|---|---:|---:|---:|---:|"]
+    groups = {}
+    for r in d["rows"]:
+        groups.setdefault((r["mesh"], r["mib"]), {})[r["set"]] = r
+    for (mesh, mib), g in groups.items():
+        sets = [g[k] for k in ("ao", "aimed") if k in g]
+        lines.append(f"| {mesh} | {mib:.1f} | " + " / ".join(f"{r['speed']:.0f}x" for r in sets) + " | " +
+                     " / ".join(f"{r['fieldwrong']:.2f}%" for r in sets) + " | " +
+                     " / ".join(f"{r['sdfwrong']:.2f}%" for r in sets) + " |")
+    return lines
+
+
 def compression_table(c):
     lines = ["| codec | bytes / payload | bytes / zstd -19's | decompression, MB/s (1 core) |",
              "|---|---:|---:|---:|"]
@@ -418,9 +433,12 @@ def readme_block(results_dir):
         spath, smachine, ssteps = with_sdf[-1]
         srel = os.path.relpath(spath, ROOT)
         reduced = f" (`run.sh --only {smachine['only']}`: a reduced run)" if smachine.get("only") else ""
-        main += [f"From [{srel}]({srel}){reduced}: {smachine['cpu']}, {smachine['cores']} cores, commit "
-                 f"{smachine['commit']}; command `{ssteps['sdf_cmd']}`.", "",
-                 *sections(smachine, {"sdf": ssteps["sdf"]}, "####")]
+        d = ssteps["sdf"]
+        main += [f"#### Field against a signed distance field at equal memory per object", "",
+                 f"From [{srel}]({srel}){reduced}: {smachine['cpu']}, {smachine['cores']} cores, commit "
+                 f"{smachine['commit']}, {d['values']} values, {d['rays']} rays per set; command "
+                 f"`{ssteps['sdf_cmd']}`. Speed above 1x: the field is faster; wrong answers: rays answered otherwise "
+                 "than Embree.", "", *sdf_summary(d), ""]
     return "\n".join(lines + main + [END])
 
 
