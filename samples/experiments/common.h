@@ -281,6 +281,7 @@ struct Options {
   // the distance-field peer's rows (sdf_field.h): on by default
   bool sdf = true;
   SdfValues sdfValues = SdfValues::kFp8;
+  float sdfBand = SdfBuildOptions{}.bandVoxels;
   // scene
   std::vector<std::string> objects;  // meshes besides --mesh (none: four procedural shapes)
 };

@@ -39,7 +39,7 @@ int renderSdfRows(const Options& o, const ImageExperiment& e, const World& world
                   const GBuffer& g, const std::vector<uint8_t>& mask, const Image& reference, const BakedQuery& c,
                   int rays, unsigned threads, uint32_t stream, const std::string& base, std::vector<Image>* strip,
                   std::vector<TableRow>* rows) {
-  auto built = SdfField::build(world.objectMesh, {.budgetBytes = c.query.payloadBytes(), .values = o.sdfValues});
+  auto built = SdfField::build(world.objectMesh, {.budgetBytes = c.query.payloadBytes(), .values = o.sdfValues, .bandVoxels = o.sdfBand});
   if (!built) return vff::cli::reportError(kProg, o.mesh, built.error());
   SdfField& sdf = *built;
   sdf.transform = world.transform;

@@ -67,6 +67,9 @@ int main(int argc, char** argv) {
       ->transform(CLI::CheckedTransformer(std::map<std::string, SdfValues>{{"fp8", SdfValues::kFp8},
                                                                            {"float", SdfValues::kFloat}}))
       ->capture_default_str();
+  app.add_option("--sdf-band", o.sdfBand, "the distance field's narrow band: half-width in voxels")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0f, 64.0f));
   app.add_option("--object", o.objects, "scene: a moving object's mesh besides --mesh (repeatable; none: four "
                  "procedural shapes); sdf-bench: a mesh besides --mesh (repeatable)");
   app.add_option("--sdf-memory", o.sdfMemory, "sdf-bench: memory per object in MiB (the field configuration of "

@@ -164,7 +164,7 @@ int runScene(const Options& o) {
   // The distance-field peer (sdf_field.h): each object's at its field's memory.
   std::vector<SdfField> sdfs;
   for (uint32_t k = 0; o.sdf && k < count; ++k) {
-    auto sdf = SdfField::build(objects[k]->mesh, {.budgetBytes = objects[k]->query.payloadBytes(), .values = o.sdfValues});
+    auto sdf = SdfField::build(objects[k]->mesh, {.budgetBytes = objects[k]->query.payloadBytes(), .values = o.sdfValues, .bandVoxels = o.sdfBand});
     if (!sdf) return vff::cli::reportError(kProg, objects[k]->name, sdf.error());
     sdfs.push_back(std::move(*sdf));
   }

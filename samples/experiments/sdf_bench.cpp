@@ -80,7 +80,7 @@ int runSdfBench(const Options& o) {
       auto field = bakeQuery(world, *(*setup)->scene, config, false, threads);
       if (!field) return vff::cli::reportError(kProg, path, field.error());
       const vff::Instance& instance = (*field)->instance;
-      auto built = SdfField::build(world.objectMesh, {.budgetBytes = (*field)->query.payloadBytes(), .values = o.sdfValues});
+      auto built = SdfField::build(world.objectMesh, {.budgetBytes = (*field)->query.payloadBytes(), .values = o.sdfValues, .bandVoxels = o.sdfBand});
       if (!built) return vff::cli::reportError(kProg, path, built.error());
       SdfField& sdf = *built;
       sdf.transform = world.transform;

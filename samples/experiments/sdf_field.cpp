@@ -225,5 +225,6 @@ uint32_t SdfField::dims(int axis) const { return impl_->dims[axis]; }
 SdfValues SdfField::values() const { return impl_->values; }
 int SdfField::builds() const { return impl_->builds; }
 double SdfField::buildSeconds() const { return impl_->seconds; }
+float SdfField::bandVoxels() const { return impl_->band; }
 
 }  // namespace vffx

@@ -8,7 +8,9 @@
 // band's width as their magnitude. Why a narrow band and not a full one: at equal memory the sparse
 // band buys smaller voxels (the accuracy an engine wants at the surface), and a sphere tracer only
 // needs a lower bound of the distance away from it, which the clamped value is (an engine's sparse
-// distance field clamps the same way). The level set is then copied into a read-only NanoVDB grid,
+// distance field clamps the same way). The band's width is a trade: at equal memory a wider band
+// costs resolution but lengthens the steps near the surface and lets the cone estimate see further
+// (an engine's coarser mips play that part); vff-experiments --sdf-band sets it. The level set is then copied into a read-only NanoVDB grid,
 // by default with 8-bit values (nanovdb::Fp8: per 8^3 leaf a minimum and a step, one byte a voxel,
 // as the field stores one byte a ray), or float values.
 //
@@ -53,7 +55,7 @@ enum class SdfValues : uint8_t { kFp8, kFloat };
 struct SdfBuildOptions {
   uint64_t budgetBytes = 1u << 20;  // bytes() at most
   SdfValues values = SdfValues::kFp8;
-  float bandVoxels = 3.0f;  // half-width of the narrow band, each side, in voxels
+  float bandVoxels = 8.0f;  // half-width of the narrow band, each side, in voxels (see above)
 };
 
 struct SdfTraceOptions {
@@ -104,6 +106,7 @@ class SdfField {
   SdfValues values() const;
   int builds() const;           // meshToVolume runs the budget search took
   double buildSeconds() const;
+  float bandVoxels() const;
 
   struct Impl;
 

@@ -199,7 +199,7 @@ TEST(Sdf, MemoryBudgetIsHonoured) {
     // The active box spans the shape plus its band on each side.
     const double h = sdf.voxelSize();
     EXPECT_GE(double(sdf.dims(0)) * h, extent);
-    EXPECT_LE(double(sdf.dims(0)) * h, extent + 2.0 * (3.0 + 1.0) * h);
+    EXPECT_LE(double(sdf.dims(0)) * h, extent + 2.0 * (sdf.bandVoxels() + 1.0) * h);
   }
   auto tooSmall = SdfField::build(m, {.budgetBytes = 512});
   ASSERT_FALSE(tooSmall);
@@ -211,8 +211,8 @@ TEST(Sdf, ConeEstimateFollowsClearanceOverDistance) {
   const SdfField sdf = build(m, 512 << 10, vffx::SdfValues::kFloat);
   // A ray passing the unit sphere at clearance c, its closest approach a distance D from the
   // origin: min over t of 0.5 + 0.5 d(t) / (t tan) is about 0.5 + 0.5 c / (D tan) (a little less,
-  // past the closest point), for clearances within the band (3 voxels); beyond it the grid knows of
-  // no surface. A ray through the sphere: the disc is covered, 0.
+  // past the closest point), for clearances within the band; beyond it the grid knows of no
+  // surface. A ray through the sphere: the disc is covered, 0.
   const float h = sdf.voxelSize(), D = 2.0f, tan = 0.05f;
   for (float c : {0.8f * h, 1.6f * h, 2.4f * h}) {
     const vff::Ray ray{{1.0f + c, 0, -D}, {0, 0, 1}, 0.0f, 4.0f};
@@ -221,7 +221,8 @@ TEST(Sdf, ConeEstimateFollowsClearanceOverDistance) {
     EXPECT_NEAR(v, expected, 0.1f * expected + 0.15f * h / (D * tan)) << "clearance " << c / h << " voxels";
     EXPECT_FALSE(sdf.occluded(ray));
   }
-  EXPECT_EQ(sdf.visibility({{1.0f + 5.0f * h, 0, -D}, {0, 0, 1}, 0.0f, 4.0f}, {.coneTan = tan}), 1.0f);
+  const float beyond = (sdf.bandVoxels() + 2.0f) * h;
+  EXPECT_EQ(sdf.visibility({{1.0f + beyond, 0, -D}, {0, 0, 1}, 0.0f, 4.0f}, {.coneTan = tan}), 1.0f);
   // The axis inside the surface by a quarter of the cone's radius there: 0.5 - 0.125.
   const float r = D * tan;
   EXPECT_NEAR(sdf.visibility({{1.0f - 0.25f * r, 0, -D}, {0, 0, 1}, 0.0f, 2.0f}, {.coneTan = tan}), 0.375f, 0.06f);
