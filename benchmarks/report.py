@@ -25,10 +25,14 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BEGIN = "<!-- benchmarks:begin: made by `python3 benchmarks/report.py readme`; do not edit -->"
 END = "<!-- benchmarks:end -->"
 STEPS = ["bake", "query", "accuracy-ao", "accuracy-intra-ao", "accuracy-shadows", "accuracy-reflections",
-         "scene", "triangles", "compression", "gpu", "python", "library"]
+         "scene", "triangles", "compression", "sdf", "gpu", "python", "library"]
 # Steps a results file may lack: the GPU bench (no headless OpenGL), the Python module (not built),
-# the library bake (files from before it existed).
-OPTIONAL = ("gpu", "python", "library")
+# the distance field and the library bake (files from before they existed).
+OPTIONAL = ("gpu", "python", "sdf", "library")
+# run.sh --only NAME: the steps it runs.
+ONLY = {"bake": ["bake"], "query": ["query"], "accuracy": [s for s in STEPS if s.startswith("accuracy-")],
+        "scene": ["scene"], "triangles": ["triangles"], "compression": ["compression"], "gpu": ["gpu"],
+        "sdf": ["sdf"], "python": ["python"], "library": ["library"]}
 
 
 class ParseError(Exception):
@@ -216,7 +220,26 @@ def library_table(lib):
     return lines + ["", f"Up-to-date re-run of {lib['entries']} entries: {lib['rerun']:.2f} s."]
 
 
-PARSERS = {"library": parse_library, "bake": parse_bake, "scene": parse_scene, "triangles": parse_triangles, "query": parse_query,
+def parse_sdf(text):
+    """vff-experiments sdf-bench: a row per mesh, field configuration and ray set."""
+    head = re.search(r"^Distance-field benchmark: (\d+) rays per set, (\d+) threads, best of (\d+), .*?"
+                     r"distance field (\w+), (.*)$", text, re.M)
+    if not head:
+        raise ParseError("vff-experiments sdf-bench output lacks its header line")
+    rows = []
+    for r in md_rows(text):
+        if len(r) != 11 or r[0] == "mesh":
+            continue
+        voxel = re.match(r"voxel ([\d.e+-]+) R", r[3])
+        rows.append({"mesh": r[0], "field": r[1], "mib": number(r[2]), "voxel": float(voxel.group(1)) if voxel else 0,
+                     "set": r[4], "embree": number(r[5]), "fieldrate": number(r[6]), "sdfrate": number(r[7]),
+                     "speed": number(r[8]), "fieldwrong": number(r[9]), "sdfwrong": number(r[10])})
+    if not rows:
+        raise ParseError("vff-experiments sdf-bench output has no table")
+    return {"rays": int(head.group(1)), "threads": int(head.group(2)), "values": head.group(4), "rows": rows}
+
+
+PARSERS = {"sdf": parse_sdf, "library": parse_library, "bake": parse_bake, "scene": parse_scene, "triangles": parse_triangles, "query": parse_query,
            "compression": parse_compression, "gpu": parse_gpu, "python": parse_python}
 
 
@@ -272,15 +295,47 @@ def accuracy_table(steps, only=None):
             if r["config"] not in configs:
                 configs.append(r["config"])
         for c in configs:
-            if only and c != only:
+            sdf = re.match(r"distance field, (\S+)'s memory", c)
+            if only and c != only and not (sdf and sdf.group(1) == only):
                 continue
             by = {r["reconstruction"]: r for r in rows if r["config"] == c}
             near, interp = by.get("nearest"), by.get("interpolated")
+            if sdf:  # the distance field at that field's memory: sphere tracing, and its cone estimate
+                near, interp = by.get("sphere trace"), by.get("cone")
+                c = f"distance field at {sdf.group(1)}'s memory"
             first = near or interp
             lines.append(f"| {name[len('accuracy-'):]} | {c} | {first['mib']:.1f} | "
                          f"{near['rms']:.2f} | " if near else f"| {name[len('accuracy-'):]} | {c} | {first['mib']:.1f} | - | ")
             lines[-1] += (f"{interp['rms']:.2f} | " if interp else "- | ") + \
                 f"{exact['time']:.2f} / {first['time']:.2f} |"
+    return lines
+
+
+def sdf_table(d):
+    lines = ["| mesh | memory MiB | ray set | Embree, Mrays/s | field, Mrays/s | distance field, Mrays/s | "
+             "field / SDF speed | wrong answers: field / SDF | faster, more often right |",
+             "|---|---:|---|---:|---:|---:|---:|---:|---|"]
+    for r in d["rows"]:
+        faster = "field" if r["speed"] > 1 else "SDF"
+        right = "field" if r["fieldwrong"] < r["sdfwrong"] else "SDF" if r["sdfwrong"] < r["fieldwrong"] else "tie"
+        lines.append(f"| {r['mesh']} | {r['mib']:.1f} | {r['set']} | {rate(r['embree'])} | {rate(r['fieldrate'])} | "
+                     f"{rate(r['sdfrate'])} | {r['speed']:.1f}x | {r['fieldwrong']:.2f}% / {r['sdfwrong']:.2f}% | "
+                     f"{faster}, {right} |")
+    return lines
+
+
+def sdf_summary(d):
+    """The README's short form: a row per mesh and memory, both ray sets in each cell (ao / aimed)."""
+    lines = ["| mesh | memory MiB | field / SDF speed (ao / aimed) | wrong answers, field (ao / aimed) | "
+             "wrong answers, SDF (ao / aimed) |", "|---|---:|---:|---:|---:|"]
+    groups = {}
+    for r in d["rows"]:
+        groups.setdefault((r["mesh"], r["mib"]), {})[r["set"]] = r
+    for (mesh, mib), g in groups.items():
+        sets = [g[k] for k in ("ao", "aimed") if k in g]
+        lines.append(f"| {mesh} | {mib:.1f} | " + " / ".join(f"{r['speed']:.0f}x" for r in sets) + " | " +
+                     " / ".join(f"{r['fieldwrong']:.2f}%" for r in sets) + " | " +
+                     " / ".join(f"{r['sdfwrong']:.2f}%" for r in sets) + " |")
     return lines
 
 
@@ -356,6 +411,8 @@ def sections(machine, steps, heading, queries=None, only=None):
                 *query_header(False), *query_rows(machine, q, False), ""]
     if any(k.startswith("accuracy-") for k in steps):
         out += [f"{heading} Accuracy against exact Embree casts (8-bit scale)", "", *accuracy_table(steps, only), ""]
+        if any(r["config"].startswith("distance field") for k, v in steps.items() if k.startswith("accuracy-") for r in v):
+            out += ["Distance-field rows: nearest is sphere tracing's hit or miss, interpolated its cone estimate.", ""]
     if "scene" in steps:
         sc = steps["scene"]
         out += [f"{heading} Scenes: time per frame against moving instances ({sc['rays']} AO rays per frame, "
@@ -367,6 +424,12 @@ def sections(machine, steps, heading, queries=None, only=None):
     if "compression" in steps:
         c = steps["compression"]
         out += [f"{heading} Compression of the distance payload ({c['payload']})", "", *compression_table(c), ""]
+    if "sdf" in steps:
+        d = steps["sdf"]
+        out += [f"{heading} Field against a signed distance field at equal memory per object ({d['values']} values, "
+                f"{d['threads']} threads, {d['rays']} rays per set)", "", *sdf_table(d), "",
+                "Wrong answers: rays answered otherwise than Embree (occluded or not); field / SDF speed above 1x: the "
+                "field is faster.", ""]
     if "gpu" in steps:
         renderer = steps["gpu"]["gpu"]
         soft = ": Mesa's software rasteriser, on the CPU" if "llvmpipe" in renderer else ""
@@ -415,7 +478,8 @@ def compose(rawdir, out):
             raise ParseError(f"{path}: {e}") from None
     lines = [f"# vff benchmarks: {machine['cpu']}, {machine['date']}", "",
              "Written by `bash benchmarks/run.sh`" + (" --quick (tiny sizes: the figures mean nothing)"
-                                                       if machine.get("quick") == "1" else "") + ".", "",
+                                                       if machine.get("quick") == "1" else "") +
+             (f" --only {machine['only']} (a reduced run: that step alone)" if machine.get("only") else "") + ".", "",
              "| | |", "|---|---|"]
     for k in ("commit", "cpu", "cores", "kernel", "compiler", "build_type", "embree", "mesh", "field"):
         if k in machine:
@@ -446,10 +510,15 @@ def read_results(path):
     for k, v in re.findall(r"^\| (\w+) \| (.*) \|$", text, re.M):
         machine.setdefault(k, v)
     machine["quick"] = "1" if "--quick" in text.split("## Summary")[0] else "0"
+    only = re.search(r"--only (\w+) \(a reduced run", text.split("## Summary")[0])
+    if only:
+        machine["only"] = only.group(1)
     steps = {}
-    for name, body in re.findall(r"^### ([\w-]+)\n\n`[^\n]*`\n\n```text\n(.*?)\n```$", text, re.M | re.S):
+    for name, cmd, body in re.findall(r"^### ([\w-]+)\n\n`([^\n]*)`\n\n```text\n(.*?)\n```$", text, re.M | re.S):
         try:
             steps[name] = parse_step(name, body)
+            if name == "sdf":
+                steps["sdf_cmd"] = cmd
         except ParseError as e:
             raise ParseError(f"{path}, {name}: {e}") from None
     return machine, steps
@@ -460,14 +529,31 @@ def readme_block(results_dir):
     runs = sorted((r for r in runs if r[1].get("quick") != "1"), key=lambda r: (r[1]["date"], r[0]))
     if not runs:
         raise ParseError(f"{results_dir}: no results file")
-    path, machine, steps = runs[-1]
+    full = [r for r in runs if not r[1].get("only")]
+    if not full:
+        raise ParseError(f"{results_dir}: no results file of a whole run")
+    path, machine, steps = full[-1]
     latest = {m["cpu"]: (m, s["query"]) for _, m, s in runs if "query" in s}
     rel = os.path.relpath(path, ROOT)
     lines = [BEGIN, "",
              f"From [{rel}]({rel}): {machine['cpu']}, {machine['cores']} cores, commit {machine['commit']}, "
              f"{machine['mesh']}, field {machine['field']}; the query table has a row for each CPU on record. "
              "Figures differ between CPUs: `bash benchmarks/run.sh` measures yours.", ""]
-    return "\n".join(lines + sections(machine, steps, "####", list(latest.values()), machine["field"]) + [END])
+    main = sections(machine, {k: v for k, v in steps.items() if k != "sdf"}, "####", list(latest.values()),
+                    machine["field"])
+    # The distance-field comparison: from the newest file that has it (a whole run, or --only sdf).
+    with_sdf = [r for r in runs if "sdf" in r[2]]
+    if with_sdf:
+        spath, smachine, ssteps = with_sdf[-1]
+        srel = os.path.relpath(spath, ROOT)
+        reduced = f" (`run.sh --only {smachine['only']}`: a reduced run)" if smachine.get("only") else ""
+        d = ssteps["sdf"]
+        main += [f"#### Field against a signed distance field at equal memory per object", "",
+                 f"From [{srel}]({srel}){reduced}: {smachine['cpu']}, {smachine['cores']} cores, commit "
+                 f"{smachine['commit']}, {d['values']} values, {d['rays']} rays per set; command "
+                 f"`{ssteps['sdf_cmd']}`. Speed above 1x: the field is faster; wrong answers: rays answered otherwise "
+                 "than Embree.", "", *sdf_summary(d), ""]
+    return "\n".join(lines + main + [END])
 
 
 def readme(args):
@@ -508,10 +594,11 @@ def main(argv):
         return 0
     if len(argv) == 3 and argv[1] == "check":
         machine, steps = read_results(argv[2])
-        missing = [n for n in STEPS if n not in OPTIONAL and n not in steps]
+        wanted = ONLY[machine["only"]] if machine.get("only") in ONLY else STEPS
+        missing = [n for n in wanted if n not in OPTIONAL and n not in steps]
         if missing:
             raise ParseError(f"{argv[2]}: no output of " + ", ".join(missing))
-        print(f"report.py: {argv[2]}: {machine['cpu']}, {machine['date']}: " + ", ".join(steps))
+        print(f"report.py: {argv[2]}: {machine['cpu']}, {machine['date']}: " + ", ".join(k for k in steps if k in STEPS))
         return 0
     if len(argv) >= 2 and argv[1] == "readme":
         return readme(argv[2:])

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # benchmarks/run.sh - runs every benchmark of vff and writes one results file.
 #
-#   bash benchmarks/run.sh [--build DIR] [--mesh FILE] [--out FILE] [--quick]
+#   bash benchmarks/run.sh [--build DIR] [--mesh FILE] [--out FILE] [--quick] [--only STEP]
+#                          [--sdf-memory "MiB ..."] [--sdf-rays N]
 #
 # Without --build it sets up and builds as scripts/main.sh does (Release preset, into build/).
 # With the bunny of Debian's glmark2-data (or --mesh) it runs:
@@ -15,23 +16,35 @@
 #   python       benchmarks/python_query.py, where the Python module is built: a million rays through
 #                vff-query (.npy in and out, end to end) and through the Python batch, each against
 #                the C++ batch on the same rays and field in the same run
+#   sdf          vff-experiments sdf-bench: the field against a signed distance field at equal
+#                memory (--sdf-memory, default 1 4 16 64 MiB per object) and Embree, on three meshes:
+#                the bunny (or --mesh), a box (sharp edges, flat faces: the CAD-like case) and a
+#                bowl (a thin shell), both from vff-procedural-mesh; --sdf-rays rays per set
+#   library      benchmarks/library.sh: vff-library's pool (and Slurm, where SLURM_CONF is set)
+#                against the same bakes one after another, and the up-to-date re-run
 # and writes benchmarks/results/<cpu>-<date>.md (or --out): the machine, the commit, a summary in
 # rounded tables (README.md copies it: python3 benchmarks/report.py readme) and the full output of
 # every command. --quick runs each at a tiny size: a check that the whole chain works, whose
-# figures mean nothing. Run it on a quiet machine: the query figures move with the memory's load.
+# figures mean nothing. --only STEP runs one step (bake, query, accuracy, scene, triangles,
+# compression, gpu, sdf, python, library): a reduced run, and its results file says so. Run it on
+# a quiet machine: the query figures move with the memory's load.
 # Exit codes: 0 written, 1 usage, 2 a file cannot be read or written, 4 a benchmark failed.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 prog="benchmarks/run.sh"
-build="" mesh="/usr/share/glmark2/models/bunny.obj" out="" quick=0
-usage() { echo "usage: $prog [--build DIR] [--mesh FILE] [--out FILE] [--quick]" >&2; exit 1; }
+build="" mesh="/usr/share/glmark2/models/bunny.obj" out="" quick=0 only="" sdfmemory="1 4 16 64" sdfrays=""
+usage() { echo "usage: $prog [--build DIR] [--mesh FILE] [--out FILE] [--quick] [--only STEP] [--sdf-memory \"MiB ...\"] [--sdf-rays N]" >&2; exit 1; }
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --build) [[ $# -ge 2 ]] || usage; build="$2"; shift 2 ;;
     --mesh) [[ $# -ge 2 ]] || usage; mesh="$2"; shift 2 ;;
     --out) [[ $# -ge 2 ]] || usage; out="$2"; shift 2 ;;
     --quick) quick=1; shift ;;
-    -h|--help) echo "usage: $prog [--build DIR] [--mesh FILE] [--out FILE] [--quick]"; exit 0 ;;
+    --only) [[ $# -ge 2 ]] || usage; only="$2"; shift 2
+      [[ $only =~ ^(bake|query|accuracy|scene|triangles|compression|gpu|sdf|python|library)$ ]] || usage ;;
+    --sdf-memory) [[ $# -ge 2 ]] || usage; sdfmemory="$2"; shift 2 ;;
+    --sdf-rays) [[ $# -ge 2 ]] || usage; sdfrays="$2"; shift 2 ;;
+    -h|--help) echo "usage: $prog [--build DIR] [--mesh FILE] [--out FILE] [--quick] [--only STEP] [--sdf-memory \"MiB ...\"] [--sdf-rays N]"; exit 0 ;;
     *) usage ;;
   esac
 done
@@ -49,8 +62,9 @@ mesh="$(cd "$(dirname "$mesh")" && pwd)/$(basename "$mesh")"
 bake="$build/tools/vff-bake/vff-bake"
 compress="$build/tools/vff-compress/vff-compress"
 experiments="$build/samples/experiments/vff-experiments"
+meshgen="$build/samples/vff-procedural-mesh"
 gpubench="$build/gpu/vff-gpu-bench"
-for t in "$bake" "$compress" "$experiments"; do
+for t in "$bake" "$compress" "$experiments" "$meshgen"; do
   [[ -x $t ]] || { echo "$prog: error: $t: not built" >&2; exit 2; }
 done
 
@@ -63,13 +77,19 @@ if ((quick)); then
   sceneargs=(--config 290x16x16 --instances 1 10 --scene-rays 4096 --frames 1)
   triangleargs=(--config 290x16x16 --bench-rays 4096 --min-triangles 500 --max-triangles 8000 --repeat 1)
   gpuargs=(--size 64 --spp 4) pyargs=(--quick)
+  sdfargs=(--config 290x16x16 --bench-rays 20000 --repeat 1)
 else
   # The paper's configuration: octa-hemi2 n = 32 (4226 maps) of 64 x 64, unorm8-diameter.
   config=(-n 32 -m 64) field=4226x64x64 expargs=()
   benchargs=(--repeat 5) bakerepeat=3 compressrepeat=3
   sceneargs=(--frames 5) triangleargs=(--repeat 5)
   gpuargs=() pyargs=()
+  # shellcheck disable=SC2206  # the memory list is words
+  sdfargs=(--repeat 3 --sdf-memory $sdfmemory)
 fi
+[[ -z $sdfrays ]] || sdfargs+=(--bench-rays "$sdfrays")
+# want STEP: true when the run includes it (all of them without --only).
+want() { [[ -z $only || $only == "$1" ]]; }
 
 # step NAME COMMAND...: runs COMMAND with its output in $raw/NAME.txt and its command line in
 # $raw/NAME.cmd (paths relative to the build folder, so that results files name no machine path).
@@ -101,34 +121,45 @@ step() {
   echo "   $((SECONDS - t0)) s" >&2
 }
 
-step bake "$bake" "$mesh" --benchmark "${config[@]}" --repeat "$bakerepeat"
-step query "$experiments" bench --mesh "$mesh" "${benchargs[@]}"
-for e in ao intra-ao shadows reflections; do
-  step "accuracy-$e" "$experiments" "$e" --mesh "$mesh" "${expargs[@]}" -o "$raw/experiments"
-done
-step scene "$experiments" scene-bench --mesh "$mesh" "${sceneargs[@]}"
-step triangles "$experiments" triangle-bench --mesh "$mesh" "${triangleargs[@]}"
-"$bake" "$mesh" -o "$raw/field.vff" "${config[@]}" -q
-step compression "$compress" --benchmark "$raw/field.vff" --repeat "$compressrepeat" --tmp "$raw"
+want bake && step bake "$bake" "$mesh" --benchmark "${config[@]}" --repeat "$bakerepeat"
+want query && step query "$experiments" bench --mesh "$mesh" "${benchargs[@]}"
+if want accuracy; then
+  for e in ao intra-ao shadows reflections; do
+    step "accuracy-$e" "$experiments" "$e" --mesh "$mesh" "${expargs[@]}" -o "$raw/experiments"
+  done
+fi
+want scene && step scene "$experiments" scene-bench --mesh "$mesh" "${sceneargs[@]}"
+want triangles && step triangles "$experiments" triangle-bench --mesh "$mesh" "${triangleargs[@]}"
+if want compression || want gpu || want python; then "$bake" "$mesh" -o "$raw/field.vff" "${config[@]}" -q; fi
+want compression && step compression "$compress" --benchmark "$raw/field.vff" --repeat "$compressrepeat" --tmp "$raw"
 # The GPU bench where it is built and a headless OpenGL 4.3 context opens; otherwise the results
 # file says why it did not run.
-if [[ -x $gpubench ]]; then
+if ! want gpu; then
+  :
+elif [[ -x $gpubench ]]; then
   skip_if="no headless OpenGL" step gpu "$gpubench" --field "$raw/field.vff" "${gpuargs[@]}"
 else
   echo "vff-gpu-bench is not built (no OpenGL or EGL development files)" >"$raw/gpu.skip"
+fi
+if want sdf; then
+  "$meshgen" box "$raw/box.obj" >/dev/null
+  "$meshgen" bowl "$raw/bowl.obj" >/dev/null
+  step sdf "$experiments" sdf-bench --mesh "$mesh" --object "$raw/box.obj" --object "$raw/bowl.obj" "${sdfargs[@]}"
 fi
 
 # The Python batch and vff-query against the C++ batch, with the interpreter the module was built
 # for, where it was built; otherwise the results file says why it did not run.
 python="$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' "$build/CMakeCache.txt" | head -1)"
-if compgen -G "$build/python/vff/_vff*.so" >/dev/null && [[ -x $python && -x $build/tools/vff-query/vff-query ]]; then
+if ! want python; then
+  :
+elif compgen -G "$build/python/vff/_vff*.so" >/dev/null && [[ -x $python && -x $build/tools/vff-query/vff-query ]]; then
   step python env PYTHONPATH="$build/python" "$python" "$root/benchmarks/python_query.py" --field "$raw/field.vff" \
     --query "$build/tools/vff-query/vff-query" "${pyargs[@]}"
 else
   echo "the Python module is not built (VFF_PYTHON=OFF: pybind11-dev, python3-dev or python3-numpy missing)" >"$raw/python.skip"
 fi
 # The library bake: the pool and Slurm against the same bakes one after another (benchmarks/library.sh).
-step library bash "$root/benchmarks/library.sh" --build "$build" $( ((quick)) && echo --quick)
+want library && step library bash "$root/benchmarks/library.sh" --build "$build" $( ((quick)) && echo --quick)
 
 # The machine and the build.
 cpu="$(python3 "$root/benchmarks/report.py" cpu)"
@@ -147,9 +178,11 @@ commit="$(git -C "$root" rev-parse --short=12 HEAD 2>/dev/null || echo unknown)"
   echo "mesh=$(basename "$mesh")"
   echo "field=$field"
   echo "quick=$quick"
+  [[ -z $only ]] || echo "only=$only"
 } >"$raw/machine.txt"
 if [[ -z $out ]]; then
-  out="$root/benchmarks/results/$(python3 "$root/benchmarks/report.py" slug "$raw/machine.txt").md"
+  # A reduced run (--only) never replaces the day's full results file.
+  out="$root/benchmarks/results/$(python3 "$root/benchmarks/report.py" slug "$raw/machine.txt")${only:+-$only}.md"
 fi
 python3 "$root/benchmarks/report.py" compose "$raw" "$out.tmp"
 mv "$out.tmp" "$out"

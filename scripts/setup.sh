@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config git
-  libembree-dev libopenexr-dev openexr libopenvdb-dev libopenvdb-tools libboost-iostreams-dev
+  libembree-dev libopenexr-dev openexr libopenvdb-dev libnanovdb-dev libopenvdb-tools libboost-iostreams-dev
   libopenmesh-dev libtinygltf-dev libdraco-dev libmeshoptimizer-dev libcli11-dev libzstd-dev libxxhash-dev
   nlohmann-json3-dev
   libstb-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev glslang-tools

@@ -36,10 +36,13 @@ namespace {
 
 constexpr uint64_t kChunk = 4096;
 
-struct RaySet {
-  std::string name;
-  std::vector<vff::Ray> world, object;
-};
+// fn(x, y) for [b, e) cut into runs of at most `batch`.
+template <class Fn>
+void inBatches(uint64_t b, uint64_t e, uint64_t batch, Fn&& fn) {
+  for (uint64_t x = b; x < e; x += batch) fn(x, std::min(e, x + batch));
+}
+
+}  // namespace
 
 RaySet makeAoRays(const World& w, uint32_t count, float range) {
   RaySet s;
@@ -69,14 +72,6 @@ RaySet makeAimedRays(const World& w, uint32_t count) {
   }
   return s;
 }
-
-// fn(x, y) for [b, e) cut into runs of at most `batch`.
-template <class Fn>
-void inBatches(uint64_t b, uint64_t e, uint64_t batch, Fn&& fn) {
-  for (uint64_t x = b; x < e; x += batch) fn(x, std::min(e, x + batch));
-}
-
-}  // namespace
 
 // The CPU as Linux names it ("model name", family and model from /proc/cpuinfo), or "unknown CPU".
 std::string cpuName() {

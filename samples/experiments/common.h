@@ -8,6 +8,7 @@
 // offsets, lights) is a multiple of the object's bounding-sphere radius R.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -20,6 +21,7 @@
 #include "vff/bake/baker.h"
 #include "vff/bake/mesh.h"
 #include "vff/query.h"
+#include "sdf_field.h"
 
 namespace vffx {
 
@@ -163,6 +165,31 @@ inline std::span<const float> openShares(const ExactTracer& exact, const BakedQu
   return out;
 }
 
+// openShares through the signed distance field instead (sdf_field.h): one batch call per pixel, as
+// the field's; 0 or 1 per ray, or the cone estimate when `so` asks for it.
+inline std::span<const float> openShares(const SdfField& sdf, const SdfTraceOptions& so, std::span<const vff::Ray> rays) {
+  thread_local std::vector<float> out;
+  out.resize(rays.size());
+  sdf.visibility(rays, out, so);
+  return out;
+}
+
+// The distance field's options for one image: the cone estimate when `cone` (the SDF's counterpart
+// of the field's interpolated row); a skip of two voxels at the start of rays leaving the object's
+// own surface (the engine's self-shadow bias: the sampled distance is a voxel off there).
+inline SdfTraceOptions sdfOptions(bool cone, bool fromObject, float coneTan = 0, float coneRadiusAtEnd = 0) {
+  SdfTraceOptions so;
+  so.startVoxels = fromObject ? 2.0f : 0.0f;
+  if (cone) so.coneTan = coneTan, so.coneRadiusAtEnd = coneRadiusAtEnd;
+  return so;
+}
+// tan of the half-angle of one of `rays` equal cones covering the hemisphere (solid angle 2 pi / rays
+// each): the AO experiments' cone estimate.
+inline float hemisphereConeTan(int rays) {
+  const float c = 1.0f - 1.0f / float(std::max(rays, 1));
+  return std::sqrt(std::max(0.0f, 1.0f - c * c)) / std::max(c, 1e-3f);
+}
+
 // Bakes one configuration (unorm8-diameter) of the object and places it like the world's object.
 vff::Result<std::unique_ptr<BakedQuery>> bakeQuery(const World& world, const vff::bake::Scene& scene,
                                                    const FieldConfig& config, bool normals, unsigned threads);
@@ -256,6 +283,12 @@ struct Options {
   uint32_t minTriangles = 10000;    // the coarsest level has at least this many
   uint32_t maxTriangles = 1000000;  // subdivide until at least this many
   int frames = 3;
+  // sdf-bench: memory per object, MiB (each the nearest field configuration's payload)
+  std::vector<double> sdfMemory{1, 4, 16, 64};
+  // the distance-field peer's rows (sdf_field.h): on by default
+  bool sdf = true;
+  SdfValues sdfValues = SdfValues::kFp8;
+  float sdfBand = SdfBuildOptions{}.bandVoxels;
   // scene
   std::vector<std::string> objects;  // meshes besides --mesh (none: four procedural shapes)
 };
@@ -287,6 +320,16 @@ int runBench(const Options& o);
 int runSceneBench(const Options& o);
 int runTriangleBench(const Options& o);
 int runScene(const Options& o);
+int runSdfBench(const Options& o);
+
+// The benchmarks' incoherent ray sets (bench.cpp, where they are described), in world space; object
+// is left for the caller to fill.
+struct RaySet {
+  std::string name;
+  std::vector<vff::Ray> world, object;
+};
+RaySet makeAoRays(const World& w, uint32_t count, float range);
+RaySet makeAimedRays(const World& w, uint32_t count);
 
 // The CPU as Linux names it ("model name", family and model from /proc/cpuinfo), or "unknown CPU".
 std::string cpuName();
@@ -301,9 +344,13 @@ struct ImageExperiment {
   bool normals = false;           // bake the normal plane too
   bool comparePlane = true;    // pixels whose error is measured: plane pixels,
   bool compareObject = false;  // object pixels
-  // Returns the shade function of one method: field == nullptr is the exact reference.
+  // The distance field's rows (sdf_field.h, at the memory of each field): kNearest is sphere
+  // tracing's hit or miss, kInterpolated its cone estimate.
+  std::vector<vff::Reconstruction> sdfRows{vff::Reconstruction::kNearest, vff::Reconstruction::kInterpolated};
+  // Returns the shade function of one method: field and sdf null is the exact reference; else the
+  // field, or the distance field, with reconstruction r.
   std::function<std::function<Vec3(const GSample&, Rng&)>(const World&, const ExactTracer&, const BakedQuery* field,
-                                                            vff::Reconstruction, int rays)>
+                                                            const SdfField* sdf, vff::Reconstruction r, int rays)>
       makeShader;
 };
 int runImageExperiment(const Options& o, const ImageExperiment& e);

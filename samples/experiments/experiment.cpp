@@ -33,6 +33,41 @@ bool writeImages(const Image& image, const std::string& base) {
   return true;
 }
 
+// The distance field at the field's memory (its payload bytes, counted as sdf_field.h says), in
+// the experiment's SDF rows: images, error maps, table rows. Returns an exit code, 0 on success.
+int renderSdfRows(const Options& o, const ImageExperiment& e, const World& world, const ExactTracer& exact,
+                  const GBuffer& g, const std::vector<uint8_t>& mask, const Image& reference, const BakedQuery& c,
+                  int rays, unsigned threads, uint32_t stream, const std::string& base, std::vector<Image>* strip,
+                  std::vector<TableRow>* rows) {
+  auto built = SdfField::build(world.objectMesh, {.budgetBytes = c.query.payloadBytes(), .values = o.sdfValues, .bandVoxels = o.sdfBand});
+  if (!built) return vff::cli::reportError(kProg, o.mesh, built.error());
+  SdfField& sdf = *built;
+  sdf.transform = world.transform;
+  const double mib = 1.0 / 1048576.0;
+  std::fprintf(stderr, "%s: %s: distance field at %s's memory: voxel %.4g R, %.2f MiB (NanoVDB %.2f MiB, dense %.2f MiB), %d builds in %.2f s\n",
+               kProg, e.name.c_str(), c.name.c_str(), double(sdf.voxelSize() / world.radius), double(sdf.bytes()) * mib,
+               double(sdf.nanovdbBytes()) * mib, double(sdf.denseBytes()) * mib, sdf.builds(), sdf.buildSeconds());
+  char what[256];
+  std::snprintf(what, sizeof what, "distance field, %s's memory (%s, voxel %.4g R, %ux%ux%u; NanoVDB %.2f MiB, dense %.2f MiB)",
+                c.name.c_str(), sdf.values() == SdfValues::kFp8 ? "fp8" : "float", double(sdf.voxelSize() / world.radius),
+                sdf.dims(0), sdf.dims(1), sdf.dims(2), double(sdf.nanovdbBytes()) * mib, double(sdf.denseBytes()) * mib);
+  for (vff::Reconstruction r : e.sdfRows) {
+    const char* mode = r == vff::Reconstruction::kNearest ? "sphere trace" : "cone";
+    double seconds = 0;
+    const Image img = renderImage(g, threads, stream, e.makeShader(world, exact, nullptr, &sdf, r, rays), &seconds);
+    const ErrorStats st = compareImages(reference, img, mask);
+    const std::string name = base + "-sdf-" + c.name + "-" + (r == vff::Reconstruction::kNearest ? "trace" : "cone");
+    if (!writeImages(img, name)) return vff::cli::kExitIo;
+    if (auto w = writeErrorMap(reference, img, mask, 8.0f, name + "-error.png"); !w)
+      return vff::cli::reportError(kProg, "", w.error());
+    if (strip) strip->push_back(img), strip = nullptr;
+    rows->push_back({what, mode, double(sdf.bytes()) * mib, st.rms, st.max, seconds, false});
+    std::fprintf(stderr, "%s: %s: distance field at %s, %s in %.2f s, RMS %.2f\n", kProg, e.name.c_str(), c.name.c_str(),
+                 mode, seconds, st.rms);
+  }
+  return 0;
+}
+
 }  // namespace
 
 std::string formatTable(const std::vector<TableRow>& rows) {
@@ -97,7 +132,8 @@ int runImageExperiment(const Options& o, const ImageExperiment& e) {
   std::vector<TableRow> rows;
   double seconds = 0;
   const Image reference =
-      renderImage(g, threads, stream, e.makeShader(*world, *exact, nullptr, vff::Reconstruction::kNearest, rays), &seconds);
+      renderImage(g, threads, stream, e.makeShader(*world, *exact, nullptr, nullptr, vff::Reconstruction::kNearest, rays),
+                  &seconds);
   if (!writeImages(reference, base + "-exact")) return vff::cli::kExitIo;
   const double meshMiB = double(world->worldMesh.positions.size() * 4 + world->worldMesh.indices.size() * 4) / 1048576.0;
   rows.push_back({"exact (Embree, " + std::to_string(world->worldMesh.triangleCount()) + " triangles)", "-",
@@ -124,7 +160,8 @@ int runImageExperiment(const Options& o, const ImageExperiment& e) {
       std::fprintf(stderr, "%s: %s: loaded %s (%.2f MiB)\n", kProg, e.name.c_str(), c.description.c_str(),
                    c.payloadMiB());
     for (vff::Reconstruction r : {vff::Reconstruction::kNearest, vff::Reconstruction::kInterpolated}) {
-      const Image img = renderImage(g, threads, stream, e.makeShader(*world, *exact, field.get(), r, rays), &seconds);
+      const Image img =
+          renderImage(g, threads, stream, e.makeShader(*world, *exact, field.get(), nullptr, r, rays), &seconds);
       const ErrorStats st = compareImages(reference, img, mask);
       const std::string name = base + "-" + c.name + "-" + reconstructionName(r);
       if (!writeImages(img, name)) return vff::cli::kExitIo;
@@ -135,9 +172,16 @@ int runImageExperiment(const Options& o, const ImageExperiment& e) {
       std::fprintf(stderr, "%s: %s: %s %s in %.2f s, RMS %.2f\n", kProg, e.name.c_str(), c.name.c_str(),
                    reconstructionName(r), seconds, st.rms);
     }
+    if (o.sdf && !e.sdfRows.empty()) {
+      const bool first = strip.size() == 3;
+      if (const int rc = renderSdfRows(o, e, *world, *exact, g, mask, reference, c, rays, threads, stream, base,
+                                       first ? &strip : nullptr, &rows))
+        return rc;
+    }
   }
 
-  // The side-by-side comparison: exact, then the first configuration nearest and interpolated.
+  // The side-by-side comparison: exact, the first configuration nearest and interpolated, its
+  // distance field's first image.
   if (auto w = writePng(sideBySide(strip), base + "-comparison.png"); !w) return vff::cli::reportError(kProg, "", w.error());
 
   uint64_t compared = 0;
@@ -146,7 +190,8 @@ int runImageExperiment(const Options& o, const ImageExperiment& e) {
   md << "Experiment `" << e.name << "`: " << o.mesh << ", " << o.size << "x" << o.size << ", " << rays
      << " rays per pixel, " << threads << " threads; error over " << compared << " "
      << (e.comparePlane && e.compareObject ? "plane and object" : e.comparePlane ? "plane" : "object")
-     << " pixels against the exact image; memory: field payload (exact: mesh + Embree BVH); time: secondary rays only.\n\n"
+     << " pixels against the exact image; memory: field payload (exact: mesh + Embree BVH; distance field: the bricks of its "
+     << "narrow band and their indirection table, at most the field's payload); time: secondary rays only.\n\n"
      << formatTable(rows);
   std::printf("%s", md.str().c_str());
   std::ofstream f(base + "-table.md");

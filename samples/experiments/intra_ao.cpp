@@ -4,7 +4,7 @@
 // from a point lifted 1e-3 R off the surface, with no range limit (self-occlusion only: the plane
 // is not an occluder here). The origins are inside the bounding sphere, so the field answers with
 // the intra-object test (the reversed ray from the sphere exit, spec/geometry.md 7.3). Plane pixels
-// get a constant colour.
+// get a constant colour. The distance field skips two voxels first (sdfOptions: its self-shadow bias).
 #include "common.h"
 
 namespace vffx {
@@ -18,10 +18,11 @@ int runIntraAo(const Options& o) {
   e.defaultConfigs = {"16642x64x64", "4226x64x64", "4226x32x32"};
   e.comparePlane = false;
   e.compareObject = true;
-  e.makeShader = [](const World& w, const ExactTracer& exact, const BakedQuery* field, vff::Reconstruction r,
-                    int rays) -> std::function<Vec3(const GSample&, Rng&)> {
+  e.makeShader = [](const World& w, const ExactTracer& exact, const BakedQuery* field, const SdfField* sdf,
+                    vff::Reconstruction r, int rays) -> std::function<Vec3(const GSample&, Rng&)> {
     const float eps = 1e-3f * w.radius;
     const vff::QueryOptions qo{.reconstruction = r};
+    const SdfTraceOptions so = sdfOptions(r == vff::Reconstruction::kInterpolated, true, hemisphereConeTan(rays));
     return [=, &exact](const GSample& s, Rng& rng) -> Vec3 {
       if (s.kind == PixelKind::kPlane) return kPlaneFlat;
       if (s.kind != PixelKind::kObject) return {};
@@ -32,7 +33,7 @@ int runIntraAo(const Options& o) {
         ray = {origin, cosineDirection(s.normal, u1, u2)};
       }
       float open = 0;
-      for (float share : openShares(exact, field, qo, batch)) open += share;
+      for (float share : sdf ? openShares(*sdf, so, batch) : openShares(exact, field, qo, batch)) open += share;
       const float v = open / float(rays);
       return {v, v, v};
     };

@@ -8,7 +8,9 @@
 //   vff-experiments scene                  a room (exact) and moving objects through their fields (Fig. 6)
 //   vff-experiments scene-bench            N moving instances: Embree instancing vs vff::Scene vs hybrid
 //   vff-experiments triangle-bench         time per ray against triangles (Loop subdivision to 1M)
+//   vff-experiments sdf-bench              field vs signed distance field vs Embree at equal memory, a sweep
 //   vff-experiments ao --field lod.vff     also (or only) evaluate field files of the same mesh
+//   vff-experiments ao --no-sdf            without the signed-distance-field rows (on by default)
 //
 // Images (PNG, EXR, error heat maps) and OUT/NAME-table.md go to --out (default out/experiments);
 // the table is printed on stdout, progress on stderr. Fields are baked in memory, never written.
@@ -31,7 +33,7 @@ int main(int argc, char** argv) {
   const std::vector<std::pair<std::string, int (*)(const Options&)>> experiments = {
       {"ao", runAo},         {"intra-ao", runIntraAo},       {"shadows", runShadows},
       {"reflections", runReflections}, {"bench", runBench}, {"scene", runScene},
-      {"scene-bench", runSceneBench},  {"triangle-bench", runTriangleBench}};
+      {"scene-bench", runSceneBench},  {"triangle-bench", runTriangleBench}, {"sdf-bench", runSdfBench}};
   std::vector<std::string> names;
   for (const auto& e : experiments) names.push_back(e.first);
   std::string list;
@@ -64,8 +66,22 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1u, 1u << 26));
   app.add_option("--repeat", o.repeat, "bench: repetitions (best is reported)")->capture_default_str()
       ->check(CLI::Range(1, 100));
+  app.add_flag("--sdf,!--no-sdf", o.sdf,
+               "image experiments: also render the signed distance field (OpenVDB level set, NanoVDB, sphere "
+               "tracing) at each field's memory (default: on)");
+  app.add_option("--sdf-values", o.sdfValues, "the distance field's values: fp8 (one byte a voxel) or float")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, SdfValues>{{"fp8", SdfValues::kFp8},
+                                                                           {"float", SdfValues::kFloat}}))
+      ->capture_default_str();
+  app.add_option("--sdf-band", o.sdfBand, "the distance field's narrow band: half-width in voxels")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0f, 64.0f));
   app.add_option("--object", o.objects, "scene: a moving object's mesh besides --mesh (repeatable; none: four "
-                 "procedural shapes)");
+                 "procedural shapes); sdf-bench: a mesh besides --mesh (repeatable)");
+  app.add_option("--sdf-memory", o.sdfMemory, "sdf-bench: memory per object in MiB (the field configuration of "
+                 "nearest payload; --config instead names them)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.01, 4096.0));
   app.add_option("--instances", o.instanceCounts, "scene-bench: instance counts (one table row each)")
       ->capture_default_str()
       ->check(CLI::Range(1u, 1u << 20));

@@ -5,7 +5,8 @@
 // Lambert under one directional light using the hit's normal: the exact image with Embree's hit
 // and the mesh's (interpolated or geometric) normal, the field images with Instance::intersect and
 // QueryHit::normal from the baked normal plane. A miss returns a constant sky colour. The plane
-// pixel is 30% its own grey plus 70% the mean reflection. Object pixels get a constant colour.
+// pixel is 30% its own grey plus 70% the mean reflection. Object pixels get a constant colour. The
+// distance field's image shades its sphere-traced hit with the distance's gradient for a normal.
 #include <algorithm>
 #include <cmath>
 
@@ -36,8 +37,9 @@ int runReflections(const Options& o) {
   e.defaultConfigs = {"4226x64x64", "4226x32x32"};
   e.normals = true;
   e.comparePlane = true;
-  e.makeShader = [](const World& w, const ExactTracer& exact, const BakedQuery* field, vff::Reconstruction r,
-                    int rays) -> std::function<Vec3(const GSample&, Rng&)> {
+  e.sdfRows = {vff::Reconstruction::kNearest};  // no cone for a hit's shading
+  e.makeShader = [](const World& w, const ExactTracer& exact, const BakedQuery* field, const SdfField* sdf,
+                    vff::Reconstruction r, int rays) -> std::function<Vec3(const GSample&, Rng&)> {
     const float eps = 1e-4f * w.radius;
     const vff::QueryOptions qo{.reconstruction = r};
     return [=, &exact](const GSample& s, Rng& rng) -> Vec3 {
@@ -53,7 +55,10 @@ int runReflections(const Options& o) {
         Vec3 dir = b * (sinT * std::cos(2 * kPi * u2)) + c * (sinT * std::sin(2 * kPi * u2)) + mirror * cosT;
         if (dir.y <= 0) dir = mirror;
         const vff::Ray ray{s.point + s.normal * eps, dir};
-        if (!field) {
+        if (sdf) {
+          const SdfHit h = sdf->intersect(ray);
+          sum = sum + (h.hit ? lambert(h.normal, dir) : kSky);
+        } else if (!field) {
           const ExactHit h = exact.intersect(ray);
           sum = sum + (h.hit ? lambert(h.normal, dir) : kSky);
         } else {

@@ -5,7 +5,9 @@
 // to a uniform point on the light's sphere, with direction = target - origin and tmax = 1. The
 // shading is Lambert toward the light's centre times the unoccluded fraction, on the plane and on
 // the object; both are compared. Rays from the object start inside the bounding sphere (the
-// field's intra-object path); most rays from the plane start outside (inter-object path).
+// field's intra-object path); most rays from the plane start outside (inter-object path). The
+// distance field traces the same rays (hit or miss), or takes the cone estimate of each: a cone
+// from the shaded point that covers the light's disc (distance-field shadows).
 #include <algorithm>
 
 #include "common.h"
@@ -33,13 +35,15 @@ int runShadows(const Options& o) {
   e.defaultConfigs = {"4226x64x64", "16642x32x32"};
   e.comparePlane = true;
   e.compareObject = true;
-  e.makeShader = [](const World& w, const ExactTracer& exact, const BakedQuery* field, vff::Reconstruction r,
-                    int rays) -> std::function<Vec3(const GSample&, Rng&)> {
+  e.makeShader = [](const World& w, const ExactTracer& exact, const BakedQuery* field, const SdfField* sdf,
+                    vff::Reconstruction r, int rays) -> std::function<Vec3(const GSample&, Rng&)> {
     const float eps = 1e-3f * w.radius;
     return [=, &exact](const GSample& s, Rng& rng) -> Vec3 {
       if (s.kind == PixelKind::kBackground) return {};
       // Plane points have no surface of their own to skip (bias 0); object points use the default.
       const vff::QueryOptions qo{.reconstruction = r, .intraBias = s.kind == PixelKind::kPlane ? 0.0f : -1.0f};
+      const SdfTraceOptions so = sdfOptions(r == vff::Reconstruction::kInterpolated, s.kind == PixelKind::kObject, 0.0f,
+                                            kLightRadius * w.radius);
       const Vec3 albedo = s.kind == PixelKind::kPlane ? Vec3{0.85f, 0.85f, 0.85f} : Vec3{0.9f, 0.85f, 0.75f};
       const Vec3 origin = s.point + s.normal * eps;
       const std::span<vff::Ray> batch = rayBuffer(size_t(rays));
@@ -49,7 +53,7 @@ int runShadows(const Options& o) {
         const Vec3 target = c + uniformSphere(u1, u2) * (kLightRadius * w.radius);
         batch[size_t(i)] = {origin, target - origin, 0.0f, 1.0f};
       }
-      const std::span<const float> shares = openShares(exact, field, qo, batch);
+      const std::span<const float> shares = sdf ? openShares(*sdf, so, batch) : openShares(exact, field, qo, batch);
       float open[3] = {0, 0, 0};
       int count[3] = {0, 0, 0};
       for (int i = 0; i < rays; ++i) {

@@ -18,7 +18,8 @@ test_quick_run_writes_a_results_file() {
   [[ -s $WORK/r.md && ! -e $WORK/r.md.tmp ]] || fail "no results file, or its temporary left behind"
   cpu=$("$PYTHON" "$report" cpu)
   grep -q -F "# vff benchmarks: $cpu, $(date -u +%Y-%m-%d)" "$WORK/r.md" || fail "the heading names another CPU or date"
-  for h in "### Bake speed" "### Query speed" "### Accuracy against exact Embree casts" "### Compression"; do
+  for h in "### Bake speed" "### Query speed" "### Accuracy against exact Embree casts" "### Compression" \
+           "### Field against a signed distance field at equal memory"; do
     grep -q -F "$h" "$WORK/r.md" || fail "results file lacks '$h'"
   done
   # The query table gives each ray set's share of the memory floor, a percentage.
@@ -40,9 +41,29 @@ test_quick_run_writes_a_results_file() {
   # No machine path: the commands are shown relative to the build folder.
   ! grep -q -F "$VFF_BUILD_DIR" "$WORK/r.md" || fail "the results file names the build folder"
   ! grep -q -F "$WORK" "$WORK/r.md" || fail "the results file names the scratch folder"
+  # The distance-field comparison: the three meshes, both ray sets, a wrong-answer share for each.
+  for m in knot box bowl; do for set in ao aimed; do
+    grep -q -E "^\| $m\.obj \| [0-9.]+ \| $set \| .* \| [0-9.]+% / [0-9.]+% \| (field|SDF), (field|SDF|tie) \|$" "$WORK/r.md" \
+      || fail "no distance-field row for $m, $set"
+  done; done
   run "$PYTHON" "$report" check "$WORK/r.md"
   expect_rc 0
-  expect_out "bake, query, accuracy-ao, accuracy-intra-ao, accuracy-shadows, accuracy-reflections, scene, triangles, compression"
+  expect_out "bake, query, accuracy-ao, accuracy-intra-ao, accuracy-shadows, accuracy-reflections, scene, triangles, compression, sdf"
+}
+
+# --only runs one step, and the results file says it is a reduced run; check asks for that step only.
+test_only_runs_one_step() {
+  "$MESHGEN" torus-knot "$WORK/knot.obj" >/dev/null
+  run bash "$VFF_SOURCE_DIR/benchmarks/run.sh" --quick --only sdf --build "$VFF_BUILD_DIR" --mesh "$WORK/knot.obj" \
+    --out "$WORK/s.md"
+  expect_rc 0
+  grep -q -F -- "--only sdf (a reduced run: that step alone)" "$WORK/s.md" || fail "the results file does not say it is reduced"
+  ! grep -q -F "### Bake speed" "$WORK/s.md" || fail "--only sdf ran the bake"
+  run "$PYTHON" "$report" check "$WORK/s.md"
+  expect_rc 0
+  expect_out ": sdf"
+  run bash "$VFF_SOURCE_DIR/benchmarks/run.sh" --only nosuch --build "$VFF_BUILD_DIR" --mesh "$WORK/knot.obj"
+  expect_rc 1
 }
 
 test_report_rejects_an_output_that_does_not_parse() {

@@ -73,9 +73,49 @@ case "$case" in
       [ -s "out/scene-f$f-$k.png" ] || { ls out; fail "missing out/scene-f$f-$k.png"; }
     done; done
     [ "$(grep -cE '^\| [0-9]+ \|' out/scene-table.md)" -eq 2 ] || { cat out/scene-table.md; fail "scene: not one row per frame"; }
+    # The distance fields' rows and images, one per frame.
+    [ "$(grep -cE '^\| [0-9]+, distance fields \|' out/scene-table.md)" -eq 2 ] \
+      || { cat out/scene-table.md; fail "scene: not one distance-field row per frame"; }
+    for f in 0 1; do [ -s "out/scene-f$f-sdf.png" ] && [ -s "out/scene-f$f-sdf-error.png" ] || { ls out; fail "scene: no distance-field image"; }; done
     # The fields answer most AO rays as the exact trace: RMS well under 32 on the 8-bit scale.
     awk -F'|' '/^\| [0-9]+ \|/ { if ($3 + 0 >= 32) bad = 1 } END { exit bad }' out/scene-table.md \
       || { cat out/scene-table.md; fail "scene: RMS error too large"; }
+    ;;
+  sdf_rows_beside_the_fields)
+    # Every image experiment renders the distance field at each field's memory: its rows (trace and,
+    # but for reflections, cone), its images and error maps; never more memory than the field's.
+    for e in ao intra-ao shadows reflections; do
+      "$exp" "$e" "${small[@]}" --rays 4 -o out >stdout.txt 2>stderr.txt || { cat stderr.txt; fail "$e failed"; }
+      modes="sphere trace cone"; [ "$e" = reflections ] && modes="sphere trace"
+      for m in "sphere trace" cone; do
+        n=$(grep -c "^| distance field, 1090x16x16's memory .* | $m |" stdout.txt)
+        case " $modes " in *" $m "*) want=1 ;; *) want=0 ;; esac
+        [ "$n" -eq "$want" ] || { cat stdout.txt; fail "$e: $n '$m' rows, expected $want"; }
+      done
+      [ -s "out/$e-sdf-1090x16x16-trace.png" ] && [ -s "out/$e-sdf-1090x16x16-trace-error.png" ] \
+        || { ls out; fail "$e: missing the distance field's image or error map"; }
+      field=$(awk -F'|' '$2 ~ /^ 1090x16x16 $/ {print $4; exit}' stdout.txt)
+      awk -F'|' -v f="$field" '$2 ~ /distance field/ { if ($4 + 0 > f + 0 || $4 + 0 < 0.8 * f) bad = 1 } END { exit bad }' stdout.txt \
+        || { cat stdout.txt; fail "$e: the distance field's memory is not the field's ($field MiB)"; }
+    done
+    # The distance field's RMS is a real error: its ao image differs from the exact one.
+    awk -F'|' '$2 ~ /distance field/ && $3 ~ /sphere trace/ { if ($5 + 0 <= 0 || $5 + 0 >= 40) bad = 1 } END { exit bad }' stdout.txt \
+      || { cat stdout.txt; fail "an implausible RMS for the distance field"; }
+    "$exp" ao "${small[@]}" --rays 4 --no-sdf -o none >stdout.txt 2>stderr.txt || { cat stderr.txt; fail "ao --no-sdf failed"; }
+    ! grep -q "^| distance field" stdout.txt || { cat stdout.txt; fail "--no-sdf still renders the distance field"; }
+    ! ls none | grep -q sdf || { ls none; fail "--no-sdf still writes the distance field's images"; }
+    ;;
+  sdf_bench_prints_three_way_rows)
+    # Field, distance field and Embree on the same rays: a row per mesh, configuration and ray set.
+    "$meshgen" bowl bowl.obj || fail "mesh generator"
+    "$exp" sdf-bench --mesh knot.obj --object bowl.obj --config 290x16x16 --bench-rays 5000 --repeat 1 -j 2 \
+      >stdout.txt 2>stderr.txt || { cat stderr.txt; fail "sdf-bench failed"; }
+    grep -q "^Distance-field benchmark: .* $(sed -n 's/^model name[[:space:]]*: *//p' /proc/cpuinfo | head -1)" stdout.txt \
+      || { head -1 stdout.txt; fail "sdf-bench header names no CPU"; }
+    [ "$(grep -cE '^\| (knot|bowl)\.obj \| 290x16x16 \|' stdout.txt)" -eq 4 ] || { cat stdout.txt; fail "sdf-bench: not four rows"; }
+    # Every rate positive; the share of wrong answers a percentage under 50 for both.
+    awk -F'|' '/^\| (knot|bowl)\.obj/ { if ($7 + 0 <= 0 || $8 + 0 <= 0 || $9 + 0 <= 0 || $11 + 0 >= 50 || $12 + 0 >= 50) bad = 1 }
+               END { exit bad }' stdout.txt || { cat stdout.txt; fail "sdf-bench: implausible figures"; }
     ;;
   images_do_not_depend_on_threads)
     "$exp" ao "${small[@]}" --rays 8 -j 1 -o one >/dev/null 2>&1 || fail "ao -j 1 failed"

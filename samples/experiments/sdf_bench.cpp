@@ -1,0 +1,133 @@
+// sdf_bench.cpp - the field against its production peer at equal memory: vff-experiments sdf-bench.
+//
+// For each mesh (--mesh, then every --object) and each memory per object (--sdf-memory MiB: the
+// field configuration of octa-hemi2 n = 32 whose payload is nearest, power-of-two maps, n = 64
+// above 64 x 64; or the --config list), the distance field is built at the field's payload bytes
+// (sdf_field.h: its bricks, never more). Both answer bench's two incoherent ray sets (ao, aimed:
+// bench.cpp) in world space, on the same threads, in calls of --batch rays, timed and repeated as
+// bench does (timedParallelFor, best of --repeat, the three taking turns):
+//   Embree   rtcOccluded1 on the mesh (the reference answers)
+//   field    Instance::occluded, batch, kNearest
+//   SDF      SdfField::occluded, batch: sphere tracing (hit or miss)
+// and the share of rays each answers otherwise than Embree. One table, a row per mesh, memory and
+// ray set: where the field is faster, and where it is more often right, at the same memory.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "cli.h"
+#include "common.h"
+
+namespace vffx {
+
+namespace {
+
+constexpr uint64_t kChunk = 4096;
+
+// The octa-hemi2 configuration whose payload (maps x m^2 bytes) is nearest `mib`.
+FieldConfig configForMemory(double mib) {
+  const double maps32 = 4226;
+  const double m = std::sqrt(mib * 1048576.0 / maps32);
+  uint32_t p = 4;
+  while (p < 4096 && double(p) * std::sqrt(2.0) < m) p *= 2;
+  FieldConfig c;
+  c.n = 32;
+  c.mapSize = p;
+  if (p > 64) c.n = 64, c.mapSize = p / 2;
+  return c;
+}
+
+std::string baseName(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+}  // namespace
+
+int runSdfBench(const Options& o) {
+  const unsigned threads = resolveThreads(o.threads);
+  std::vector<FieldConfig> configs;
+  for (const std::string& text : o.configs) {
+    FieldConfig c;
+    if (!parseFieldConfig(text, &c)) {
+      vff::cli::usageError(kProg, "--config " + text + ": expected MAPSxMxM with an octa-hemi2 map count");
+      return vff::cli::kExitUsage;
+    }
+    configs.push_back(c);
+  }
+  if (configs.empty())
+    for (double mib : o.sdfMemory) configs.push_back(configForMemory(mib));
+  std::vector<std::string> meshes{o.mesh};
+  meshes.insert(meshes.end(), o.objects.begin(), o.objects.end());
+
+  std::printf("Distance-field benchmark: %u rays per set, %u threads, best of %d, %u rays per batch call, "
+              "distance field %s, %s\n\n",
+              o.benchRays, threads, o.repeat, o.benchBatch, o.sdfValues == SdfValues::kFp8 ? "fp8" : "float",
+              cpuName().c_str());
+  std::printf("| mesh | field | memory MiB | distance field | ray set | Embree Mrays/s | field Mrays/s | SDF Mrays/s | "
+              "field / SDF speed | field wrong | SDF wrong |\n");
+  std::printf("|---|---|---:|---|---|---:|---:|---:|---:|---:|---:|\n");
+  std::fflush(stdout);
+  for (const std::string& path : meshes) {
+    Options om = o;
+    om.mesh = path;
+    auto setup = makeSetup(om, threads);
+    if (!setup) return vff::cli::reportError(kProg, path, setup.error());
+    const World& world = (*setup)->world;
+    const ExactTracer& exact = *(*setup)->exact;
+    std::vector<RaySet> sets{makeAoRays(world, o.benchRays, o.aoDistance), makeAimedRays(world, o.benchRays)};
+    for (const FieldConfig& config : configs) {
+      auto field = bakeQuery(world, *(*setup)->scene, config, false, threads);
+      if (!field) return vff::cli::reportError(kProg, path, field.error());
+      const vff::Instance& instance = (*field)->instance;
+      auto built = SdfField::build(world.objectMesh, {.budgetBytes = (*field)->query.payloadBytes(), .values = o.sdfValues, .bandVoxels = o.sdfBand});
+      if (!built) return vff::cli::reportError(kProg, path, built.error());
+      SdfField& sdf = *built;
+      sdf.transform = world.transform;
+      std::fprintf(stderr, "%s: sdf-bench: %s %s: field baked in %.2f s, distance field built in %.2f s (%d builds)\n",
+                   kProg, baseName(path).c_str(), config.name().c_str(), (*field)->bakeSeconds, sdf.buildSeconds(),
+                   sdf.builds());
+      char what[160];
+      std::snprintf(what, sizeof what, "voxel %.4g R, %.2f MiB (NanoVDB %.2f)", double(sdf.voxelSize() / world.radius),
+                    double(sdf.bytes()) / 1048576.0, double(sdf.nanovdbBytes()) / 1048576.0);
+      for (const RaySet& set : sets) {
+        const size_t n = set.world.size();
+        const std::span<const vff::Ray> rays(set.world);
+        std::vector<uint8_t> ref(n), byField(n), bySdf(n);
+        const vff::QueryOptions qn{.reconstruction = vff::Reconstruction::kNearest, .intraBias = 0.0f};
+        auto batched = [&](auto&& call) {
+          return timedParallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
+            for (uint64_t x = b; x < e; x += o.benchBatch) call(x, std::min<uint64_t>(e, x + o.benchBatch) - x);
+          });
+        };
+        double ta = 1e30, tf = 1e30, ts = 1e30;
+        for (int rep = 0; rep < o.repeat; ++rep) {
+          ta = std::min(ta, timedParallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
+            for (uint64_t i = b; i < e; ++i) ref[i] = exact.occluded(set.world[i]) ? 1 : 0;
+          }));
+          tf = std::min(tf, batched([&](uint64_t x, uint64_t k) {
+            instance.occluded(rays.subspan(x, k), std::span<uint8_t>(byField).subspan(x, k), qn);
+          }));
+          ts = std::min(ts, batched([&](uint64_t x, uint64_t k) {
+            sdf.occluded(rays.subspan(x, k), std::span<uint8_t>(bySdf).subspan(x, k));
+          }));
+        }
+        uint64_t wrongField = 0, wrongSdf = 0;
+        for (size_t i = 0; i < n; ++i) {
+          wrongField += (byField[i] != 0) != (ref[i] != 0);
+          wrongSdf += (bySdf[i] != 0) != (ref[i] != 0);
+        }
+        const double mr = double(n) / 1e6;
+        std::printf("| %s | %s | %.2f | %s | %s | %.2f | %.2f | %.2f | %.2f | %.2f%% | %.2f%% |\n", baseName(path).c_str(),
+                    config.name().c_str(), (*field)->payloadMiB(), what, set.name.c_str(), mr / ta, mr / tf, mr / ts,
+                    ts / tf, 100.0 * double(wrongField) / double(n), 100.0 * double(wrongSdf) / double(n));
+        std::fflush(stdout);
+      }
+    }
+  }
+  std::printf("\nwrong: the share of rays answered otherwise than Embree (occluded or not). field / SDF speed > 1: the "
+              "field is faster. Both at the same memory: the field's payload, the distance field's bricks (sdf_field.h).\n");
+  return vff::cli::kExitSuccess;
+}
+
+}  // namespace vffx
