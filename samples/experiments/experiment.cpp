@@ -39,6 +39,12 @@ int renderSdfRows(const Options& o, const ImageExperiment& e, const World& world
                   const GBuffer& g, const std::vector<uint8_t>& mask, const Image& reference, const BakedQuery& c,
                   int rays, unsigned threads, uint32_t stream, const std::string& base, std::vector<Image>* strip,
                   std::vector<TableRow>* rows) {
+  if (c.query.payloadBytes() < kSdfMinBudget) {  // a field this small has no distance field beside it
+    std::fprintf(stderr, "%s: %s: note: no distance-field rows for %s: its %llu bytes are under the %llu a distance grid needs\n",
+                 kProg, e.name.c_str(), c.name.c_str(), static_cast<unsigned long long>(c.query.payloadBytes()),
+                 static_cast<unsigned long long>(kSdfMinBudget));
+    return 0;
+  }
   auto built = SdfField::build(world.objectMesh, {.budgetBytes = c.query.payloadBytes(), .values = o.sdfValues, .bandVoxels = o.sdfBand});
   if (!built) return vff::cli::reportError(kProg, o.mesh, built.error());
   SdfField& sdf = *built;

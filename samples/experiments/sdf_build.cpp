@@ -11,6 +11,7 @@
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <string>
 
 #include "sdf_impl.h"
 
@@ -93,7 +94,8 @@ vff::Result<SdfField> SdfField::build(const vff::bake::Mesh& objectMesh, const S
   // First guess: the band's voxels (area x 2 bands / h^2), about twice that once rounded up to
   // whole leaves with their headers.
   double h = std::sqrt(std::max(g.area, 1e-12) * 2.0 * options.bandVoxels * valueBytes * 2.0 / budget);
-  if (budget < 4096) return vff::makeError(vff::Code::kInvalidArgument, "a budget under 4096 bytes holds no distance grid");
+  if (options.budgetBytes < kSdfMinBudget)
+    return vff::makeError(vff::Code::kInvalidArgument, "a budget under " + std::to_string(kSdfMinBudget) + " bytes holds no distance grid");
   double exponent = 2.0;  // bytes ~ h^-exponent: a band's area; a volume's (3) when the band fills the object
   double prevH = 0, prevBytes = 0, bestBytes = 0;
   SdfField out;

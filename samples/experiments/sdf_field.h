@@ -52,8 +52,11 @@ namespace vffx {
 
 enum class SdfValues : uint8_t { kFp8, kFloat };
 
+// The smallest budget a build accepts: a few bricks.
+inline constexpr uint64_t kSdfMinBudget = 4096;
+
 struct SdfBuildOptions {
-  uint64_t budgetBytes = 1u << 20;  // bytes() at most
+  uint64_t budgetBytes = 1u << 20;  // bytes() at most; kSdfMinBudget at least
   SdfValues values = SdfValues::kFp8;
   float bandVoxels = 8.0f;  // half-width of the narrow band, each side, in voxels (see above)
 };
