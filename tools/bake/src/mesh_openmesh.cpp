@@ -8,6 +8,7 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <mutex>
 #include <set>
 #include <vector>
 #include <sstream>
@@ -197,6 +198,11 @@ void importTriangles(const PlyTriangles& t, TriMesh* tm, OpenMesh::IO::Options* 
 }  // namespace
 
 Result<Mesh> loadWithOpenMesh(const std::string& path, const std::string& ext) {
+  // OpenMesh's streams (omerr, omlog, omout: their targets are process-wide vectors) and its reader
+  // registry are not thread-safe, and callers load meshes on several threads (vff-library hashes
+  // its entries in parallel): one load at a time goes through OpenMesh.
+  static std::mutex openMesh;
+  const std::lock_guard<std::mutex> lock(openMesh);
   // OpenMesh reports through global streams; the importer's own errors carry the message.
   omerr().disable();
   omlog().disable();
