@@ -244,11 +244,11 @@ VffSceneHit vffSceneWalk(vec3 origin, vec3 direction, float tmin, float tmax, fl
       continue;
     }
     VffSceneNode n = vffSceneNodes[ref];
-    vec4 t1x = (n.loX - origin.x) * inv.x, t2x = (n.hiX - origin.x) * inv.x;
-    vec4 t1y = (n.loY - origin.y) * inv.y, t2y = (n.hiY - origin.y) * inv.y;
-    vec4 t1z = (n.loZ - origin.z) * inv.z, t2z = (n.hiZ - origin.z) * inv.z;
-    vec4 tn = max(max(vec4(0.0), min(t1x, t2x)), max(min(t1y, t2y), min(t1z, t2z)));
-    vec4 tf = min(min(vec4(limit), max(t1x, t2x)), min(max(t1y, t2y), max(t1z, t2z)));
+    vec4 tLoX = (n.loX - origin.x) * inv.x, tHiX = (n.hiX - origin.x) * inv.x;
+    vec4 tLoY = (n.loY - origin.y) * inv.y, tHiY = (n.hiY - origin.y) * inv.y;
+    vec4 tLoZ = (n.loZ - origin.z) * inv.z, tHiZ = (n.hiZ - origin.z) * inv.z;
+    vec4 tn = max(max(vec4(0.0), min(tLoX, tHiX)), max(min(tLoY, tHiY), min(tLoZ, tHiZ)));
+    vec4 tf = min(min(vec4(limit), max(tLoX, tHiX)), min(max(tLoY, tHiY), max(tLoZ, tHiZ)));
     // The children the segment reaches, sorted by entry (insertion sort of at most four).
     uint order[4];
     int k = 0;
