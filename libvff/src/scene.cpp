@@ -106,18 +106,22 @@ Status Scene::commit() {
     m.maxRadius = std::max(m.maxRadius, r);
   }
   m.bvh.build(boxes);
-  m.byField.resize(m.instances.size());
-  for (uint32_t i = 0; i < m.byField.size(); ++i) m.byField[i] = i;
-  // Grouped by the order in which each field first appears, so that the grouping does not depend
-  // on where the fields lie in memory.
-  std::vector<uint32_t> firstUse(m.instances.size());
-  std::unordered_map<const FieldQuery*, uint32_t> first;
-  for (uint32_t i = 0; i < firstUse.size(); ++i) firstUse[i] = first.try_emplace(m.instances[i].field, i).first->second;
-  std::stable_sort(m.byField.begin(), m.byField.end(), [&](uint32_t a, uint32_t b) { return firstUse[a] < firstUse[b]; });
-  m.fieldStart.clear();
-  for (uint32_t k = 0; k < m.byField.size(); ++k)
-    if (k == 0 || firstUse[m.byField[k]] != firstUse[m.byField[k - 1]]) m.fieldStart.push_back(k);
-  m.fieldStart.push_back(uint32_t(m.byField.size()));
+  // Grouped by field, in the order in which each field first appears (so that the grouping does
+  // not depend on where the fields lie in memory). Instances are only ever appended and keep their
+  // field, so the grouping changes only when instances were added: a frame that only moves them
+  // keeps it.
+  if (m.byField.size() != m.instances.size()) {
+    m.byField.resize(m.instances.size());
+    for (uint32_t i = 0; i < m.byField.size(); ++i) m.byField[i] = i;
+    std::vector<uint32_t> firstUse(m.instances.size());
+    std::unordered_map<const FieldQuery*, uint32_t> first;
+    for (uint32_t i = 0; i < firstUse.size(); ++i) firstUse[i] = first.try_emplace(m.instances[i].field, i).first->second;
+    std::stable_sort(m.byField.begin(), m.byField.end(), [&](uint32_t a, uint32_t b) { return firstUse[a] < firstUse[b]; });
+    m.fieldStart.clear();
+    for (uint32_t k = 0; k < m.byField.size(); ++k)
+      if (k == 0 || firstUse[m.byField[k]] != firstUse[m.byField[k - 1]]) m.fieldStart.push_back(k);
+    m.fieldStart.push_back(uint32_t(m.byField.size()));
+  }
   m.committed = true;
   return {};
 }
