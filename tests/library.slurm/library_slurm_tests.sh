@@ -17,18 +17,29 @@ test_changed_option_rebakes_only_affected() { case_changed_option_rebakes_only_a
 test_sharded_bake_merges_to_whole() { case_sharded_bake_merges_to_whole; }
 
 # cancel_task_1 RETRIES: bakes the library (shared meshes too) as two array tasks, one at a time,
-# and cancels task 1 once it runs; the run's exit code in RC, its report in $WORK/report.json.
+# and cancels task 1 while it runs; the run's exit code in RC, its report in $WORK/report.json.
+# Task 1's first bake is held (a vff-bake wrapper that waits) until the cancel: however fast the
+# machine, the cancel comes mid-task, after task 0 baked its share.
 cancel_task_1() {
   make_library "$WORK/lib" shared
-  SLURM_CONF=$VFF_TEST_SLURM_CONF "$VFF_LIBRARY" bake "$WORK/lib" --out "$WORK/fields" --slurm --poll 0.2 \
-    --state "$WORK/state" --tasks 2 --max-running 1 --retries "$1" --json "$WORK/report.json" -q -- "${SLOW[@]}" \
-    >"$WORK/first.out" 2>"$WORK/first.err" &
-  local pid=$! job="" i
-  for i in $(seq 600); do
-    job=$(cut -d';' -f1 "$WORK/state/round-0.sbatch.out" 2>/dev/null || true)
-    [[ -n $job ]] && SLURM_CONF=$VFF_TEST_SLURM_CONF squeue -h -j "${job}_1" -t RUNNING 2>/dev/null | grep -q . && break
+  cat >"$WORK/held-bake.sh" <<EOS
+#!/usr/bin/env bash
+if [[ \${SLURM_ARRAY_TASK_ID:-} == 1 ]] && mkdir "$WORK/held" 2>/dev/null; then
+  for i in \$(seq 1200); do sleep 0.1; done  # the cancel ends this; a bound keeps a lost one finite
+fi
+exec "$VFF_BAKE" "\$@"
+EOS
+  chmod +x "$WORK/held-bake.sh"
+  SLURM_CONF=$VFF_TEST_SLURM_CONF VFF_BAKE=$WORK/held-bake.sh "$VFF_LIBRARY" bake "$WORK/lib" --out "$WORK/fields" \
+    --slurm --poll 0.2 --state "$WORK/state" --tasks 2 --max-running 1 --retries "$1" --json "$WORK/report.json" \
+    -q -- "${SLOW[@]}" >"$WORK/first.out" 2>"$WORK/first.err" &
+  local pid=$! job i
+  for i in $(seq 1200); do
+    [[ -d $WORK/held ]] && break
     sleep 0.05
   done
+  [[ -d $WORK/held ]] || fail "array task 1 never started a bake"
+  job=$(cut -d';' -f1 "$WORK/state/round-0.sbatch.out")
   SLURM_CONF=$VFF_TEST_SLURM_CONF scancel "${job}_1"
   RC=0
   wait $pid || RC=$?
