@@ -19,6 +19,7 @@ template <class Emit>
 void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept {
   constexpr size_t kPlanned = detail::kPlanLanes;
   const detail::GroupKernel* kernel = detail::groupKernel();  // (one for the whole batch)
+  needNeighbours();
   Lookup l[kPlanned];
   detail::PlanBlock plan{};  // (zeroed: the blend kernel reads every lane of a slot)
   size_t which[kPlanned];    // the lanes' rays (indices into rays)

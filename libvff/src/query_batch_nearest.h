@@ -3,8 +3,6 @@
 // visibilities), included only by query_batch.cpp, which instantiates it for each batch call.
 #pragma once
 
-#include <cstring>
-
 #include "query_impl.h"
 
 namespace vff {
@@ -40,13 +38,7 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
     }
     return;
   }
-  detail::GroupTables tables = groupTables(o, kHitOnly);
-  if (to) {
-    tables.toObject = true;
-    std::memcpy(tables.objectRotation, to->r, sizeof tables.objectRotation);
-    tables.objectShift = to->translation;
-    tables.objectInvScale = to->invScale;
-  }
+  const detail::GroupTables tables = detail::toObjectTables(groupTables(o, kHitOnly), to);
   forEachGroup(*kernel, rays, tables, [&](size_t base, size_t n, detail::Group& g) {
     // Every ray misses unless it reaches the sphere.
     if constexpr (!kHitOnly) detail::forEachClear(g.reached, n, [&](size_t r) { emit(base + r, QueryHit{}, 1.0f); });

@@ -85,7 +85,6 @@ void FieldQuery::Impl::build() {
         chordScale[size_t(j) * m + i] =
             quantizationStep(field.distanceEncoding, radius, texelDirection(field.directionScheme, m, i, j).z);
   }
-  neighbours = queryNeighbours(positions);
 }
 
 std::vector<uint32_t> queryNeighbours(const PositionSet& positions) {
@@ -241,6 +240,7 @@ detail::GroupTables FieldQuery::Impl::groupTables(const QueryOptions& o, bool de
 }
 
 detail::PlanTables FieldQuery::Impl::planTables() const noexcept {
+  needNeighbours();
   detail::PlanTables t;
   t.unit4 = unit4.data();
   t.neighbours = neighbours.data();

@@ -13,6 +13,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <mutex>
 #include <span>
 #include <vector>
 
@@ -62,6 +64,18 @@ struct ToObject {
   Vec3 point(Vec3 p) const noexcept { return vector(p - translation); }
   Ray ray(const Ray& w) const noexcept { return Ray{point(w.origin), vector(w.direction), w.tmin, w.tmax}; }
 };
+
+// Tables whose kernel takes world-space rays to object space by `to`, lane by lane (none: the
+// rays are in object space).
+inline GroupTables toObjectTables(GroupTables t, const ToObject* to) noexcept {
+  if (to) {
+    t.toObject = true;
+    std::memcpy(t.objectRotation, to->r, sizeof t.objectRotation);
+    t.objectShift = to->translation;
+    t.objectInvScale = to->invScale;
+  }
+  return t;
+}
 
 // The field's answer to an object-space ray, in world space (both rays share t).
 inline void toWorld(const RigidTransform& x, const Ray& worldRay, QueryHit* h) {
@@ -118,7 +132,13 @@ struct FieldQuery::Impl {
   std::vector<uint8_t> octaMasks;    // octa-hemi2: detail::octaCandidateMasks (the group kernel)
   std::vector<uint32_t> octaCornerRows;  // detail::octaCornerRows of octaMasks (n <= 32)
   static constexpr uint32_t kNeighbours = kQueryNeighbours;
-  std::vector<uint32_t> neighbours;  // kNeighbours per map; UINT32_MAX pads
+  // kNeighbours per map; UINT32_MAX pads. Only the interpolated reconstruction reads them, so
+  // they are made by its first call (needNeighbours), not when the query opens.
+  mutable std::vector<uint32_t> neighbours;
+  mutable std::once_flag neighboursMade;
+  void needNeighbours() const noexcept {
+    std::call_once(neighboursMade, [this] { neighbours = queryNeighbours(positions); });
+  }
   float spacing = 0;                 // mean angular spacing sqrt(4 pi / mapCount)
   float kernelRadius2 = 0;           // squared chord radius of the interpolation kernel
   float defaultBias = 0;             // fraction of R
@@ -298,6 +318,10 @@ struct FieldQuery::Impl {
                      const RigidTransform* x) const noexcept;
   void visibilityBatch(std::span<const Ray> rays, std::span<float> out, const QueryOptions& o,
                        const RigidTransform* x) const noexcept;
+  // The lookup sites of a batch (query_site.cpp): the group kernel's first steps, stopped before
+  // the texels are read.
+  void sitesBatch(std::span<const Ray> rays, std::span<LookupSite> out, const QueryOptions& o,
+                  const RigidTransform* x) const noexcept;
   const uint8_t* texelAddress(uint32_t k, uint32_t i, uint32_t j) const noexcept {
     return dist[k] + detail::texelByte(field.distanceEncoding, m, i, j);
   }

@@ -177,6 +177,7 @@ QueryHit FieldQuery::Impl::blendInterpolated(const Ray& ray, const Lookup& l, co
 }
 
 QueryHit FieldQuery::Impl::interpolated(const Ray& ray, const Lookup& l, float* visibility) const noexcept {
+  needNeighbours();
   detail::PlanBlock plan;  // (lane 0 only)
   planInterpolated(ray, l, &plan, 0);
   return blendInterpolated(ray, l, plan, 0, visibility);

@@ -365,11 +365,18 @@ int expectBatchesEqualSingleRays(const Q& q, const std::vector<Ray>& rays) {
     std::vector<QueryHit> hits(rays.size());
     std::vector<uint8_t> occ(rays.size());
     std::vector<float> vis(rays.size());
+    std::vector<LookupSite> where(rays.size());
     q.intersect(rays, hits, o);
     q.occluded(rays, occ, o);
     q.visibility(rays, vis, o);
+    q.sites(rays, where, o);
     for (size_t r = 0; r < rays.size(); ++r) {
       const QueryHit h = q.intersect(rays[r], o);
+      const LookupSite s = q.site(rays[r], o);
+      EXPECT_EQ(where[r].valid, s.valid) << "ray " << r;
+      EXPECT_EQ(where[r].sample, s.sample) << "ray " << r;
+      EXPECT_EQ(where[r].i, s.i) << "ray " << r;
+      EXPECT_EQ(where[r].j, s.j) << "ray " << r;
       EXPECT_EQ(hits[r].hit, h.hit) << "ray " << r;
       EXPECT_EQ(hits[r].t, h.t) << "ray " << r;
       EXPECT_EQ(hits[r].point.x, h.point.x) << "ray " << r;
@@ -526,8 +533,12 @@ TEST(Query, Bit1FieldsAnswerHitOrMissOnly) {
     }
   }
   EXPECT_GE(double(agree) / total, 0.9);
-  // From inside there is no distance to compare: never occluded.
+  // From inside there is no distance to compare: never occluded, and no lookup.
   EXPECT_FALSE(b->query.occluded(Ray{c, {1, 0, 0}}));
+  std::vector<Ray> rays(1000);
+  for (Ray& ray : rays) ray = Ray{add(c, mul(rng.direction(), 2 * R * rng.uniform())), rng.direction()};
+  EXPECT_GT(expectBatchesEqualSingleRays(b->query, rays), 50);
+  EXPECT_FALSE(b->query.site(Ray{c, {1, 0, 0}}).valid);
 }
 
 TEST(Query, DefaultIntraBiasFollowsTheDocumentedFormula) {

@@ -522,10 +522,12 @@ void checkBatches(detail::KernelChoice) {
       for (size_t batch : {size_t(1), size_t(3), size_t(63), size_t(65), rays.size()}) {
         std::vector<QueryHit> hits(rays.size());
         std::vector<uint8_t> occ(rays.size());
+        std::vector<LookupSite> where(rays.size());
         for (size_t b = 0; b < rays.size(); b += batch) {
           const size_t e = std::min(rays.size(), b + batch);
           q->intersect(std::span<const Ray>(rays).subspan(b, e - b), std::span<QueryHit>(hits).subspan(b, e - b), o);
           q->occluded(std::span<const Ray>(rays).subspan(b, e - b), std::span<uint8_t>(occ).subspan(b, e - b), o);
+          q->sites(std::span<const Ray>(rays).subspan(b, e - b), std::span<LookupSite>(where).subspan(b, e - b), o);
         }
         size_t hitCount = 0;
         for (size_t r = 0; r < rays.size(); ++r) {
@@ -538,6 +540,10 @@ void checkBatches(detail::KernelChoice) {
           }
           const QueryHit single = q->intersect(rays[r], o);
           ASSERT_EQ(single.hit, ref.hit);
+          const LookupSite site = q->site(rays[r], o);  // the reference prepare()
+          ASSERT_EQ(where[r].valid, site.valid) << "n " << n << " batch " << batch << " ray " << r;
+          ASSERT_TRUE(where[r].sample == site.sample && where[r].i == site.i && where[r].j == site.j)
+              << "n " << n << " batch " << batch << " ray " << r;
           if (ref.hit) {
             ASSERT_EQ(single.t, ref.t);
           }
