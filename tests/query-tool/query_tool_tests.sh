@@ -21,7 +21,7 @@ test_help() {
   query --help
   expect_rc 0
   for opt in --ray --input --output --format --interpolated --visibility --tmin --tmax --rotate --translate --scale \
-    --threads --checksums --no-sites "Exit codes:" "3  invalid input file"; do expect_out "$opt"; done
+    --threads --checksums --no-sites --columns "Exit codes:" "3  invalid input file"; do expect_out "$opt"; done
 }
 
 # Nearest answers, split over threads in batches, equal the one-ray calls on every encoding.
@@ -148,6 +148,45 @@ test_sites_and_no_sites() {
     /usr/bin/python3 -c "import numpy as np; a = np.load('$WORK/h.npy'); assert a.shape == (1, 9), a.shape" ||
       fail "--no-sites .npy shape"
   fi
+}
+
+# --columns: the columns named, in that order, with the values of the same columns of the default
+# answer, in CSV and .npy; the visibility and the sites computed only when named.
+test_columns_pick_and_order() {
+  local f="$VECTORS/u8d-zstd-normals-meta.vff"
+  "$REFERENCE" rays "$f" 200 3 >"$WORK/rays.csv"
+  query "$f" -i "$WORK/rays.csv" --visibility
+  expect_rc 0
+  cp "$WORK/out" "$WORK/all.csv"
+  query "$f" -i "$WORK/rays.csv" --columns visibility,j,t,hit
+  expect_rc 0
+  [[ $(sed -n 1p "$WORK/out") == visibility,j,t,hit ]] || { show; fail "--columns CSV header"; }
+  # hit,t,...,j,visibility are columns 1, 2, 12 and 13 of the full answer.
+  same "$WORK/out" <(cut -d, -f13,12,2,1 --output-delimiter=, "$WORK/all.csv" | awk -F, -v OFS=, '{print $4, $3, $2, $1}')
+  [[ $(awk -F, 'NR > 1 && $4 == 1' "$WORK/out" | wc -l) -gt 10 ]] || fail "the rays hit too rarely to tell"
+  if has_numpy; then
+    /usr/bin/python3 -c "import numpy as np; np.save('$WORK/rays.npy', np.loadtxt('$WORK/rays.csv', delimiter=',', dtype=np.float32))"
+    query "$f" -i "$WORK/rays.npy" -o "$WORK/all.npy" --visibility
+    expect_rc 0
+    query "$f" -i "$WORK/rays.npy" -o "$WORK/some.npy" --columns t,sample,nz
+    expect_rc 0
+    /usr/bin/python3 -c "
+import numpy as np
+a, s = np.load('$WORK/all.npy'), np.load('$WORK/some.npy')
+assert s.shape == (200, 3), s.shape
+assert np.array_equal(s, a[:, [1, 9, 7]], equal_nan=True)" || fail "--columns .npy differs from the full answer's columns"
+  fi
+  query "$f" --ray 0 0 5 0 0 -1 --columns t,speed
+  expect_rc 1
+  expect_err 'unknown column "speed"'
+  query "$f" --ray 0 0 5 0 0 -1 --columns t,t
+  expect_rc 1
+  expect_err 'column "t" named twice'
+  query "$f" --ray 0 0 5 0 0 -1 --columns t --no-sites
+  expect_rc 1
+  query "$f" --ray 0 0 5 0 0 -1 --columns t --format jsonl
+  expect_rc 1
+  expect_err "--columns applies to csv and npy"
 }
 
 # --checksums: all (the default) refuses a field whose bytes do not match their checksum; none

@@ -54,6 +54,7 @@ struct Options {
   unsigned threads = 0;
   std::string checksums = "all";
   bool noSites = false;
+  std::string columns;
   bool timing = false;
 };
 
@@ -99,8 +100,14 @@ void addOptions(CLI::App& app, Options& o) {
       ->check(CLI::IsMember({"all", "lazy", "none"}))
       ->capture_default_str();
   app.add_flag("--no-sites", o.noSites,
-               "leave out the columns sample, i, j (which map and texel answered): finding them repeats the first "
-               "step of each lookup on one ray at a time");
+               "leave out the columns sample, i, j (which map and texel answered): finding them is a second "
+               "pass of each lookup's first steps");
+  app.add_option("--columns", o.columns,
+                 "the output's columns, comma-separated, in this order (csv and npy): any of hit,t,x,y,z,nx,ny,nz,"
+                 "inside,sample,i,j,visibility (default: all but visibility; fewer columns, less to write)")
+      ->excludes("--no-sites")
+      ->excludes("--visibility")
+      ->option_text("LIST");
   app.add_flag("--timing", o.timing,
                "print to stderr the seconds spent reading, querying and writing, and the rays per second of the "
                "whole and of the batch calls alone on warm memory (run 3 more times; for benchmarks)");
@@ -173,7 +180,7 @@ struct RaySource {
     if (!rows) return rays.subspan(first, count);
     for (size_t k = 0; k < count; ++k) {
       out[k] = row(first + k);
-      if (!*bad && checkRay(out[k])) *bad = first + k;
+      if (!*bad && !rayIsGood(out[k])) *bad = first + k;
     }
     return {out, count};
   }
@@ -200,42 +207,48 @@ struct Target {
   }
 };
 
-// Answers the rays in chunks over `threads` threads; each chunk's answers go to store(first,
-// answers) from the thread that made them (visibility empty unless asked for; sites only when
-// `sites`). A chunk holding a bad .npy row is not answered; the index of the first bad row is
-// returned.
-template <class Store>
-std::optional<size_t> answer(const Target& target, const RaySource& src, const QueryOptions& qo, bool visibility,
-                             bool sites, unsigned threads, Store store) {
-  const size_t chunks = (src.size + kChunk - 1) / kChunk;
-  std::atomic<size_t> next{0}, firstBad{SIZE_MAX};
+// fn(first, count) for the chunks of `size` rays, handed out to `threads` threads (this one too).
+template <class Fn>
+void inChunks(size_t size, unsigned threads, Fn&& fn) {
+  const size_t chunks = (size + kChunk - 1) / kChunk;
+  std::atomic<size_t> next{0};
   auto work = [&] {
-    std::vector<Ray> rays(src.rows ? kChunk : 0);
-    std::vector<QueryHit> hits(kChunk);
-    std::vector<LookupSite> where(sites ? kChunk : 0);
-    std::vector<float> vis(visibility ? kChunk : 0);
-    for (size_t c; (c = next.fetch_add(1)) < chunks;) {
-      const size_t b = c * kChunk, n = std::min(kChunk, src.size - b);
-      std::optional<size_t> bad;
-      const std::span<const Ray> in = src.get(b, n, rays.data(), &bad);
-      if (bad) {
-        for (size_t was = firstBad.load(); *bad < was && !firstBad.compare_exchange_weak(was, *bad);) {
-        }
-        continue;
-      }
-      Answers a{std::span<const QueryHit>(hits.data(), n), std::span<const LookupSite>(where.data(), sites ? n : 0),
-                std::span<const float>(vis.data(), visibility ? n : 0), sites, visibility};
-      target.intersect(in, std::span(hits.data(), n), qo);
-      if (sites) target.sites(in, std::span(where.data(), n), qo);
-      if (visibility) target.visibility(in, std::span(vis.data(), n), qo);
-      store(b, a);
-    }
+    for (size_t c; (c = next.fetch_add(1)) < chunks;) fn(c * kChunk, std::min(kChunk, size - c * kChunk));
   };
   const unsigned n = std::max(1u, std::min<unsigned>(threads, unsigned(chunks)));
   std::vector<std::thread> pool;
   for (unsigned t = 1; t < n; ++t) pool.emplace_back(work);
   work();
   for (auto& t : pool) t.join();
+}
+
+// Answers the rays in chunks over `threads` threads; each chunk's answers go to store(first,
+// answers) from the thread that made them (the sites and visibilities only where `columns` have
+// them). A chunk holding a bad .npy row is not answered; the index of the first bad row is
+// returned.
+template <class Store>
+std::optional<size_t> answer(const Target& target, const RaySource& src, const QueryOptions& qo,
+                             std::span<const Column> columns, unsigned threads, Store store) {
+  const bool sites = needsSites(columns), visibility = hasColumn(columns, Column::kVisibility);
+  std::atomic<size_t> firstBad{SIZE_MAX};
+  inChunks(src.size, threads, [&](size_t b, size_t n) {
+    thread_local std::vector<Ray> rays;
+    thread_local std::vector<QueryHit> hits;
+    thread_local std::vector<LookupSite> where;
+    thread_local std::vector<float> vis;
+    rays.resize(src.rows ? n : 0), hits.resize(n), where.resize(sites ? n : 0), vis.resize(visibility ? n : 0);
+    std::optional<size_t> bad;
+    const std::span<const Ray> in = src.get(b, n, rays.data(), &bad);
+    if (bad) {
+      for (size_t was = firstBad.load(); *bad < was && !firstBad.compare_exchange_weak(was, *bad);) {
+      }
+      return;
+    }
+    target.intersect(in, hits, qo);
+    if (sites) target.sites(in, where, qo);
+    if (visibility) target.visibility(in, vis, qo);
+    store(b, Answers{hits, where, vis, columns});
+  });
   if (firstBad.load() != SIZE_MAX) return firstBad.load();
   return std::nullopt;
 }
@@ -249,7 +262,8 @@ int run(int argc, char** argv) {
       "\"direction\":[..],\"tmin\":..,\"tmax\":..} or [6 or 8 numbers]) from a file or standard input.\n"
       "A bad line is reported as FILE:LINE:COLUMN (exit 3) after the rays before it are answered.\n"
       "Output columns: hit,t,x,y,z,nx,ny,nz,inside,sample,i,j[,visibility] (a miss: t inf, point nan; no\n"
-      "normal: nan; sample, i, j: the map and texel that answered, -1 without a lookup; --no-sites: left out).\n\n"
+      "normal: nan; sample, i, j: the map and texel that answered, -1 without a lookup; --no-sites: left out;\n"
+      "--columns: those named, in that order).\n\n"
       "  vff-query field.vff --ray 0 0 5 0 0 -1\n"
       "  vff-query field.vff -i rays.npy -o hits.npy --interpolated\n",
       kProg};
@@ -348,8 +362,19 @@ int run(int argc, char** argv) {
   qo.intraBias = o.intraBias;
   const unsigned threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
   const Target target{&*q, inst};
-  const bool sites = !o.noSites;
-  const size_t cols = columnCount(sites, o.visibility);
+  std::vector<Column> columns = defaultColumns(!o.noSites, o.visibility);
+  if (!o.columns.empty()) {
+    if (auto bad = parseColumns(o.columns, &columns)) {
+      cli::usageError(kProg, "--columns: " + *bad);
+      return cli::kExitUsage;
+    }
+    if (format == OutputFormat::kJsonLines) {
+      cli::usageError(kProg, "--columns applies to csv and npy answers (JSON lines name their keys)");
+      return cli::kExitUsage;
+    }
+  }
+  const bool sites = needsSites(columns), visibility = hasColumn(columns, Column::kVisibility);
+  const size_t cols = columns.size();
   const auto t1 = std::chrono::steady_clock::now();
   std::optional<size_t> badRow;
   if (format == OutputFormat::kNpy && o.output != "-") {
@@ -364,7 +389,7 @@ int run(int argc, char** argv) {
       if (!failed.exchange(true)) writeError = st.error();  // (the first failure only)
     };
     if (Status st = out->writeAt(0, header); !st) failWith(st);
-    badRow = answer(target, src, qo, o.visibility, sites, threads, [&](size_t first, const Answers& a) {
+    badRow = answer(target, src, qo, columns, threads, [&](size_t first, const Answers& a) {
       if (failed) return;
       thread_local std::vector<float> rowBuffer;
       rowBuffer.resize(a.hits.size() * cols);
@@ -382,8 +407,8 @@ int run(int argc, char** argv) {
   } else {
     std::vector<QueryHit> hits(src.size);
     std::vector<LookupSite> where(sites ? src.size : 0);
-    std::vector<float> vis(o.visibility ? src.size : 0);
-    badRow = answer(target, src, qo, o.visibility, sites, threads, [&](size_t first, const Answers& a) {
+    std::vector<float> vis(visibility ? src.size : 0);
+    badRow = answer(target, src, qo, columns, threads, [&](size_t first, const Answers& a) {
       std::copy(a.hits.begin(), a.hits.end(), hits.begin() + ptrdiff_t(first));
       std::copy(a.sites.begin(), a.sites.end(), where.begin() + ptrdiff_t(first));
       std::copy(a.visibility.begin(), a.visibility.end(), vis.begin() + ptrdiff_t(first));
@@ -392,30 +417,40 @@ int run(int argc, char** argv) {
       cli::printError(kProg, label + ": " + badRowMessage(src, *badRow));
       return cli::kExitInvalidFile;
     }
-    const std::vector<uint8_t> out = formatAnswers({hits, where, vis, sites, o.visibility}, format);
+    const std::vector<uint8_t> out = formatAnswers({hits, where, vis, columns}, format);
     if (auto st = cli::writeFileAtomic(o.output, out); !st) return cli::reportError(kProg, "", st.error());
   }
   if (o.timing) {
     const auto t2 = std::chrono::steady_clock::now();
     auto sec = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
     const double n = double(src.size) / 1e6;
-    // The baseline the end-to-end rate compares with: the batch calls alone, as a library caller
-    // makes them, on the same rays already in memory as vff::Ray, warm (best of 3; the answers are
-    // dropped, the lookup sites not asked for).
+    // The baselines the end-to-end rate compares with, on the same rays already in memory as
+    // vff::Ray, warm (best of 3 each), over the same threads in the same chunks: the batch calls
+    // as a library caller makes them, every answer kept in an array of all of them; and the batch
+    // calls alone, each chunk's answers dropped (a bound no caller reaches: its answers never
+    // leave the cache). Intersect only: no lookup sites, no visibility.
     std::vector<Ray> held(src.rows ? src.size : 0);
     for (size_t i = 0; i < held.size(); ++i) held[i] = src.row(i);
-    RaySource warm{nullptr, 0, src.rows ? std::span<const Ray>(held) : src.rays, src.size, o.tmin, o.tmax};
-    double batch = 1e30;
+    const std::span<const Ray> warmRays = src.rows ? std::span<const Ray>(held) : src.rays;
+    const RaySource warm{nullptr, 0, warmRays, src.size, o.tmin, o.tmax};
+    std::vector<QueryHit> kept(src.size);
+    const Column hitColumns[] = {Column::kHit, Column::kT};
+    double batch = 1e30, keptBatch = 1e30;
     for (int r = 0; r < 3; ++r) {
-      const auto b0 = std::chrono::steady_clock::now();
-      answer(target, warm, qo, o.visibility, false, threads, [](size_t, const Answers&) {});
+      auto b0 = std::chrono::steady_clock::now();
+      inChunks(src.size, threads, [&](size_t first, size_t count) {
+        target.intersect(warmRays.subspan(first, count), std::span(kept).subspan(first, count), qo);
+      });
+      keptBatch = std::min(keptBatch, sec(b0, std::chrono::steady_clock::now()));
+      b0 = std::chrono::steady_clock::now();
+      answer(target, warm, qo, hitColumns, threads, [](size_t, const Answers&) {});
       batch = std::min(batch, sec(b0, std::chrono::steady_clock::now()));
     }
     std::fprintf(stderr,
                  "vff-query: timing: %zu rays, %u threads, %s: field %.4f s, read %.4f s, query and write %.4f s, total %.4f s "
-                 "(%.1f Mrays/s); batch alone, warm: %.4f s (%.1f Mrays/s)\n",
+                 "(%.1f Mrays/s); batch, answers kept, warm: %.4f s (%.1f Mrays/s); batch alone, warm: %.4f s (%.1f Mrays/s)\n",
                  src.size, threads, o.interpolated ? "interpolated" : "nearest", sec(tOpen, t0), sec(t0, t1), sec(t1, t2), sec(tOpen, t2),
-                 n / std::max(1e-9, sec(tOpen, t2)), batch, n / std::max(1e-9, batch));
+                 n / std::max(1e-9, sec(tOpen, t2)), keptBatch, n / std::max(1e-9, keptBatch), batch, n / std::max(1e-9, batch));
   }
   if (badInput) {
     cli::printError(kProg, *badInput);

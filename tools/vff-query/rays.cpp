@@ -122,6 +122,7 @@ void appendNumber(std::string& out, float v) {
 }  // namespace
 
 std::optional<std::pair<std::string, int>> checkRay(const Ray& ray) {
+  if (rayIsGood(ray)) return std::nullopt;
   const float v[6] = {ray.origin.x, ray.origin.y, ray.origin.z, ray.direction.x, ray.direction.y, ray.direction.z};
   for (int k = 0; k < 6; ++k)
     if (!std::isfinite(v[k])) return std::pair{std::string(k < 3 ? "the origin" : "the direction") + " is not finite", k};
@@ -163,37 +164,96 @@ ParsedRays parseRayLines(std::string_view text, float tmin, float tmax) {
   return out;
 }
 
-void answerRows(const Answers& a, float* rows) {
-  const bool vis = a.withVisibility, sites = a.withSites;
-  const size_t cols = columnCount(sites, vis);
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  for (size_t i = 0; i < a.hits.size(); ++i) {
-    const QueryHit& h = a.hits[i];
-    float* r = rows + i * cols;
-    r[0] = h.hit ? 1.0f : 0.0f;
-    r[1] = h.t;
-    r[2] = h.hit ? h.point.x : nan;
-    r[3] = h.hit ? h.point.y : nan;
-    r[4] = h.hit ? h.point.z : nan;
-    r[5] = h.hasNormal ? h.normal.x : nan;
-    r[6] = h.hasNormal ? h.normal.y : nan;
-    r[7] = h.hasNormal ? h.normal.z : nan;
-    r[8] = h.inside ? 1.0f : 0.0f;
-    if (sites) {
-      // (sample indices stay below 2^24, so float32 holds them exactly)
-      const LookupSite& s = a.sites[i];
-      r[9] = s.valid ? float(s.sample) : -1.0f;
-      r[10] = s.valid ? float(s.i) : -1.0f;
-      r[11] = s.valid ? float(s.j) : -1.0f;
+std::vector<Column> defaultColumns(bool sites, bool visibility) {
+  std::vector<Column> out;
+  for (int c = 0; c <= int(Column::kInside); ++c) out.push_back(Column(c));
+  if (sites) out.insert(out.end(), {Column::kSample, Column::kI, Column::kJ});
+  if (visibility) out.push_back(Column::kVisibility);
+  return out;
+}
+
+std::optional<std::string> parseColumns(std::string_view list, std::vector<Column>* out) {
+  out->clear();
+  size_t pos = 0;
+  while (true) {
+    const size_t comma = std::min(list.find(',', pos), list.size());
+    const std::string_view name = list.substr(pos, comma - pos);
+    int found = -1;
+    for (int c = 0; c < kAllColumns; ++c)
+      if (name == kColumns[c]) found = c;
+    if (found < 0) {
+      std::string known;
+      for (int c = 0; c < kAllColumns; ++c) known.append(c ? "," : "").append(kColumns[c]);
+      return "unknown column \"" + std::string(name) + "\" (the columns: " + known + ")";
     }
-    if (vis) r[cols - 1] = a.visibility[i];
+    if (hasColumn(*out, Column(found))) return "column \"" + std::string(name) + "\" named twice";
+    out->push_back(Column(found));
+    if (comma == list.size()) return std::nullopt;
+    pos = comma + 1;
+  }
+}
+
+namespace {
+
+// Every column's value of answer i as a .npy float (kColumns order).
+void rowValues(const Answers& a, size_t i, float* v) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const QueryHit& h = a.hits[i];
+  v[0] = h.hit ? 1.0f : 0.0f;
+  v[1] = h.t;
+  v[2] = h.hit ? h.point.x : nan;
+  v[3] = h.hit ? h.point.y : nan;
+  v[4] = h.hit ? h.point.z : nan;
+  v[5] = h.hasNormal ? h.normal.x : nan;
+  v[6] = h.hasNormal ? h.normal.y : nan;
+  v[7] = h.hasNormal ? h.normal.z : nan;
+  v[8] = h.inside ? 1.0f : 0.0f;
+  // (sample indices stay below 2^24, so float32 holds them exactly)
+  const LookupSite s = a.sites.empty() ? LookupSite{} : a.sites[i];
+  v[9] = s.valid ? float(s.sample) : -1.0f;
+  v[10] = s.valid ? float(s.i) : -1.0f;
+  v[11] = s.valid ? float(s.j) : -1.0f;
+  v[12] = a.visibility.empty() ? 1.0f : a.visibility[i];
+}
+
+// One CSV field of answer i.
+void appendCsv(std::string& out, const Answers& a, size_t i, Column c) {
+  const QueryHit& h = a.hits[i];
+  const LookupSite s = a.sites.empty() ? LookupSite{} : a.sites[i];
+  switch (c) {
+    case Column::kHit: out += h.hit ? '1' : '0'; return;
+    case Column::kT: h.hit ? appendNumber(out, h.t) : void(out += "inf"); return;
+    case Column::kX: h.hit ? appendNumber(out, h.point.x) : void(out += "nan"); return;
+    case Column::kY: h.hit ? appendNumber(out, h.point.y) : void(out += "nan"); return;
+    case Column::kZ: h.hit ? appendNumber(out, h.point.z) : void(out += "nan"); return;
+    case Column::kNx: h.hasNormal ? appendNumber(out, h.normal.x) : void(out += "nan"); return;
+    case Column::kNy: h.hasNormal ? appendNumber(out, h.normal.y) : void(out += "nan"); return;
+    case Column::kNz: h.hasNormal ? appendNumber(out, h.normal.z) : void(out += "nan"); return;
+    case Column::kInside: out += h.inside ? '1' : '0'; return;
+    case Column::kSample: out += s.valid ? std::to_string(s.sample) : "-1"; return;
+    case Column::kI: out += s.valid ? std::to_string(s.i) : "-1"; return;
+    case Column::kJ: out += s.valid ? std::to_string(s.j) : "-1"; return;
+    case Column::kVisibility: appendNumber(out, a.visibility.empty() ? 1.0f : a.visibility[i]); return;
+  }
+}
+
+}  // namespace
+
+void answerRows(const Answers& a, float* rows) {
+  const size_t cols = a.columns.size();
+  uint8_t pick[kAllColumns];
+  for (size_t c = 0; c < cols; ++c) pick[c] = uint8_t(a.columns[c]);
+  for (size_t i = 0; i < a.hits.size(); ++i) {
+    float v[kAllColumns];
+    rowValues(a, i, v);
+    float* r = rows + i * cols;
+    for (size_t c = 0; c < cols; ++c) r[c] = v[pick[c]];
   }
 }
 
 std::vector<uint8_t> formatAnswers(const Answers& a, OutputFormat format) {
-  const bool vis = a.withVisibility, sites = a.withSites;
+  const size_t cols = a.columns.size();
   if (format == OutputFormat::kNpy) {
-    const uint64_t cols = columnCount(sites, vis);
     std::vector<float> m(a.hits.size() * cols);
     answerRows(a, m.data());
     return npyMatrixBytes(m, a.hits.size(), cols);
@@ -201,58 +261,48 @@ std::vector<uint8_t> formatAnswers(const Answers& a, OutputFormat format) {
   std::string out;
   out.reserve(a.hits.size() * 80 + 80);
   if (format == OutputFormat::kCsv) {
-    for (int c = 0; c < kColumnCount - (sites ? 0 : kSiteColumns); ++c) out += c ? "," : "", out += kColumns[c];
-    out += vis ? ",visibility\n" : "\n";
+    for (size_t c = 0; c < cols; ++c) out += c ? "," : "", out += kColumns[int(a.columns[c])];
+    out += '\n';
+    for (size_t i = 0; i < a.hits.size(); ++i) {
+      for (size_t c = 0; c < cols; ++c) {
+        if (c) out += ',';
+        appendCsv(out, a, i, a.columns[c]);
+      }
+      out += '\n';
+    }
+    return {out.begin(), out.end()};
   }
+  const bool sites = needsSites(a.columns), vis = hasColumn(a.columns, Column::kVisibility);
   for (size_t i = 0; i < a.hits.size(); ++i) {
     const QueryHit& h = a.hits[i];
     const LookupSite s = sites ? a.sites[i] : LookupSite{};
-    if (format == OutputFormat::kCsv) {
-      out += h.hit ? "1," : "0,";
-      if (h.hit) {
-        appendNumber(out, h.t);
-        for (float v : {h.point.x, h.point.y, h.point.z}) out += ',', appendNumber(out, v);
-      } else {
-        out += "inf,nan,nan,nan";
-      }
-      if (h.hasNormal)
-        for (float v : {h.normal.x, h.normal.y, h.normal.z}) out += ',', appendNumber(out, v);
-      else
-        out += ",nan,nan,nan";
-      out += h.inside ? ",1" : ",0";
-      if (sites && s.valid)
-        out += ',' + std::to_string(s.sample) + ',' + std::to_string(s.i) + ',' + std::to_string(s.j);
-      else if (sites)
-        out += ",-1,-1,-1";
+    out += h.hit ? "{\"hit\":true,\"t\":" : "{\"hit\":false,\"t\":null";
+    if (h.hit) {
+      appendNumber(out, h.t);
+      out += ",\"point\":[";
+      appendNumber(out, h.point.x), out += ',', appendNumber(out, h.point.y), out += ',', appendNumber(out, h.point.z);
+      out += ']';
     } else {
-      out += h.hit ? "{\"hit\":true,\"t\":" : "{\"hit\":false,\"t\":null";
-      if (h.hit) {
-        appendNumber(out, h.t);
-        out += ",\"point\":[";
-        appendNumber(out, h.point.x), out += ',', appendNumber(out, h.point.y), out += ',', appendNumber(out, h.point.z);
-        out += ']';
-      } else {
-        out += ",\"point\":null";
-      }
-      if (h.hasNormal) {
-        out += ",\"normal\":[";
-        appendNumber(out, h.normal.x), out += ',', appendNumber(out, h.normal.y), out += ',', appendNumber(out, h.normal.z);
-        out += ']';
-      } else {
-        out += ",\"normal\":null";
-      }
-      out += h.inside ? ",\"inside\":true" : ",\"inside\":false";
-      if (sites && s.valid)
-        out += ",\"sample\":" + std::to_string(s.sample) + ",\"texel\":[" + std::to_string(s.i) + ',' +
-               std::to_string(s.j) + ']';
-      else if (sites)
-        out += ",\"sample\":null,\"texel\":null";
+      out += ",\"point\":null";
     }
+    if (h.hasNormal) {
+      out += ",\"normal\":[";
+      appendNumber(out, h.normal.x), out += ',', appendNumber(out, h.normal.y), out += ',', appendNumber(out, h.normal.z);
+      out += ']';
+    } else {
+      out += ",\"normal\":null";
+    }
+    out += h.inside ? ",\"inside\":true" : ",\"inside\":false";
+    if (sites && s.valid)
+      out += ",\"sample\":" + std::to_string(s.sample) + ",\"texel\":[" + std::to_string(s.i) + ',' +
+             std::to_string(s.j) + ']';
+    else if (sites)
+      out += ",\"sample\":null,\"texel\":null";
     if (vis) {
-      out += format == OutputFormat::kCsv ? "," : ",\"visibility\":";
+      out += ",\"visibility\":";
       appendNumber(out, a.visibility[i]);
     }
-    out += format == OutputFormat::kCsv ? "\n" : "}\n";
+    out += "}\n";
   }
   return {out.begin(), out.end()};
 }

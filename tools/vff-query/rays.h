@@ -8,6 +8,7 @@
 // "ox,oy,oz,dx,dy,dz[,tmin,tmax]". Rays without their own tmin/tmax take the command line's.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -37,37 +38,55 @@ ParsedRays parseRayLines(std::string_view text, float tmin, float tmax);
 // Checks one ray: finite origin and direction, a non-zero direction, tmin <= tmax, no NaN bound.
 // Returns the problem and the 0-based index of the number it concerns (0..7).
 std::optional<std::pair<std::string, int>> checkRay(const Ray& ray);
+// checkRay(ray) finds nothing: the test alone, inlined, for every row of a large input.
+inline bool rayIsGood(const Ray& ray) {
+  const float v[6] = {ray.origin.x, ray.origin.y, ray.origin.z, ray.direction.x, ray.direction.y, ray.direction.z};
+  bool finite = true;
+  for (float x : v) finite &= std::isfinite(x);
+  return finite && (v[3] != 0 || v[4] != 0 || v[5] != 0) && ray.tmin <= ray.tmax;  // (false for a NaN bound)
+}
 
-// The columns of every answer, in order (CSV header, .npy columns): the hit, then which map
-// (positional sample) and texel (i, j) of it answered (vff::LookupSite; -1 where the ray made no
-// lookup).
-inline constexpr const char* kColumns[] = {"hit", "t", "x", "y", "z", "nx", "ny", "nz", "inside", "sample", "i", "j"};
-inline constexpr int kColumnCount = 12;
-inline constexpr int kSiteColumns = 3;  // sample, i, j: left out when the sites are not asked for
+// The columns an answer can have (CSV header, .npy columns): the hit, then which map (positional
+// sample) and texel (i, j) of it answered (vff::LookupSite; -1 where the ray made no lookup), then
+// the visibility (0..1). By default all but the visibility, in this order.
+enum class Column : uint8_t { kHit, kT, kX, kY, kZ, kNx, kNy, kNz, kInside, kSample, kI, kJ, kVisibility };
+inline constexpr const char* kColumns[] = {"hit", "t",      "x", "y", "z", "nx", "ny", "nz", "inside",
+                                           "sample", "i", "j", "visibility"};
+inline constexpr int kAllColumns = 13;
+
+// The default columns: every one but the visibility, without sample, i, j when !sites, and with the
+// visibility last when asked for.
+std::vector<Column> defaultColumns(bool sites, bool visibility);
+// The columns of a comma-separated list of their names (any order, each at most once), or the
+// problem with the list.
+std::optional<std::string> parseColumns(std::string_view list, std::vector<Column>* out);
+inline bool hasColumn(std::span<const Column> columns, Column c) {
+  for (Column x : columns)
+    if (x == c) return true;
+  return false;
+}
+// Whether the columns need the lookup sites (sample, i or j).
+inline bool needsSites(std::span<const Column> columns) {
+  return hasColumn(columns, Column::kSample) || hasColumn(columns, Column::kI) || hasColumn(columns, Column::kJ);
+}
 
 enum class OutputFormat { kCsv, kJsonLines, kNpy };
 
-// The answers to a run of rays: one hit per ray, one site per ray and one visibility per ray when
-// asked for (else empty).
+// The answers to a run of rays: one hit per ray, one site per ray when the columns need them
+// (needsSites) and one visibility per ray when they have it (else empty).
 struct Answers {
   std::span<const QueryHit> hits;
   std::span<const LookupSite> sites;
   std::span<const float> visibility;
-  bool withSites = true;         // the columns sample, i, j (sites holds one per ray)
-  bool withVisibility = false;   // the column visibility (visibility holds one per ray)
+  std::span<const Column> columns;  // the output's, in order
 };
 
-// The .npy rows of answers: kColumnCount floats per ray (hit and inside as 0/1, NaN where there is
-// no point or normal, sample and texel exact as floats, -1 without a lookup; without sites those
-// three columns are left out), and visibility last when asked for.
+// The .npy rows of answers: a float per column per ray (hit and inside as 0/1, t inf for a miss,
+// NaN where there is no point or normal, sample and texel exact as floats, -1 without a lookup).
 void answerRows(const Answers& a, float* rows);
-// The number of those columns.
-inline size_t columnCount(bool sites, bool visibility) {
-  return size_t(kColumnCount - (sites ? 0 : kSiteColumns) + (visibility ? 1 : 0));
-}
 
-// The answers as one output document (CSV with a header line, JSON lines, or .npy). With
-// visibility, a last column "visibility".
+// The answers as one output document: CSV with a header line or .npy, of the answers' columns, or
+// JSON lines (always every key but the sites without them and the visibility without it).
 std::vector<uint8_t> formatAnswers(const Answers& a, OutputFormat format);
 
 }  // namespace vff::query_tool
