@@ -10,6 +10,8 @@ test_outputs_match_plain_bake() { case_outputs_match_plain_bake; }
 test_rerun_bakes_nothing() { case_rerun_bakes_nothing; }
 test_changed_option_rebakes_only_affected() { case_changed_option_rebakes_only_affected; }
 test_sharded_bake_merges_to_whole() { case_sharded_bake_merges_to_whole; }
+test_split_scene_matches_plain_bake() { case_split_scene_matches_plain_bake; }
+test_split_rerun_bakes_nothing() { case_split_rerun_bakes_nothing; }
 
 test_killed_pool_loses_nothing_and_resumes() {
   make_library "$WORK/lib" shared
