@@ -116,4 +116,31 @@ test_manifest_errors() {
   expect_rc 1
 }
 
+test_split_entry_errors() {
+  mkdir -p "$WORK/lib"
+  "$MESHGEN" box "$WORK/lib/a.obj"
+  "$MESHGEN" --gltf-scene "$WORK/lib/s.gltf"
+  echo '{"vffLibrary": 1, "entries": [{"mesh": "s.gltf", "split": "triangles"}]}' >"$WORK/lib/m.json"
+  run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields"
+  expect_rc 3
+  expect_err "entries[0].split: must be \"mesh\" or \"node\""
+  echo '{"vffLibrary": 1, "entries": [{"mesh": "s.gltf", "split": "mesh", "output": "s.vff"}]}' >"$WORK/lib/m.json"
+  run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields"
+  expect_rc 3
+  expect_err "output \"s.vff\" of a split entry must name its scene description (.json)"
+  # vff-bake refuses --split for a mesh that is not glTF: that entry fails (usage), the other bakes.
+  echo '{"vffLibrary": 1, "defaults": {"count": 2, "map-size": 8},
+         "entries": [{"mesh": "a.obj", "split": "mesh"}, {"mesh": "s.gltf", "split": "node", "options": {"scene": 5}, "output": "five.json"},
+                     {"mesh": "s.gltf", "split": "mesh"}]}' >"$WORK/lib/m.json"
+  run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields" --json "$WORK/report.json"
+  expect_rc 1
+  expect_err "a.obj: options: --split applies to a glTF input"
+  expect_err "there is no scene 5"
+  [[ $(json '[f["exitCode"] for f in r["failed"]]') == "[1, 1]" ]] || { show; fail "both refusals: exit 1"; }
+  [[ -s $WORK/fields/s.vffscene.json && ! -e $WORK/fields/a.vffscene.json ]] || fail "outputs: $(ls "$WORK/fields")"
+  run "$VFF_LIBRARY" bake "$WORK/lib" --out "$WORK/fields" -- -m 8 --split mesh
+  expect_rc 1
+  expect_err "--split names a scene description per entry: give it in a manifest"
+}
+
 run_test "$1"

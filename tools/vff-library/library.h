@@ -1,6 +1,7 @@
 // library.h - what vff-library's parts share: the entries of a library (manifest.cpp), their cache
-// keys and the cache itself (cache.cpp), baking an entry into the cache with vff-bake (worker.cpp),
-// the local pool (pool.cpp), Slurm job arrays (slurm.cpp) and the report (report.cpp).
+// keys and the cache itself (cache.cpp; split glTF scenes: scene_cache.cpp), baking an entry into
+// the cache with vff-bake (worker.cpp), the local pool (pool.cpp), Slurm job arrays (slurm.cpp) and
+// the report (report.cpp).
 #pragma once
 
 #include <nlohmann/json.hpp>

@@ -7,7 +7,8 @@
 //   vff-library bake library.json --out fields/ --cache /shared/vff-cache --slurm --partition cpu --max-running 50
 //   vff-library run-shard PLAN TASK                          one array task (what the batch script runs)
 //
-// manifest.cpp reads the entries, cache.cpp keys and stores them, worker.cpp runs vff-bake for one,
+// manifest.cpp reads the entries, cache.cpp keys and stores them (scene_cache.cpp: split glTF
+// scenes), worker.cpp runs vff-bake for one,
 // pool.cpp and slurm.cpp run many, report.cpp tells what happened (library.h).
 #include <unistd.h>
 
