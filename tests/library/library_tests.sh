@@ -116,6 +116,39 @@ test_manifest_errors() {
   expect_rc 1
 }
 
+# A pool killed while a split scene is baked (its files all written in the private folder, not yet
+# in the cache) leaves no field and no description at the outputs; the next run completes the scene.
+test_killed_split_bake_leaves_no_partial_scene() {
+  mkdir -p "$WORK/lib"
+  "$MESHGEN" --gltf-scene "$WORK/lib/s.gltf"
+  echo '{"vffLibrary": 1, "defaults": {"count": 2, "map-size": 8}, "entries": [{"mesh": "s.gltf", "split": "mesh"}]}' \
+    >"$WORK/lib/library.json"
+  cat >"$WORK/held-bake.sh" <<EOS
+#!/usr/bin/env bash
+"$VFF_BAKE" "\$@" || exit
+touch "$WORK/baked"
+for i in \$(seq 600); do sleep 0.1; done  # the kill ends this; a bound keeps a lost one finite
+EOS
+  chmod +x "$WORK/held-bake.sh"
+  VFF_BAKE="$WORK/held-bake.sh" "$VFF_LIBRARY" bake "$WORK/lib/library.json" --out "$WORK/fields" -q >/dev/null 2>&1 &
+  local pid=$! i
+  for i in $(seq 600); do
+    [[ -e $WORK/baked ]] && break
+    sleep 0.05
+  done
+  [[ -e $WORK/baked ]] || fail "the held bake never finished"
+  [[ -n $(find "$WORK/fields/.vff-cache/tmp" -name 's.mesh0.vff') ]] || fail "the scene is not in the private folder"
+  kill -9 $pid
+  wait $pid || true
+  [[ -z $(find "$WORK/fields" -maxdepth 1 -name 's.*') ]] || fail "a killed split bake left outputs: $(ls "$WORK/fields")"
+  [[ -z $(find "$WORK/fields/.vff-cache" -name '*.scene') ]] || fail "a killed split bake entered the cache"
+  lib_bake "$WORK/lib/library.json"
+  expect_rc 0
+  [[ $(json 'len(r["baked"])') == 1 ]] || { show; fail "the next run did not bake the scene"; }
+  expect_split_matches_plain_bake mesh s.vffscene.json -n 2 -m 8
+  [[ -z $(ls -A "$WORK/fields/.vff-cache/tmp") ]] || fail "the killed run's private folder was not removed"
+}
+
 test_split_entry_errors() {
   mkdir -p "$WORK/lib"
   "$MESHGEN" box "$WORK/lib/a.obj"
