@@ -2,7 +2,8 @@
 # library_tests.sh - vff-library with the local pool (cases library.*): every output byte-identical to
 # a plain vff-bake of its entry, a re-run bakes nothing, a changed option re-bakes only what it
 # affects, a killed pool loses nothing and the next run completes it, the broken entry reported while
-# the others finish; manifests, dry runs and the Slurm batch script (printed, not submitted).
+# the others finish; glTF scenes split per object (split entries); manifests, dry runs and the Slurm
+# batch script (printed, not submitted).
 MODE=local
 source "$(dirname "${BASH_SOURCE[0]}")/library_harness.sh"
 
