@@ -161,8 +161,18 @@ int runScene(const Options& o) {
     (void)fields.add(&objects[k]->query, {});
   }
   // The distance-field peer (sdf_field.h): each object's at its field's memory.
+  // An object too small for a distance field leaves the distance-field part out for all of them,
+  // as --no-sdf does: a frame with some objects missing would compare nothing.
+  bool withSdf = o.sdf;
+  for (uint32_t k = 0; withSdf && k < count; ++k)
+    if (const uint64_t bytes = objects[k]->query.payloadBytes(); bytes < kSdfMinBudget) {
+      std::fprintf(stderr, "%s: scene: note: no distance-field rows: %s's field has %llu bytes, under the %llu a distance grid needs\n",
+                   kProg, objects[k]->name.c_str(), static_cast<unsigned long long>(bytes),
+                   static_cast<unsigned long long>(kSdfMinBudget));
+      withSdf = false;
+    }
   std::vector<SdfField> sdfs;
-  for (uint32_t k = 0; o.sdf && k < count; ++k) {
+  for (uint32_t k = 0; withSdf && k < count; ++k) {
     auto sdf = SdfField::build(objects[k]->mesh, {.budgetBytes = objects[k]->query.payloadBytes(), .values = o.sdfValues, .bandVoxels = o.sdfBand});
     if (!sdf) return vff::cli::reportError(kProg, objects[k]->name, sdf.error());
     sdfs.push_back(std::move(*sdf));

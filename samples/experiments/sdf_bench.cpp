@@ -80,6 +80,14 @@ int runSdfBench(const Options& o) {
       auto field = bakeQuery(world, *(*setup)->scene, config, false, threads);
       if (!field) return vff::cli::reportError(kProg, path, field.error());
       const vff::Instance& instance = (*field)->instance;
+      // Every row compares the field with its distance field: a field too small for one has no row
+      // here (the image experiments leave out their distance-field rows instead).
+      if (const uint64_t bytes = (*field)->query.payloadBytes(); bytes < kSdfMinBudget) {
+        vff::cli::usageError(kProg, "sdf-bench: " + baseName(path) + " " + config.name() + ": the field's " +
+                                        std::to_string(bytes) + " bytes are under the " + std::to_string(kSdfMinBudget) +
+                                        " a distance grid needs; choose a larger --config or --sdf-memory");
+        return vff::cli::kExitUsage;
+      }
       auto built = SdfField::build(world.objectMesh, {.budgetBytes = (*field)->query.payloadBytes(), .values = o.sdfValues, .bandVoxels = o.sdfBand});
       if (!built) return vff::cli::reportError(kProg, path, built.error());
       SdfField& sdf = *built;

@@ -117,6 +117,31 @@ case "$case" in
     awk -F'|' '/^\| (knot|bowl)\.obj/ { if ($7 + 0 <= 0 || $8 + 0 <= 0 || $9 + 0 <= 0 || $11 + 0 >= 50 || $12 + 0 >= 50) bad = 1 }
                END { exit bad }' stdout.txt || { cat stdout.txt; fail "sdf-bench: implausible figures"; }
     ;;
+  small_fields_leave_out_the_distance_field)
+    # A field under kSdfMinBudget (sdf_field.h) has no distance field beside it: the image
+    # experiments and `scene` leave the distance-field rows out with a note and finish; scene-bench
+    # has none; sdf-bench, all of whose rows compare the two, refuses with a usage error.
+    tiny=(--mesh knot.obj --config 10x4x4 -j 2)
+    "$exp" ao "${tiny[@]}" --size 16 --rays 2 -o ao >stdout.txt 2>stderr.txt || { cat stderr.txt; fail "ao on a tiny field failed"; }
+    grep -q "note: no distance-field rows for 10x4x4: its 160 bytes are under the 4096" stderr.txt \
+      || { cat stderr.txt; fail "ao: no note about the distance field"; }
+    ! grep -q "^| distance field" stdout.txt || { cat stdout.txt; fail "ao: a distance-field row for a tiny field"; }
+    "$exp" scene "${tiny[@]}" --size 16 --rays 2 --frames 1 -o sc >stdout.txt 2>stderr.txt \
+      || { cat stderr.txt; fail "scene on tiny fields failed"; }
+    grep -q "scene: note: no distance-field rows: .* has 160 bytes, under the 4096" stderr.txt \
+      || { cat stderr.txt; fail "scene: no note about the distance fields"; }
+    [ "$(grep -cE '^\| 0 \|' sc/scene-table.md)" -eq 1 ] || { cat sc/scene-table.md; fail "scene: no row for the frame"; }
+    ! grep -q "distance fields" sc/scene-table.md || { cat sc/scene-table.md; fail "scene: distance-field rows"; }
+    [ ! -e sc/scene-f0-sdf.png ] || fail "scene: a distance-field image for tiny fields"
+    "$exp" scene-bench "${tiny[@]}" --instances 1 3 --scene-rays 300 --frames 1 >stdout.txt 2>stderr.txt \
+      || { cat stderr.txt; fail "scene-bench on tiny fields failed"; }
+    [ "$(grep -cE '^\| [0-9]+ \|' stdout.txt)" -eq 2 ] || { cat stdout.txt; fail "scene-bench: not one row per count"; }
+    "$exp" sdf-bench "${tiny[@]}" --bench-rays 2000 --repeat 1 >stdout.txt 2>stderr.txt
+    rc=$?
+    [ "$rc" -eq 1 ] || { cat stderr.txt; fail "sdf-bench on a tiny field: exit $rc, expected 1 (usage)"; }
+    grep -q "vff-experiments: error: sdf-bench: knot.obj 10x4x4: the field's 160 bytes are under the 4096 a distance grid needs" \
+      stderr.txt || { cat stderr.txt; fail "sdf-bench: the error names no minimum"; }
+    ;;
   images_do_not_depend_on_threads)
     "$exp" ao "${small[@]}" --rays 8 -j 1 -o one >/dev/null 2>&1 || fail "ao -j 1 failed"
     "$exp" ao "${small[@]}" --rays 8 -j 2 -o two >/dev/null 2>&1 || fail "ao -j 2 failed"

@@ -15,6 +15,8 @@ test_outputs_match_plain_bake() { case_outputs_match_plain_bake; }
 test_rerun_submits_nothing() { case_rerun_bakes_nothing; }
 test_changed_option_rebakes_only_affected() { case_changed_option_rebakes_only_affected; }
 test_sharded_bake_merges_to_whole() { case_sharded_bake_merges_to_whole; }
+test_split_scene_matches_plain_bake() { case_split_scene_matches_plain_bake; }
+test_split_rerun_submits_nothing() { case_split_rerun_bakes_nothing; }
 
 # cancel_task_1 RETRIES: bakes the library (shared meshes too) as two array tasks, one at a time,
 # and cancels task 1 while it runs; the run's exit code in RC, its report in $WORK/report.json.

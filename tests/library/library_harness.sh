@@ -137,3 +137,97 @@ JSON
   lib_bake "$WORK/lib/library.json"
   [[ $(json 'len(r["upToDate"])') == 2 ]] || fail "the merged field is not the whole bake's cache entry"
 }
+
+# Split entries (vff-bake --split): a glTF scene as a field per object and a scene description,
+# cached and installed as one unit (spec/library.md section 6).
+# write_split_manifest: lib/s.gltf (vff-procedural-mesh's sample scene) split by mesh and by node,
+# box.obj, and a broken glTF split by mesh.
+write_split_manifest() {
+  mkdir -p "$WORK/lib"
+  [[ -e $WORK/lib/s.gltf ]] || "$MESHGEN" --gltf-scene "$WORK/lib/s.gltf" || fail "vff-procedural-mesh --gltf-scene"
+  "$MESHGEN" box "$WORK/lib/box.obj"
+  printf '{"asset": {"version": "2.0"}, "meshes": [' >"$WORK/lib/broken.gltf"
+  cat >"$WORK/lib/library.json" <<JSON
+{"vffLibrary": 1, "defaults": {"count": 2, "map-size": 8},
+ "entries": [{"mesh": "s.gltf", "split": "mesh"},
+             {"mesh": "s.gltf", "split": "node", "output": "nodes/s-nodes.json", "options": {"map-size": ${1:-8}}},
+             {"mesh": "box.obj"}, {"mesh": "broken.gltf", "split": "mesh"}]}
+JSON
+}
+
+# expect_split_matches_plain_bake SPLIT OUTPUT OPTS...: vff-bake --split SPLIT of lib/s.gltf to a
+# scratch folder writes the files of fields/OUTPUT (its description and its fields) byte for byte.
+expect_split_matches_plain_bake() {
+  local split=$1 out=$2 f n=0
+  shift 2
+  rm -rf "$WORK/plain" && mkdir -p "$WORK/plain"
+  "$VFF_BAKE" "$WORK/lib/s.gltf" --split "$split" -o "$WORK/plain/$(basename "$out")" -q "$@" || fail "plain vff-bake --split"
+  for f in "$WORK"/plain/*; do
+    cmp "$f" "$WORK/fields/$(dirname "$out")/$(basename "$f")" || fail "$(basename "$f") differs from a plain vff-bake --split $split"
+    n=$((n + 1))
+  done
+  [[ $n -ge 3 ]] || fail "vff-bake --split $split wrote $n files"
+}
+
+case_split_scene_matches_plain_bake() {
+  write_split_manifest
+  if [[ -n ${SCHEMA_CHECK:-} ]]; then
+    "$SCHEMA_CHECK" "$SCHEMA" "$WORK/lib/library.json" || fail "a manifest with split entries does not match the schema"
+  fi
+  lib_bake "$WORK/lib/library.json"
+  expect_rc 3  # the broken glTF's exit code, as vff-bake --split gives it
+  "$VFF_BAKE" "$WORK/lib/broken.gltf" --split mesh -o "$WORK/x.json" -q 2>/dev/null && fail "vff-bake took the broken glTF"
+  [[ $(json 'r["failed"][0]["exitCode"]') == 3 ]] || fail "the broken glTF's exit code"
+  [[ $(json '[f["mesh"] for f in r["failed"]]') == "['broken.gltf']" ]] || { show; fail "broken.gltf not reported"; }
+  expect_err "mesh-parse (10002)"
+  [[ $(json 'sorted(b["mesh"] for b in r["baked"])') == "['box.obj', 's.gltf', 's.gltf']" ]] || { show; fail "baked"; }
+  expect_split_matches_plain_bake mesh s.vffscene.json -n 2 -m 8
+  expect_split_matches_plain_bake node nodes/s-nodes.json -n 2 -m 8
+  expect_matches_plain_bake box -n 2 -m 8
+  [[ ! -e $WORK/fields/broken.vffscene.json && -z $(find "$WORK/fields" -maxdepth 1 -name 'broken*') ]] \
+    || fail "an output for the broken glTF"
+  [[ -z $(find "$WORK/fields" -name '*.tmp*') ]] || fail "temporaries left"
+  # The rays of every field of a scene: 3 node fields, 2 mesh fields, the box, 2(2*2^2+2*2+1) = 26
+  # maps of 8x8 each.
+  [[ $(json 'r["rays"]') == $(((3 + 2 + 1) * 26 * 64)) ]] || fail "rays: $(json 'r["rays"]')"
+  if [[ -n ${SCHEMA_CHECK:-} ]]; then
+    "$SCHEMA_CHECK" "$(dirname "$SCHEMA")/scene-schema.json" "$WORK/fields/s.vffscene.json" \
+      || fail "the installed scene description does not match the schema"
+  fi
+}
+
+case_split_rerun_bakes_nothing() {
+  write_split_manifest
+  lib_bake "$WORK/lib/library.json"
+  expect_rc 3
+  local before
+  before=$(stat -c '%i %Y' "$WORK"/fields/s.* "$WORK"/fields/nodes/*)
+  lib_bake "$WORK/lib/library.json"
+  expect_rc 3
+  [[ $(json 'len(r["baked"])') == 0 ]] || { show; fail "a re-run baked something"; }
+  [[ $(json 'len(r["upToDate"])') == 3 ]] || fail "not every entry up to date"
+  [[ $(json 'r.get("slurmJobs", [])') == "[]" ]] || fail "a re-run submitted a job"
+  [[ $(stat -c '%i %Y' "$WORK"/fields/s.* "$WORK"/fields/nodes/*) == "$before" ]] || fail "outputs were rewritten"
+  # A removed field of a scene comes back from the cache, without a bake.
+  rm "$WORK/fields/s.mesh1.node3.vff"
+  lib_bake "$WORK/lib/library.json"
+  [[ $(json 'len(r["baked"])') == 0 ]] || fail "a removed field was baked again"
+  expect_split_matches_plain_bake mesh s.vffscene.json -n 2 -m 8
+  # A changed option re-bakes its scene only.
+  write_split_manifest 12
+  lib_bake "$WORK/lib/library.json"
+  [[ $(json '[b["output"] for b in r["baked"]]') == "['$WORK/fields/nodes/s-nodes.json']" ]] || { show; fail "only the node split re-baked"; }
+  expect_split_matches_plain_bake node nodes/s-nodes.json -n 2 -m 12
+  # A changed object (the stretched knot stretched further) re-bakes both scenes, not the box.
+  python3 - "$WORK/lib/s.gltf" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+next(n for n in d["nodes"] if n.get("name") == "knotStretched")["scale"] = [1.0, 3.0, 1.0]
+json.dump(d, open(sys.argv[1], "w"))
+PY
+  lib_bake "$WORK/lib/library.json"
+  [[ $(json 'sorted(b["mesh"] for b in r["baked"])') == "['s.gltf', 's.gltf']" ]] || { show; fail "both scenes re-baked"; }
+  [[ $(json '[u["mesh"] for u in r["upToDate"]]') == "['box.obj']" ]] || fail "box.obj up to date"
+  expect_split_matches_plain_bake mesh s.vffscene.json -n 2 -m 8
+  expect_split_matches_plain_bake node nodes/s-nodes.json -n 2 -m 12
+}

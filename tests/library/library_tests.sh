@@ -2,7 +2,8 @@
 # library_tests.sh - vff-library with the local pool (cases library.*): every output byte-identical to
 # a plain vff-bake of its entry, a re-run bakes nothing, a changed option re-bakes only what it
 # affects, a killed pool loses nothing and the next run completes it, the broken entry reported while
-# the others finish; manifests, dry runs and the Slurm batch script (printed, not submitted).
+# the others finish; glTF scenes split per object (split entries); manifests, dry runs and the Slurm
+# batch script (printed, not submitted).
 MODE=local
 source "$(dirname "${BASH_SOURCE[0]}")/library_harness.sh"
 
@@ -10,6 +11,8 @@ test_outputs_match_plain_bake() { case_outputs_match_plain_bake; }
 test_rerun_bakes_nothing() { case_rerun_bakes_nothing; }
 test_changed_option_rebakes_only_affected() { case_changed_option_rebakes_only_affected; }
 test_sharded_bake_merges_to_whole() { case_sharded_bake_merges_to_whole; }
+test_split_scene_matches_plain_bake() { case_split_scene_matches_plain_bake; }
+test_split_rerun_bakes_nothing() { case_split_rerun_bakes_nothing; }
 
 test_killed_pool_loses_nothing_and_resumes() {
   make_library "$WORK/lib" shared
@@ -112,6 +115,66 @@ test_manifest_errors() {
   expect_err "a.obj: options: --map-size"
   run "$VFF_LIBRARY" bake "$WORK/lib" --out "$WORK/fields" --no-such-option
   expect_rc 1
+}
+
+# A pool killed while a split scene is baked (its files all written in the private folder, not yet
+# in the cache) leaves no field and no description at the outputs; the next run completes the scene.
+test_killed_split_bake_leaves_no_partial_scene() {
+  mkdir -p "$WORK/lib"
+  "$MESHGEN" --gltf-scene "$WORK/lib/s.gltf"
+  echo '{"vffLibrary": 1, "defaults": {"count": 2, "map-size": 8}, "entries": [{"mesh": "s.gltf", "split": "mesh"}]}' \
+    >"$WORK/lib/library.json"
+  cat >"$WORK/held-bake.sh" <<EOS
+#!/usr/bin/env bash
+"$VFF_BAKE" "\$@" || exit
+touch "$WORK/baked"
+for i in \$(seq 600); do sleep 0.1; done  # the kill ends this; a bound keeps a lost one finite
+EOS
+  chmod +x "$WORK/held-bake.sh"
+  VFF_BAKE="$WORK/held-bake.sh" "$VFF_LIBRARY" bake "$WORK/lib/library.json" --out "$WORK/fields" -q >/dev/null 2>&1 &
+  local pid=$! i
+  for i in $(seq 600); do
+    [[ -e $WORK/baked ]] && break
+    sleep 0.05
+  done
+  [[ -e $WORK/baked ]] || fail "the held bake never finished"
+  [[ -n $(find "$WORK/fields/.vff-cache/tmp" -name 's.mesh0.vff') ]] || fail "the scene is not in the private folder"
+  kill -9 $pid
+  wait $pid || true
+  [[ -z $(find "$WORK/fields" -maxdepth 1 -name 's.*') ]] || fail "a killed split bake left outputs: $(ls "$WORK/fields")"
+  [[ -z $(find "$WORK/fields/.vff-cache" -name '*.scene') ]] || fail "a killed split bake entered the cache"
+  lib_bake "$WORK/lib/library.json"
+  expect_rc 0
+  [[ $(json 'len(r["baked"])') == 1 ]] || { show; fail "the next run did not bake the scene"; }
+  expect_split_matches_plain_bake mesh s.vffscene.json -n 2 -m 8
+  [[ -z $(ls -A "$WORK/fields/.vff-cache/tmp") ]] || fail "the killed run's private folder was not removed"
+}
+
+test_split_entry_errors() {
+  mkdir -p "$WORK/lib"
+  "$MESHGEN" box "$WORK/lib/a.obj"
+  "$MESHGEN" --gltf-scene "$WORK/lib/s.gltf"
+  echo '{"vffLibrary": 1, "entries": [{"mesh": "s.gltf", "split": "triangles"}]}' >"$WORK/lib/m.json"
+  run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields"
+  expect_rc 3
+  expect_err "entries[0].split: must be \"mesh\" or \"node\""
+  echo '{"vffLibrary": 1, "entries": [{"mesh": "s.gltf", "split": "mesh", "output": "s.vff"}]}' >"$WORK/lib/m.json"
+  run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields"
+  expect_rc 3
+  expect_err "output \"s.vff\" of a split entry must name its scene description (.json)"
+  # vff-bake refuses --split for a mesh that is not glTF: that entry fails (usage), the other bakes.
+  echo '{"vffLibrary": 1, "defaults": {"count": 2, "map-size": 8},
+         "entries": [{"mesh": "a.obj", "split": "mesh"}, {"mesh": "s.gltf", "split": "node", "options": {"scene": 5}, "output": "five.json"},
+                     {"mesh": "s.gltf", "split": "mesh"}]}' >"$WORK/lib/m.json"
+  run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields" --json "$WORK/report.json"
+  expect_rc 1
+  expect_err "a.obj: options: --split applies to a glTF input"
+  expect_err "there is no scene 5"
+  [[ $(json '[f["exitCode"] for f in r["failed"]]') == "[1, 1]" ]] || { show; fail "both refusals: exit 1"; }
+  [[ -s $WORK/fields/s.vffscene.json && ! -e $WORK/fields/a.vffscene.json ]] || fail "outputs: $(ls "$WORK/fields")"
+  run "$VFF_LIBRARY" bake "$WORK/lib" --out "$WORK/fields" -- -m 8 --split mesh
+  expect_rc 1
+  expect_err "--split names a scene description per entry: give it in a manifest"
 }
 
 run_test "$1"

@@ -56,7 +56,7 @@ std::optional<std::string> canonicalOptions(const Entry& e, bake_tool::Options* 
   bake_tool::addOptions(app, *o);
   std::vector<std::string> argv = {"vff-bake", e.mesh};
   argv.insert(argv.end(), e.args.begin(), e.args.end());
-  argv.insert(argv.end(), {"-o", "library.vff"});
+  argv.insert(argv.end(), {"-o", e.split.empty() ? "library.vff" : "library.vffscene.json"});
   std::vector<std::string> rev(argv.rbegin(), argv.rend() - 1);
   try {
     app.parse(rev);
@@ -90,6 +90,7 @@ std::optional<std::string> canonicalOptions(const Entry& e, bake_tool::Options* 
                   double(bo.sphere->center[2]), double(bo.sphere->radius));
     c["sphere"] = s;
   }
+  if (!o->split.empty()) c["split"] = o->split;  // absent for one field: the keys of earlier runs hold
   return c.dump();
 }
 
@@ -104,22 +105,31 @@ std::optional<std::string> meshGeometry(const Entry& e, const bake_tool::Options
   if (c.statNotes && ::stat(e.mesh.c_str(), &st) == 0) {
     const std::string id = e.mesh + "\n" + std::to_string(st.st_dev) + " " + std::to_string(st.st_ino) + " " +
                            std::to_string(st.st_size) + " " + std::to_string(st.st_mtim.tv_sec) + "." +
-                           std::to_string(st.st_mtim.tv_nsec) + "\nscene " + std::to_string(o.scene);
+                           std::to_string(st.st_mtim.tv_nsec) + "\nscene " + std::to_string(o.scene) +
+                           (e.split.empty() ? "" : "\nsplit " + e.split);
     const std::string key = hex128(XXH3_128bits(id.data(), id.size()));
     note = c.dir + "/sources/" + key.substr(0, 2) + "/" + key + ".txt";
     std::ifstream in(note, std::ios::binary);
     std::string line;
     if (in && std::getline(in, line) && line.rfind("mesh ", 0) == 0) return line;
   }
-  bake::MeshInfo info;
-  auto mesh = bake::loadMesh(e.mesh, &info, {.gltfScene = o.scene});
-  if (!mesh) {
-    *error = mesh.error();
-    return std::nullopt;
+  std::string geometry;
+  if (!e.split.empty()) {
+    uint64_t objects = 0;
+    auto g = splitGeometry(e, o.scene, error, &objects);
+    if (!g) return std::nullopt;
+    geometry = *g;
+  } else {
+    bake::MeshInfo info;
+    auto mesh = bake::loadMesh(e.mesh, &info, {.gltfScene = o.scene});
+    if (!mesh) {
+      *error = mesh.error();
+      return std::nullopt;
+    }
+    geometry = "mesh " + info.format + " " + cli::hexDigits64(bake::geometryHash(*mesh)) + " " +
+               cli::hexDigits64(bake::meshHash(*mesh)) + " " + std::to_string(mesh->droppedDegenerate) + " " +
+               std::to_string(info.gltfScene);
   }
-  const std::string geometry = "mesh " + info.format + " " + cli::hexDigits64(bake::geometryHash(*mesh)) + " " +
-                               cli::hexDigits64(bake::meshHash(*mesh)) + " " + std::to_string(mesh->droppedDegenerate) +
-                               " " + std::to_string(info.gltfScene);
   if (!note.empty()) {
     std::error_code ec;
     fs::create_directories(fs::path(note).parent_path(), ec);
@@ -154,17 +164,21 @@ void computeKey(Entry& e, const CacheOptions& c) {
     geometry = *g;
   } else {
     e.error = cli::formatDiagnostic("vff-bake", "error", e.mesh, err);
-    e.exitCode = cli::exitCodeFor(err.code);
+    // As vff-bake: a --scene the file does not have is a usage error.
+    e.exitCode = err.code == Code::kInvalidArgument ? cli::kExitUsage : cli::exitCodeFor(err.code);
     return;
   }
   const bake::BakeOptions bo = bake_tool::bakeOptions(o);
   if (auto maps = positionCount(bo.positionScheme, bo.positionParam)) {
     e.maps = *maps;
     e.rays = uint64_t(*maps) * bo.mapResolution * bo.mapResolution;
+    if (!e.split.empty()) e.rays *= splitObjects(geometry);
   }
   const std::string text = std::string("vff-library key 1\nbaker vff-bake ") + kLibraryVersion + "\nformat " +
                            std::to_string(kVersionMajor) + "\nsource " + fs::path(e.mesh).filename().string() +
-                           "\ngeometry " + geometry + "\noptions " + *options + "\n";
+                           "\ngeometry " + geometry + "\noptions " + *options + "\n" +
+                           // The description names its fields after its own file name.
+                           (e.split.empty() ? "" : "output " + fs::path(e.output).filename().string() + "\n");
   e.key = hex128(XXH3_128bits(text.data(), text.size()));
 }
 
@@ -197,25 +211,35 @@ std::string partPath(const std::string& cacheDir, const std::string& key, uint32
          ".vff";
 }
 
-bool inCache(const std::string& cacheDir, const std::string& key) {
+bool inCache(const std::string& cacheDir, const Entry& e) {
   struct stat st{};
-  return ::stat(cachePath(cacheDir, key).c_str(), &st) == 0 && S_ISREG(st.st_mode);
+  if (!e.split.empty()) return ::stat(sceneCachePath(cacheDir, e.key).c_str(), &st) == 0 && S_ISDIR(st.st_mode);
+  return ::stat(cachePath(cacheDir, e.key).c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
-bool outputUpToDate(const std::string& cacheDir, const Entry& e) {
+bool sameFile(const std::string& from, const std::string& to) {
   struct stat c{}, o{};
-  if (::stat(cachePath(cacheDir, e.key).c_str(), &c) != 0 || ::stat(e.output.c_str(), &o) != 0) return false;
+  if (::stat(from.c_str(), &c) != 0 || ::stat(to.c_str(), &o) != 0) return false;
   if (c.st_dev == o.st_dev && c.st_ino == o.st_ino) return true;
   return c.st_size == o.st_size && c.st_mtim.tv_sec == o.st_mtim.tv_sec && c.st_mtim.tv_nsec == o.st_mtim.tv_nsec;
 }
 
+bool outputUpToDate(const std::string& cacheDir, const Entry& e) {
+  if (!e.split.empty()) return sceneUpToDate(cacheDir, e);
+  return sameFile(cachePath(cacheDir, e.key), e.output);
+}
+
 std::optional<std::string> installOutput(const std::string& cacheDir, const Entry& e) {
-  const std::string from = cachePath(cacheDir, e.key);
+  if (!e.split.empty()) return installScene(cacheDir, e);
+  return installFile(cachePath(cacheDir, e.key), e.output);
+}
+
+std::optional<std::string> installFile(const std::string& from, const std::string& output) {
   std::error_code ec;
-  fs::create_directories(fs::path(e.output).parent_path(), ec);
-  if (ec) return fs::path(e.output).parent_path().string() + ": " + ec.message();
+  fs::create_directories(fs::path(output).parent_path(), ec);
+  if (ec) return fs::path(output).parent_path().string() + ": " + ec.message();
   static std::atomic<unsigned> counter{0};
-  const std::string tmp = fs::path(e.output).parent_path().string() + "/." + fs::path(e.output).filename().string() +
+  const std::string tmp = fs::path(output).parent_path().string() + "/." + fs::path(output).filename().string() +
                           ".tmp-" + std::to_string(getpid()) + "-" + std::to_string(counter++);
   if (::link(from.c_str(), tmp.c_str()) != 0) {
     if (errno != EXDEV && errno != EPERM) return tmp + ": " + std::strerror(errno);
@@ -228,13 +252,13 @@ std::optional<std::string> installOutput(const std::string& cacheDir, const Entr
     }
     if (ec) {
       ::unlink(tmp.c_str());
-      return e.output + ": " + ec.message();
+      return output + ": " + ec.message();
     }
   }
-  if (::rename(tmp.c_str(), e.output.c_str()) != 0) {
+  if (::rename(tmp.c_str(), output.c_str()) != 0) {
     const std::string why = std::strerror(errno);
     ::unlink(tmp.c_str());
-    return e.output + ": " + why;
+    return output + ": " + why;
   }
   return std::nullopt;
 }

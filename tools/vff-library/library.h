@@ -1,9 +1,12 @@
 // library.h - what vff-library's parts share: the entries of a library (manifest.cpp), their cache
-// keys and the cache itself (cache.cpp), baking an entry into the cache with vff-bake (worker.cpp),
-// the local pool (pool.cpp), Slurm job arrays (slurm.cpp) and the report (report.cpp).
+// keys and the cache itself (cache.cpp; split glTF scenes: scene_cache.cpp), baking an entry into
+// the cache with vff-bake (worker.cpp), the local pool (pool.cpp), Slurm job arrays (slurm.cpp) and
+// the report (report.cpp).
 #pragma once
 
 #include <nlohmann/json.hpp>
+
+#include "vff/error.h"
 
 #include <cstdint>
 #include <optional>
@@ -15,19 +18,22 @@ namespace vff::library {
 inline constexpr const char* kProg = "vff-library";
 
 // ---- Entries (manifest.cpp) ---------------------------------------------------------------------
-// One field to bake: a mesh, the vff-bake options that shape its bytes, and where it goes.
+// One field to bake: a mesh, the vff-bake options that shape its bytes, and where it goes. A split
+// entry (a glTF scene baked as a field per object, vff-bake --split) is a scene description and its
+// fields instead, cached and installed as one unit (scene_cache.cpp).
 struct Entry {
   std::string mesh;               // the input file, absolute
   std::string name;               // how the report names it (the path as the manifest or folder gives it)
   std::vector<std::string> args;  // vff-bake options, as vff-bake spells them (no -o, -j, --json)
-  std::string output;             // the output file, absolute
+  std::string output;             // the output file, absolute (a split entry's: its scene description)
+  std::string split;              // "mesh" or "node": vff-bake --split (also in args); "": one field
   uint64_t shardMaps = 0;         // above this many maps, bake in map ranges (0: never)
   // Filled by computeKeys (cache.cpp):
   std::string key;    // 32 hex digits; empty when the entry cannot be baked (error says why)
   std::string error;  // a problem found before baking (unreadable mesh, bad option)
   int exitCode = 0;   // vff-bake's exit code for `error`
-  uint64_t rays = 0;  // the rays its field has (maps x M x M)
-  uint64_t maps = 0;
+  uint64_t rays = 0;  // the rays its field has (maps x M x M), a split entry's all its fields'
+  uint64_t maps = 0;  // of one field
 };
 
 // Reads a manifest (spec/library.md) into entries; outputs under `outDir`. A problem of the
@@ -53,14 +59,33 @@ void computeKeys(std::vector<Entry>& entries, const CacheOptions& o);
 std::string cachePath(const std::string& cacheDir, const std::string& key);
 // CACHE/ab/KEY.maps-BEGIN-END.vff: a partial result of maps [begin, end) (vff-bake --map-range).
 std::string partPath(const std::string& cacheDir, const std::string& key, uint32_t begin, uint32_t end);
-// The entry's field is in the cache.
-bool inCache(const std::string& cacheDir, const std::string& key);
+// The entry's field (a split entry's scene) is in the cache.
+bool inCache(const std::string& cacheDir, const Entry& e);
 // The entry's output is the cached field: the same file (a hard link) or a copy of it with its size
-// and modification time.
+// and modification time. A split entry's: its description and every field it names.
 bool outputUpToDate(const std::string& cacheDir, const Entry& e);
 // Puts the cached field at the entry's output, by a hard link, or a copy when the output is on
-// another filesystem, through a temporary and a rename. An error message, or nothing.
+// another filesystem, through a temporary and a rename (a split entry: its fields, then its
+// description). An error message, or nothing.
 std::optional<std::string> installOutput(const std::string& cacheDir, const Entry& e);
+// Puts the file `from` at `to` as installOutput does.
+std::optional<std::string> installFile(const std::string& from, const std::string& to);
+// `to` is the file `from`, or a copy of it with its size and modification time.
+bool sameFile(const std::string& from, const std::string& to);
+
+// ---- Split entries in the cache (scene_cache.cpp) -----------------------------------------------
+// CACHE/ab/KEY.scene/: a split entry's scene description (named as its output) and its fields, as
+// vff-bake --split wrote them; it enters the cache by one rename of the whole folder.
+std::string sceneCachePath(const std::string& cacheDir, const std::string& key);
+// What a split bake reads of a glTF file as one line (beginning "mesh "): the file's bytes and each
+// object's geometry; *objects: how many fields it gives. Nothing, with *error, when it cannot be read.
+std::optional<std::string> splitGeometry(const Entry& e, int scene, Error* error, uint64_t* objects);
+// The object count a line of splitGeometry records (0 when it records none).
+uint64_t splitObjects(const std::string& geometry);
+// The files of a cached scene, relative to its folder: its fields, then its description.
+std::optional<std::vector<std::string>> sceneFiles(const std::string& cacheDir, const Entry& e);
+bool sceneUpToDate(const std::string& cacheDir, const Entry& e);
+std::optional<std::string> installScene(const std::string& cacheDir, const Entry& e);
 // A fresh private folder under CACHE/tmp for one bake (named by host, process and a counter, so
 // processes on several machines never share one).
 std::string makePrivateDir(const std::string& cacheDir);

@@ -7,7 +7,8 @@
 //   vff-library bake library.json --out fields/ --cache /shared/vff-cache --slurm --partition cpu --max-running 50
 //   vff-library run-shard PLAN TASK                          one array task (what the batch script runs)
 //
-// manifest.cpp reads the entries, cache.cpp keys and stores them, worker.cpp runs vff-bake for one,
+// manifest.cpp reads the entries, cache.cpp keys and stores them (scene_cache.cpp: split glTF
+// scenes), worker.cpp runs vff-bake for one,
 // pool.cpp and slurm.cpp run many, report.cpp tells what happened (library.h).
 #include <unistd.h>
 
@@ -84,6 +85,10 @@ int bakeLibrary(const Options& o) {
   std::vector<Entry> entries;
   std::error_code ec;
   if (fs::is_directory(o.input, ec)) {
+    if (std::find(o.bakeArgs.begin(), o.bakeArgs.end(), "--split") != o.bakeArgs.end()) {
+      cli::usageError(kProg, "--split names a scene description per entry: give it in a manifest (\"split\": \"mesh\")");
+      return cli::kExitUsage;
+    }
     if (auto p = readFolder(o.input, o.glob, o.bakeArgs, o.out, &entries)) {
       cli::printError(kProg, *p);
       return cli::kExitIo;
@@ -128,7 +133,7 @@ int bakeLibrary(const Options& o) {
     const Entry& e = entries[i];
     if (!e.error.empty()) {
       report.failed.push_back(i);
-    } else if (inCache(wo.cacheDir, e.key)) {
+    } else if (inCache(wo.cacheDir, e)) {
       if (!outputUpToDate(wo.cacheDir, e) && !o.dryRun)
         if (auto p = installOutput(wo.cacheDir, e)) {
           entries[i].error = *p;
@@ -170,6 +175,9 @@ int bakeLibrary(const Options& o) {
         if (u.part())
           std::printf(" --map-range %u:%u -o %s -j %u  # part of %s\n", u.begin, u.end,
                       partPath(wo.cacheDir, e.key, u.begin, u.end).c_str(), wo.threads, e.output.c_str());
+        else if (!e.split.empty())
+          std::printf(" -o %s/%s -j %u  # -> %s and its fields\n", sceneCachePath(wo.cacheDir, e.key).c_str(),
+                      fs::path(e.output).filename().c_str(), wo.threads, e.output.c_str());
         else
           std::printf(" -o %s -j %u  # -> %s\n", cachePath(wo.cacheDir, e.key).c_str(), wo.threads, e.output.c_str());
       }

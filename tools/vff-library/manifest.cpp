@@ -104,7 +104,8 @@ std::optional<std::string> readManifest(const std::string& path, const std::stri
     const std::string where = path + ": entries[" + std::to_string(i++) + "]";
     if (!j.is_object() || !j.contains("mesh") || !j["mesh"].is_string()) return where + ": needs \"mesh\" (a path)";
     for (const auto& [k, v] : j.items())
-      if (k != "mesh" && k != "options" && k != "output" && k != "shardMaps") return where + ": unknown field \"" + k + "\"";
+      if (k != "mesh" && k != "options" && k != "output" && k != "shardMaps" && k != "split")
+        return where + ": unknown field \"" + k + "\"";
     Entry e;
     e.name = j["mesh"].get<std::string>();
     const fs::path mesh = fs::path(e.name).is_absolute() ? fs::path(e.name) : base / e.name;
@@ -116,12 +117,23 @@ std::optional<std::string> readManifest(const std::string& path, const std::stri
       for (const auto& [k, v] : j["options"].items()) options[k] = v;
     }
     if (auto p = appendOptions(options, where + ".options", &e.args)) return p;
-    const std::string rel = j.contains("output") ? j["output"].get<std::string>()
-                                                 : expandPattern(pattern, fs::path(e.name).is_absolute()
-                                                                              ? fs::path(e.name).filename()
-                                                                              : fs::path(e.name));
+    if (j.contains("split")) {
+      if (!j["split"].is_string() || (j["split"] != "mesh" && j["split"] != "node"))
+        return where + ".split: must be \"mesh\" or \"node\" (vff-bake --split)";
+      e.split = j["split"].get<std::string>();
+      e.args.insert(e.args.end(), {"--split", e.split});
+    }
+    std::string rel = j.contains("output") ? j["output"].get<std::string>()
+                                           : expandPattern(pattern, fs::path(e.name).is_absolute()
+                                                                        ? fs::path(e.name).filename()
+                                                                        : fs::path(e.name));
+    // A split entry's output is its scene description: the pattern's ".vff" becomes ".vffscene.json".
+    if (!e.split.empty() && !j.contains("output") && rel.size() > 4 && rel.compare(rel.size() - 4, 4, ".vff") == 0)
+      rel = rel.substr(0, rel.size() - 4) + ".vffscene.json";
     if (rel.empty() || fs::path(rel).is_absolute() || rel.find("..") != std::string::npos)
       return where + ": output \"" + rel + "\" must be a relative path inside the output folder";
+    if (!e.split.empty() && (rel.size() < 5 || rel.compare(rel.size() - 5, 5, ".json") != 0))
+      return where + ": output \"" + rel + "\" of a split entry must name its scene description (.json)";
     e.output = (fs::absolute(fs::path(outDir)) / rel).lexically_normal().string();
     if (!outputs.insert(e.output).second) return where + ": output \"" + rel + "\" is named by an earlier entry too";
     e.shardMaps = j.value("shardMaps", shardDefault);

@@ -26,7 +26,8 @@ std::vector<Unit> allParts(const Entry& e, size_t index) {
   return parts;
 }
 
-bool sharded(const Entry& e) { return e.shardMaps > 0 && e.maps > e.shardMaps; }
+// A split entry is one vff-bake --split, which bakes no map ranges: never sharded.
+bool sharded(const Entry& e) { return e.split.empty() && e.shardMaps > 0 && e.maps > e.shardMaps; }
 
 }  // namespace
 

@@ -52,6 +52,7 @@ nlohmann::json makePlan(const std::vector<Entry>& entries, const std::vector<Uni
     const Entry& e = entries[order[i].entry];
     plan["entries"].push_back({{"index", order[i].entry}, {"begin", order[i].begin}, {"end", order[i].end},
                                {"task", i % tasks}, {"key", e.key}, {"mesh", e.mesh}, {"args", e.args},
+                               {"split", e.split}, {"output", e.output},
                                {"rays", unitRays(entries, order[i])}});
   }
   return plan;
@@ -91,7 +92,7 @@ std::optional<std::string> runSlurm(const std::vector<Entry>& entries, const std
   // A unit's file in the cache: the entry's field, or its part.
   auto cached = [&](const Unit& u) {
     const Entry& e = entries[u.entry];
-    if (!u.part()) return inCache(wo.cacheDir, e.key);
+    if (!u.part()) return inCache(wo.cacheDir, e);
     struct stat st{};
     return ::stat(partPath(wo.cacheDir, e.key, u.begin, u.end).c_str(), &st) == 0;
   };
@@ -213,10 +214,12 @@ int runShard(const std::string& planPath, unsigned task) {
     e.key = j.value("key", std::string());
     e.mesh = j.value("mesh", std::string());
     e.args = j.value("args", std::vector<std::string>{});
+    e.split = j.value("split", std::string());
+    e.output = j.value("output", std::string());
     const Unit u{0, j.value("begin", 0u), j.value("end", 0u)};
     BakeResult r;
     struct stat st{};
-    if (::stat((u.part() ? partPath(wo.cacheDir, e.key, u.begin, u.end) : cachePath(wo.cacheDir, e.key)).c_str(), &st) == 0) {
+    if (u.part() ? ::stat(partPath(wo.cacheDir, e.key, u.begin, u.end).c_str(), &st) == 0 : inCache(wo.cacheDir, e)) {
       r.ok = true;  // an earlier or concurrent task baked it
     } else {
       r = bakeUnit(e, u, wo);

@@ -3,6 +3,7 @@
 // point leaves at most a private folder, which the next run on that machine removes.
 #include <fcntl.h>
 #include <sys/prctl.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -74,22 +75,36 @@ int runProcess(const std::vector<std::string>& args, const std::string& out, con
 namespace {
 
 // Runs vff-bake with `args` (and -o DIR/NAME) in a private folder; on success moves the file to
-// `to` in the cache.
-BakeResult runVffBake(std::vector<std::string> args, const std::string& to, const WorkerOptions& o) {
+// `to` in the cache. A scene (`sceneName`: its description's file name): -o DIR/scene/NAME, and the
+// folder DIR/scene, description and fields, is moved to `to`.
+BakeResult runVffBake(std::vector<std::string> args, const std::string& to, const WorkerOptions& o,
+                      const std::string& sceneName = "") {
   BakeResult r;
   const auto t0 = std::chrono::steady_clock::now();
   const std::string dir = makePrivateDir(o.cacheDir);
-  const std::string file = dir + "/" + fs::path(to).filename().string();
-  args.insert(args.end(), {"-o", file});
+  std::string file = dir + "/" + fs::path(to).filename().string();
+  if (!sceneName.empty()) {
+    std::error_code ec;
+    fs::create_directories(dir + "/scene", ec);
+    file = dir + "/scene";
+    args.insert(args.end(), {"-o", file + "/" + sceneName});
+  } else {
+    args.insert(args.end(), {"-o", file});
+  }
   const int rc = runProcess(args, dir + "/stdout.json", dir + "/stderr.txt");
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.exitCode = rc;
   if (rc == 0) {
     auto summary = nlohmann::json::parse(readText(dir + "/stdout.json"), nullptr, false);
     if (!summary.is_discarded()) r.rays = summary.value("rays", uint64_t{0});
+    if (!summary.is_discarded() && summary.contains("fields") && summary["fields"].is_array())  // a scene
+      for (const auto& f : summary["fields"]) r.rays += f.value("rays", uint64_t{0});
     std::error_code ec;
     fs::create_directories(fs::path(to).parent_path(), ec);
-    if (::rename(file.c_str(), to.c_str()) != 0) {
+    struct stat st{};
+    if (::rename(file.c_str(), to.c_str()) != 0 &&
+        // A folder cannot replace another: a racing writer put the same scene there first.
+        !(!sceneName.empty() && (errno == ENOTEMPTY || errno == EEXIST) && ::stat(to.c_str(), &st) == 0)) {
       const std::string problem = to + ": " + std::strerror(errno);
       r.error = problem;
       r.exitCode = cli::kExitIo;
@@ -115,6 +130,8 @@ BakeResult bakeUnit(const Entry& e, const Unit& u, const WorkerOptions& o) {
   std::vector<std::string> args = {o.vffBake, e.mesh};
   args.insert(args.end(), e.args.begin(), e.args.end());
   args.insert(args.end(), {"-j", std::to_string(o.threads), "--json", "-q"});
+  if (!e.split.empty())
+    return runVffBake(args, sceneCachePath(o.cacheDir, e.key), o, fs::path(e.output).filename().string());
   if (!u.part()) return runVffBake(args, cachePath(o.cacheDir, e.key), o);
   args.insert(args.end(), {"--map-range", std::to_string(u.begin) + ":" + std::to_string(u.end)});
   return runVffBake(args, partPath(o.cacheDir, e.key, u.begin, u.end), o);
