@@ -81,7 +81,8 @@ int answer(int argc, char** argv) {
     sites.push_back(inst ? inst->site(r, qo) : q->site(r, qo));
     if (visibility) vis.push_back(inst ? inst->visibility(r, qo) : q->visibility(r, qo));
   }
-  const auto out = vff::query_tool::formatAnswers({hits, sites, vis, true, visibility}, vff::query_tool::OutputFormat::kCsv);
+  const std::vector<vff::query_tool::Column> columns = vff::query_tool::defaultColumns(true, visibility);
+  const auto out = vff::query_tool::formatAnswers({hits, sites, vis, columns}, vff::query_tool::OutputFormat::kCsv);
   std::fwrite(out.data(), 1, out.size(), stdout);
   return 0;
 }
