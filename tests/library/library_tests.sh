@@ -117,6 +117,48 @@ test_manifest_errors() {
   expect_rc 1
 }
 
+# A .gltf whose buffer is a file of its own: a changed buffer is a changed entry, though the .gltf
+# itself (path, size, time) is not (the source notes of an up-to-date run also name its files).
+test_gltf_external_buffer_change_rebakes() {
+  mkdir -p "$WORK/lib"
+  "$MESHGEN" --gltf-scene "$WORK/lib/s.gltf"
+  python3 - "$WORK/lib/s.gltf" <<'PY'
+import base64, json, sys
+path = sys.argv[1]
+d = json.load(open(path))
+assert len(d["buffers"]) == 1 and d["buffers"][0]["uri"].startswith("data:"), d["buffers"]
+open(path[:-5] + " data.bin", "wb").write(base64.b64decode(d["buffers"][0]["uri"].split(",", 1)[1]))
+d["buffers"][0]["uri"] = "s%20data.bin"
+json.dump(d, open(path, "w"))
+PY
+  echo '{"vffLibrary": 1, "defaults": {"count": 2, "map-size": 8}, "entries": [{"mesh": "s.gltf", "split": "mesh"}]}' \
+    >"$WORK/lib/library.json"
+  lib_bake "$WORK/lib/library.json"
+  expect_rc 0
+  lib_bake "$WORK/lib/library.json"
+  [[ $(json 'len(r["upToDate"])') == 1 ]] || { show; fail "an unchanged scene was not up to date"; }
+  expect_split_matches_plain_bake mesh s.vffscene.json -n 2 -m 8
+  # The positions doubled in the buffer file; the .gltf stays as it was.
+  python3 - "$WORK/lib/s data.bin" "$WORK/lib/s.gltf" <<'PY'
+import json, struct, sys
+d = json.load(open(sys.argv[2]))
+pos = [a for m in d["meshes"] for p in m["primitives"] for k, a in p["attributes"].items() if k == "POSITION"]
+raw = bytearray(open(sys.argv[1], "rb").read())
+for a in pos:
+    acc = d["accessors"][a]
+    view = d["bufferViews"][acc["bufferView"]]
+    start = view.get("byteOffset", 0) + acc.get("byteOffset", 0)
+    for i in range(acc["count"] * 3):
+        o = start + 4 * i
+        raw[o:o + 4] = struct.pack("<f", 2 * struct.unpack("<f", raw[o:o + 4])[0])
+open(sys.argv[1], "wb").write(raw)
+PY
+  lib_bake "$WORK/lib/library.json"
+  expect_rc 0
+  [[ $(json 'len(r["baked"])') == 1 ]] || { show; fail "a changed buffer did not re-bake the scene"; }
+  expect_split_matches_plain_bake mesh s.vffscene.json -n 2 -m 8
+}
+
 # A pool killed while a split scene is baked (its files all written in the private folder, not yet
 # in the cache) leaves no field and no description at the outputs; the next run completes the scene.
 test_killed_split_bake_leaves_no_partial_scene() {

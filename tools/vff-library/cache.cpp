@@ -8,11 +8,14 @@
 #include <xxhash.h>
 
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <thread>
+
+#include <nlohmann/json.hpp>
 
 #include "../vff-bake/bake.h"
 #include "cli.h"
@@ -94,19 +97,59 @@ std::optional<std::string> canonicalOptions(const Entry& e, bake_tool::Options* 
   return c.dump();
 }
 
+// A file's identity for the notes below: device, inode, size and modification time in nanoseconds.
+std::optional<std::string> statLine(const std::string& path) {
+  struct stat st{};
+  if (::stat(path.c_str(), &st) != 0) return std::nullopt;
+  return std::to_string(st.st_dev) + " " + std::to_string(st.st_ino) + " " + std::to_string(st.st_size) + " " +
+         std::to_string(st.st_mtim.tv_sec) + "." + std::to_string(st.st_mtim.tv_nsec);
+}
+
+// The identities of the files a .gltf reads besides itself (its buffers and images not inlined as
+// data: URIs), one line each; nothing for other formats. None when the .gltf cannot be read as
+// JSON or a file it names is missing: the entry is then read anew (and the bake says what is wrong).
+std::optional<std::string> referencedFiles(const std::string& mesh) {
+  if (fs::path(mesh).extension() != ".gltf") return std::string();
+  std::ifstream in(mesh, std::ios::binary);
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return std::nullopt;
+  std::string out;
+  for (const char* list : {"buffers", "images"}) {
+    if (!j.contains(list) || !j[list].is_array()) continue;
+    for (const auto& item : j[list]) {
+      if (!item.is_object() || !item.contains("uri") || !item["uri"].is_string()) continue;
+      const std::string uri = item["uri"].get<std::string>();
+      if (uri.rfind("data:", 0) == 0) continue;
+      std::string path;  // percent-decoded, relative to the .gltf
+      for (size_t i = 0; i < uri.size(); ++i) {
+        if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit(uint8_t(uri[i + 1])) && std::isxdigit(uint8_t(uri[i + 2]))) {
+          path += char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
+          i += 2;
+        } else {
+          path += uri[i];
+        }
+      }
+      const std::string full = (fs::path(mesh).parent_path() / path).string();
+      const auto id = statLine(full);
+      if (!id) return std::nullopt;
+      out += "\n" + full + " " + *id;
+    }
+  }
+  return out;
+}
+
 // What the bake reads of a mesh and records of it, as one line; read from the mesh, or from the
 // note CACHE/sources/ab/ID.txt an earlier run left for the same file (path, device, inode, size and
-// modification time in nanoseconds unchanged), so that an up-to-date run reads no mesh.
-// *error: why the mesh could not be read.
+// modification time in nanoseconds unchanged, and those of the files a .gltf names), so that an
+// up-to-date run reads no mesh. *error: why the mesh could not be read.
 std::optional<std::string> meshGeometry(const Entry& e, const bake_tool::Options& o, const CacheOptions& c,
                                         Error* error) {
-  struct stat st{};
   std::string note;
-  if (c.statNotes && ::stat(e.mesh.c_str(), &st) == 0) {
-    const std::string id = e.mesh + "\n" + std::to_string(st.st_dev) + " " + std::to_string(st.st_ino) + " " +
-                           std::to_string(st.st_size) + " " + std::to_string(st.st_mtim.tv_sec) + "." +
-                           std::to_string(st.st_mtim.tv_nsec) + "\nscene " + std::to_string(o.scene) +
-                           (e.split.empty() ? "" : "\nsplit " + e.split);
+  const auto self = c.statNotes ? statLine(e.mesh) : std::nullopt;
+  const auto others = self ? referencedFiles(e.mesh) : std::nullopt;
+  if (self && others) {
+    const std::string id = e.mesh + "\n" + *self + "\nscene " + std::to_string(o.scene) +
+                           (e.split.empty() ? "" : "\nsplit " + e.split) + *others;
     const std::string key = hex128(XXH3_128bits(id.data(), id.size()));
     note = c.dir + "/sources/" + key.substr(0, 2) + "/" + key + ".txt";
     std::ifstream in(note, std::ios::binary);
