@@ -36,7 +36,8 @@ std::string hex128(XXH128_hash_t h) {
   return s;
 }
 
-// XXH3-128 of a file's bytes (level sets: their voxels are what vff-bake reads).
+}  // namespace
+
 std::optional<std::string> fileHash(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return std::nullopt;
@@ -51,6 +52,8 @@ std::optional<std::string> fileHash(const std::string& path) {
   XXH3_freeState(s);
   return hex128(h);
 }
+
+namespace {
 
 // The options as vff-bake resolves them (its own parser), one canonical line: two spellings of
 // the same bake (a default given or left out, -m or --map-size) share a key.

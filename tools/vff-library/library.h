@@ -53,6 +53,9 @@ struct CacheOptions {
   bool statNotes = true;  // reuse what an earlier run read of an unchanged file (cache.cpp)
 };
 
+// XXH3-128 of a file's bytes, as hex (level sets and glTF scenes: what vff-bake reads of them);
+// nothing when it cannot be read.
+std::optional<std::string> fileHash(const std::string& path);
 // Reads every entry's mesh and options and sets its key (or its error), in parallel.
 void computeKeys(std::vector<Entry>& entries, const CacheOptions& o);
 // CACHE/ab/KEY.vff

@@ -21,33 +21,6 @@ namespace fs = std::filesystem;
 
 namespace vff::library {
 
-namespace {
-
-std::string hex128(XXH128_hash_t h) {
-  char s[33];
-  std::snprintf(s, sizeof s, "%016llx%016llx", static_cast<unsigned long long>(h.high64),
-                static_cast<unsigned long long>(h.low64));
-  return s;
-}
-
-// XXH3-128 of a file's bytes; nothing when it cannot be read.
-std::optional<std::string> bytesHash(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return std::nullopt;
-  XXH3_state_t* s = XXH3_createState();
-  XXH3_128bits_reset(s);
-  std::vector<char> buf(1 << 20);
-  while (in) {
-    in.read(buf.data(), std::streamsize(buf.size()));
-    XXH3_128bits_update(s, buf.data(), size_t(in.gcount()));
-  }
-  const XXH128_hash_t h = XXH3_128bits_digest(s);
-  XXH3_freeState(s);
-  return hex128(h);
-}
-
-}  // namespace
-
 std::string sceneCachePath(const std::string& cacheDir, const std::string& key) {
   return cacheDir + "/" + key.substr(0, 2) + "/" + key + ".scene";
 }
@@ -62,7 +35,7 @@ std::optional<std::string> splitGeometry(const Entry& e, int scene, Error* error
   }
   // The file's bytes hold the placements and names the description records (a .gltf's buffers
   // are in each object's hashes).
-  auto bytes = bytesHash(e.mesh);
+  auto bytes = fileHash(e.mesh);
   if (!bytes) {
     *error = Error{Code::kIoRead, 0, kNoOffset, "cannot be read"};
     return std::nullopt;
