@@ -1,6 +1,7 @@
 // cli.cpp - the shared command-line helpers (see cli.h).
 #include "cli.h"
 
+#include <algorithm>
 #include <new>
 #include <stdexcept>
 #include <utility>
@@ -190,17 +191,24 @@ std::string hex64(uint64_t value) {
 }
 
 Result<std::vector<uint8_t>> readStdin() {
+  // Read straight into the vector, sized up front when standard input is a file (a redirection):
+  // through a small buffer, every growth of the vector copied and faulted in the bytes again.
   std::vector<uint8_t> bytes;
-  uint8_t buf[1 << 16];
+  struct stat st {};
+  size_t room = size_t(1) << 20;
+  if (::fstat(STDIN_FILENO, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) room = size_t(st.st_size) + 1;
+  size_t used = 0;
   for (;;) {
-    const ssize_t n = ::read(STDIN_FILENO, buf, sizeof buf);
+    if (used == bytes.size()) bytes.resize(std::max(bytes.size() * 2, used + room));
+    const ssize_t n = ::read(STDIN_FILENO, bytes.data() + used, bytes.size() - used);
     if (n == 0) break;
     if (n < 0) {
       if (errno == EINTR) continue;
       return makeError(Code::kIoRead, std::string("standard input: ") + std::strerror(errno));
     }
-    bytes.insert(bytes.end(), buf, buf + n);
+    used += size_t(n);
   }
+  bytes.resize(used);
   return bytes;
 }
 

@@ -170,9 +170,14 @@ struct RaySource {
 
   Ray row(size_t i) const {
     float r[8];
-    std::memcpy(r, rows + i * cols * sizeof(float), cols * sizeof(float));  // (any alignment)
-    return cols == 8 ? Ray{{r[0], r[1], r[2]}, {r[3], r[4], r[5]}, r[6], r[7]}
-                     : Ray{{r[0], r[1], r[2]}, {r[3], r[4], r[5]}, tmin, tmax};
+    const uint8_t* p = rows + i * cols * sizeof(float);
+    // (memcpy: any alignment; of a constant size, so that it compiles to plain loads)
+    if (cols == 8) {
+      std::memcpy(r, p, 8 * sizeof(float));
+      return Ray{{r[0], r[1], r[2]}, {r[3], r[4], r[5]}, r[6], r[7]};
+    }
+    std::memcpy(r, p, 6 * sizeof(float));
+    return Ray{{r[0], r[1], r[2]}, {r[3], r[4], r[5]}, tmin, tmax};
   }
   // Rays [first, first + count) into `out` (unless read already: then a view of them); the index of
   // the first bad one (checkRay), if any.
