@@ -5,6 +5,9 @@
 // which keeps the batch path's memory pipeline full); the answers are combined per ray in id order,
 // as the one-ray functions and the loop over instances do.
 #include <algorithm>
+#include <memory>
+#include <mutex>
+#include <new>
 #include <string>
 
 #include "query_impl.h"
@@ -16,30 +19,37 @@ namespace {
 
 constexpr size_t kChunk = 32768;  // rays a chunk
 
-// The (instance, ray) pairs of a chunk. Instance i's pairs are [first[i], first[i] + count[i]),
-// rays ascending; the instances of a field (Scene::Impl::byField) lie back to back, so that the
-// pairs of a field form one range.
-struct Pairs {
-  std::vector<uint32_t> first, count;  // per instance
-  std::vector<uint32_t> ray;           // per pair: the ray's index in the chunk
-  std::vector<Ray> rays;               // per pair: the ray in the instance's object space
-};
+using Pairs = detail::ScenePairs;
+using Scratch = detail::SceneScratch;
 
-// What a batch call works in, kept per thread from call to call: fresh large vectors would cost
-// page faults and zeroing on every call.
-struct Scratch {
-  Pairs pairs;
-  std::vector<detail::BoxRay> boxRays;
-  detail::RayLists lists;
-  std::vector<QueryHit> hits;
-  std::vector<uint8_t> blocked;
-  std::vector<float> vis;
-};
+// A scratch of the scene's spares (Scene::Impl::spare), or a new one, for the length of a call.
+class ScratchLease {
+ public:
+  explicit ScratchLease(const Scene::Impl& m) : m_(m) {
+    {
+      std::lock_guard<std::mutex> lock(m.spareLock);
+      if (!m.spare.empty()) {
+        s_ = std::move(m.spare.back());
+        m.spare.pop_back();
+      }
+    }
+    if (!s_) s_ = std::make_unique<Scratch>();
+  }
+  ~ScratchLease() {
+    std::lock_guard<std::mutex> lock(m_.spareLock);
+    try {
+      m_.spare.push_back(std::move(s_));
+    } catch (const std::bad_alloc&) {  // (the scratch is then freed: the next call makes another)
+    }
+  }
+  ScratchLease(const ScratchLease&) = delete;
+  ScratchLease& operator=(const ScratchLease&) = delete;
+  Scratch& operator*() const { return *s_; }
 
-Scratch& scratch() {
-  thread_local Scratch s;
-  return s;
-}
+ private:
+  const Scene::Impl& m_;
+  std::unique_ptr<Scratch> s_;
+};
 
 void pairUp(const Scene::Impl& m, std::span<const Ray> chunk, Scratch* s) {
   Pairs* p = &s->pairs;
@@ -96,7 +106,8 @@ Status Scene::intersect(std::span<const Ray> rays, std::span<SceneHit> out, cons
   std::fill(out.begin(), out.end(), SceneHit{});
   if (!impl_) return {};
   const Impl& m = *impl_;
-  Scratch& s = scratch();
+  const ScratchLease lease(m);
+  Scratch& s = *lease;
   const Pairs& p = s.pairs;
   std::vector<QueryHit>& hits = s.hits;
   for (size_t c = 0; c < rays.size(); c += kChunk) {
@@ -125,7 +136,8 @@ Status Scene::occluded(std::span<const Ray> rays, std::span<uint8_t> out, const 
   std::fill(out.begin(), out.end(), uint8_t(0));
   if (!impl_) return {};
   const Impl& m = *impl_;
-  Scratch& s = scratch();
+  const ScratchLease lease(m);
+  Scratch& s = *lease;
   const Pairs& p = s.pairs;
   std::vector<uint8_t>& blocked = s.blocked;
   for (size_t c = 0; c < rays.size(); c += kChunk) {
@@ -145,7 +157,8 @@ Status Scene::visibility(std::span<const Ray> rays, std::span<float> out, const 
   std::fill(out.begin(), out.end(), 1.0f);
   if (!impl_) return {};
   const Impl& m = *impl_;
-  Scratch& s = scratch();
+  const ScratchLease lease(m);
+  Scratch& s = *lease;
   const Pairs& p = s.pairs;
   std::vector<float>& vis = s.vis;
   for (size_t c = 0; c < rays.size(); c += kChunk) {

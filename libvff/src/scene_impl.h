@@ -3,12 +3,37 @@
 #pragma once
 
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "scene_bvh.h"
 #include "vff/scene.h"
 
 namespace vff {
+
+namespace detail {
+
+// The (instance, ray) pairs of a chunk of a batch. Instance i's pairs are [first[i], first[i] +
+// count[i]), rays ascending; the instances of a field (Scene::Impl::byField) lie back to back, so
+// that the pairs of a field form one range.
+struct ScenePairs {
+  std::vector<uint32_t> first, count;  // per instance
+  std::vector<uint32_t> ray;           // per pair: the ray's index in the chunk
+  std::vector<Ray> rays;               // per pair: the ray in the instance's object space
+};
+
+// What a batch call works in (scene_batch.cpp): megabytes for a large chunk, which fresh memory
+// would fault in and zero on every call.
+struct SceneScratch {
+  ScenePairs pairs;
+  std::vector<BoxRay> boxRays;
+  RayLists lists;
+  std::vector<QueryHit> hits;
+  std::vector<uint8_t> blocked;
+  std::vector<float> vis;
+};
+
+}  // namespace detail
 
 struct Scene::Impl {
   std::vector<Instance> instances;
@@ -19,6 +44,12 @@ struct Scene::Impl {
   // of all its instances.
   std::vector<uint32_t> byField, fieldStart;
   bool committed = true;
+  // The working memory of batch calls that ended, for the next ones (ScratchLease in
+  // scene_batch.cpp): kept by the scene, not by the calling threads, so that a caller whose
+  // threads are new at each call (a thread per call, as Python's batches make) still finds it
+  // faulted in. At most one per call running at once.
+  mutable std::mutex spareLock;
+  mutable std::vector<std::unique_ptr<detail::SceneScratch>> spare;
 
   static Impl& of(std::unique_ptr<Impl>& p);
   // kBadState unless committed (a scene never touched is committed and empty).
