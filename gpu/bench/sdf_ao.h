@@ -2,8 +2,10 @@
 // (SdfField's batch, for gpubench::cpuAo) and the compute shader's text (vff_sdf.glsl in place of
 // the field's queries). Shared by vff-gpu-bench --sdf and tests/gpu/test_gpu_sdf.cpp.
 //
-// Both sides answer hit or miss (SdfField::visibility without a cone: 0 or 1), so the AO is the
-// mean of 1 - occluded over the same rays, as the field's kNearest row.
+// kAoShader's nearest path (aoInterpolated 0) answers hit or miss (vffSdfOccluded: the mean of
+// 1 - occluded, as the field's kNearest row); its interpolated path (1) calls vffSdfVisibility, the
+// cone estimate when the uploaded block asks for one (SdfField::visibility on the CPU: the
+// experiments' counterpart of the field's kInterpolated row, ao.cpp).
 #pragma once
 
 #include <span>
@@ -31,7 +33,7 @@ struct SdfAoQuery {
 inline std::string sdfAoShaderSource(const vffx::SdfField& sdf, const std::string& queryGlsl, const std::string& sdfGlsl) {
   return "#version 430\n" + vffx::gl::sdfShaderDefines(sdf) + queryGlsl + "\n" + vffx::gl::sdfShaderSource(sdfGlsl) +
          "\n#define AO_OCCLUDED(o, d) vffSdfOccluded(o, d, 0.0, aoTmax)\n"
-         "#define AO_VISIBILITY(o, d) (vffSdfOccluded(o, d, 0.0, aoTmax) ? 0.0 : 1.0)\n" +
+         "#define AO_VISIBILITY(o, d) vffSdfVisibility(o, d, 0.0, aoTmax)\n" +
          kAoShader;
 }
 

@@ -11,6 +11,7 @@
 
 #include "../../tests/common/embree_reference.h"
 #include "../../tests/gpu/egl_context.h"
+#include "common.h"  // samples/experiments: the AO experiments' distance-field options
 #include "scene_bench.h"
 #include "sdf_ao.h"
 #include "sdf_bench.h"
@@ -101,15 +102,26 @@ int benchSdf(const File& file, const FieldQuery& cpu, const bake::Mesh& mesh, fl
     std::fflush(stdout);
   }
   glUseProgram(sdfProgram);
-  std::vector<float> g;
-  const double gpuS = renderGpuAo(s, spp, 0, bufs[2], &g);
-  c0 = Clock::now();
-  (void)cpuAo(SdfAoQuery{&sdf, {}}, s, spp, Reconstruction::kNearest, o.threads);
-  const double cpuS = secondsSince(c0);
-  const AoDiff d = compareAo(ref, g);
-  std::printf("| distance field GLSL, sphere tracing | bricks %.2f MiB (NanoVDB %.2f MiB) | %.3f | %.3f | %.0f | %.3f |\n",
-              mib(sdf.bytes()), mib(gpuSdf->gridBytes()), gpuS, cpuS, d.max, d.rms);
-  std::fflush(stdout);
+  // As vff-experiments ao: hit or miss beside the field's nearest row, the cone estimate (one of
+  // spp equal cones over the hemisphere) beside its interpolated row.
+  for (const bool cone : {false, true}) {
+    const vffx::SdfTraceOptions so = vffx::sdfOptions(cone, false, vffx::hemisphereConeTan(spp));
+    if (vff::Status st = gpuSdf->setTraceOptions(so); !st) {
+      std::fprintf(stderr, "vff-gpu-bench: error: %s\n", st.error().toString().c_str());
+      return 4;
+    }
+    gpuSdf->bind();
+    std::vector<float> g;
+    const double gpuS = renderGpuAo(s, spp, cone ? 1 : 0, bufs[2], &g);
+    c0 = Clock::now();
+    (void)cpuAo(SdfAoQuery{&sdf, so}, s, spp, Reconstruction::kNearest, o.threads);
+    const double cpuS = secondsSince(c0);
+    const AoDiff d = compareAo(ref, g);
+    std::printf("| distance field GLSL, %s | bricks %.2f MiB (NanoVDB %.2f MiB) | %.3f | %.3f | %.0f | %.3f |\n",
+                cone ? "cone estimate" : "hit or miss", mib(sdf.bytes()), mib(gpuSdf->gridBytes()), gpuS, cpuS, d.max,
+                d.rms);
+    std::fflush(stdout);
+  }
   glDeleteBuffers(3, bufs);
   glDeleteProgram(sdfProgram);
   if (const GLenum e = glGetError(); e != GL_NO_ERROR) {

@@ -1,6 +1,7 @@
 // sdf_bench.h - vff-gpu-bench's distance-field mode (--sdf): the ground AO of ao_scene.h rendered by
 // the field's GLSL (vff_query.glsl, kNearest and kInterpolated) and by the distance-field peer's
-// GLSL (vff_sdf.glsl: sphere tracing of an SdfField's NanoVDB grid) at equal memory, each against
+// GLSL (vff_sdf.glsl: sphere tracing of an SdfField's NanoVDB grid; hit or miss, and the cone
+// estimate with vff-experiments ao's options) at equal memory, each against
 // the exact image (Embree casts of the mesh on the same rays), with the CPU's time for the same
 // image by the same method (FieldQuery, SdfField, Embree) as the baseline, in one table.
 //

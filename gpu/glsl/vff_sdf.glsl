@@ -11,12 +11,18 @@
 //   space), or to the exit of the empty tree block around the voxel nearest p when that is further
 //   (skipEmpty); a miss after maxSteps steps or past tmax.
 //
+// The cone estimate (vffSdfVisibility, when the block's coneTan or coneRadiusAtEnd is positive):
+// the minimum over the steps of 0.5 + 0.5 d / (t tan(half-angle)), t in voxels no less than
+// VFF_SDF_CONE_MIN_DISTANCE, clamped to [0, 1]; the trace goes on inside (steps of |d|) until it
+// reaches 0 or a sample deeper than VFF_SDF_CONE_DEPTH of the band (covered: 0). sdf_field.h
+// says why.
+//
 // No #include in GL: the line `#include "nanovdb/PNanoVDB.h"` below is replaced by the header's
 // text (Debian's libnanovdb-dev) by vffx::gl::sdfShaderSource (gpu/sdf/sdf_gl.h), after this file's
 // buffer declaration, which PNanoVDB's GLSL path reads as `pnanovdb_buf_data`. The constants and
 // the trace options come from the C++ side (sdfShaderDefines: VFF_SDF_GRID_TYPE, VFF_SDF_SKIP_NUDGE;
 // the VffSdfBlock uniform block, vffx::gl::SdfBlock, filled from vffx::SdfTraceOptions), never
-// retyped here. The cone estimate of the CPU tracer is not ported: AO here is hit or miss.
+// retyped here.
 //
 // Resources (defaults; define to move): the grid's bytes as an SSBO at VFF_SDF_GRID_BINDING (8),
 // the uniform block at VFF_SDF_BLOCK_BINDING (9).
@@ -29,8 +35,8 @@
 #ifndef VFF_SDF_GRID_TYPE
 #error "VFF_SDF_GRID_TYPE: the grid's PNANOVDB_GRID_TYPE (vffx::gl::sdfShaderDefines)"
 #endif
-#ifndef VFF_SDF_SKIP_NUDGE
-#error "VFF_SDF_SKIP_NUDGE: vffx::kSdfSkipNudge (vffx::gl::sdfShaderDefines)"
+#if !defined(VFF_SDF_SKIP_NUDGE) || !defined(VFF_SDF_CONE_DEPTH) || !defined(VFF_SDF_CONE_MIN_DISTANCE)
+#error "VFF_SDF_SKIP_NUDGE, VFF_SDF_CONE_DEPTH, VFF_SDF_CONE_MIN_DISTANCE: vffx::gl::sdfShaderDefines"
 #endif
 
 layout(std430, binding = VFF_SDF_GRID_BINDING) readonly buffer VffSdfGrid { uint pnanovdb_buf_data[]; };
@@ -43,6 +49,7 @@ layout(std140, binding = VFF_SDF_BLOCK_BINDING) uniform VffSdfBlock {
   vec4 vffSdfScale;   // x: voxel size (object units); y: the band's half-width (voxels)
   vec4 vffSdfTrace;   // hitVoxels, minStepVoxels, startVoxels, skipEmpty (0 or 1)
   ivec4 vffSdfSteps;  // x: maxSteps
+  vec4 vffSdfCone;    // x: coneTan; y: coneRadiusAtEnd (object units at tmax)
 };
 
 struct VffSdfHit {
@@ -107,8 +114,10 @@ float vffSdfEmptyExit(inout pnanovdb_readaccessor_t acc, vec3 p, vec3 org, vec3 
   return found ? exitT * (1.0 + VFF_SDF_SKIP_NUDGE) + VFF_SDF_SKIP_NUDGE : 0.0;
 }
 
-// The first hit of the ray o + t d, t in [tmin, tmax] (object space, t in multiples of d).
-VffSdfHit vffSdfIntersect(vec3 o, vec3 d, float tmin, float tmax) {
+// The march along o + t d, t in [tmin, tmax] (object space, t in multiples of d); cone: tan of the
+// cone estimate's half-angle, 0 for none; vis gets the estimate (1 without a cone) (Tracer::trace).
+VffSdfHit vffSdfMarch(vec3 o, vec3 d, float tmin, float tmax, float cone, out float vis) {
+  vis = 1.0;
   VffSdfHit h;
   h.hit = false;
   h.t = 0.0;
@@ -145,15 +154,49 @@ VffSdfHit vffSdfIntersect(vec3 o, vec3 d, float tmin, float tmax) {
     float dv = vffSdfSample(acc, p);
     h.steps = step + 1;
     float skip = vffSdfTrace.w != 0.0 ? vffSdfEmptyExit(acc, p, org, dir) : 0.0;
+    if (cone > 0.0) {
+      vis = min(vis, 0.5 + 0.5 * dv / (max(t * len, VFF_SDF_CONE_MIN_DISTANCE) * cone));
+      if (vis <= 0.0 || dv <= -VFF_SDF_CONE_DEPTH * vffSdfScale.y) {
+        h.hit = true;
+        h.t = t;
+        vis = 0.0;
+        return h;
+      }
+      t = max(t + max(abs(dv) / len, minStep), skip);
+      if (t > t1) break;
+      continue;
+    }
     if (dv < vffSdfTrace.x) {
       h.hit = true;
       h.t = t;
+      vis = 0.0;
       return h;
     }
     t = max(t + max(dv / len, minStep), skip);
     if (t > t1) break;
   }
+  vis = clamp(vis, 0.0, 1.0);
   return h;
 }
 
+// The first hit (SdfField::intersect, without the normal).
+VffSdfHit vffSdfIntersect(vec3 o, vec3 d, float tmin, float tmax) {
+  float vis;
+  return vffSdfMarch(o, d, tmin, tmax, 0.0, vis);
+}
+
 bool vffSdfOccluded(vec3 o, vec3 d, float tmin, float tmax) { return vffSdfIntersect(o, d, tmin, tmax).hit; }
+
+// tan of the cone estimate's half-angle for this ray, 0 for none (sdf_field.cpp coneTan).
+float vffSdfConeTan(vec3 d, float tmax) {
+  if (vffSdfCone.y > 0.0) return vffSdfCone.y / (tmax * length(d));
+  return max(vffSdfCone.x, 0.0);
+}
+
+// SdfField::visibility: the cone estimate when the block asks for one, else 0 (hit) or 1.
+float vffSdfVisibility(vec3 o, vec3 d, float tmin, float tmax) {
+  float cone = vffSdfConeTan(d, tmax);
+  float vis;
+  bool hit = vffSdfMarch(o, d, tmin, tmax, cone, vis).hit;
+  return cone > 0.0 ? vis : (hit ? 0.0 : 1.0);
+}

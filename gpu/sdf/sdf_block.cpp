@@ -14,18 +14,26 @@ SdfBlock makeSdfBlock(const SdfField& sdf, const SdfTraceOptions& options) {
   SdfBlock b;
   b.voxel = sdf.voxelSize();
   b.bandVoxels = sdf.bandVoxels();
+  return withTraceOptions(b, options);
+}
+
+SdfBlock withTraceOptions(SdfBlock b, const SdfTraceOptions& options) {
   b.hitVoxels = options.hitVoxels;
   b.minStepVoxels = options.minStepVoxels;
   b.startVoxels = options.startVoxels;
   b.skipEmpty = options.skipEmpty ? 1.0f : 0.0f;
   b.maxSteps = options.maxSteps;
+  b.coneTan = options.coneTan;
+  b.coneRadiusAtEnd = options.coneRadiusAtEnd;
   return b;
 }
 
 std::string sdfShaderDefines(const SdfField& sdf) {
-  char nudge[64];
+  char nudge[256];
   // %.9g: a binary32 value round-trips through nine significant digits.
-  std::snprintf(nudge, sizeof nudge, "#define VFF_SDF_SKIP_NUDGE %.9g\n", double(kSdfSkipNudge));
+  std::snprintf(nudge, sizeof nudge,
+                "#define VFF_SDF_SKIP_NUDGE %.9g\n#define VFF_SDF_CONE_DEPTH %.9g\n#define VFF_SDF_CONE_MIN_DISTANCE %.9g\n",
+                double(kSdfSkipNudge), double(kSdfConeDepth), double(kSdfConeMinDistance));
   return std::string("#define VFF_SDF_GRID_TYPE ") +
          (sdf.values() == SdfValues::kFp8 ? "PNANOVDB_GRID_TYPE_FP8\n" : "PNANOVDB_GRID_TYPE_FLOAT\n") + nudge;
 }

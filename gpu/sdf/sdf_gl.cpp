@@ -48,6 +48,19 @@ void GpuSdf::release() noexcept {
   gridBytes_ = 0;
 }
 
+vff::Status GpuSdf::setTraceOptions(const SdfTraceOptions& options) {
+  const SdfBlock b = withTraceOptions(block_, options);
+  glGetError();
+  GLint old = 0;
+  glGetIntegerv(GL_UNIFORM_BUFFER_BINDING, &old);
+  glBindBuffer(GL_UNIFORM_BUFFER, blockBuffer_);
+  glBufferSubData(GL_UNIFORM_BUFFER, 0, GLsizeiptr(sizeof b), &b);
+  glBindBuffer(GL_UNIFORM_BUFFER, GLuint(old));
+  if (const GLenum e = glGetError(); e != GL_NO_ERROR) return glError("glBufferSubData", e);
+  block_ = b;
+  return {};
+}
+
 void GpuSdf::bind(const SdfBindings& bindings) const noexcept {
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, bindings.grid, gridBuffer_);
   glBindBufferBase(GL_UNIFORM_BUFFER, bindings.block, blockBuffer_);

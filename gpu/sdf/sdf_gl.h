@@ -16,7 +16,7 @@
 // What uploadSdf creates (owned by the GpuSdf, deleted by its destructor): a shader storage buffer
 // holding the grid's bytes as SdfField::gridBuffer() gives them (the NanoVDB buffer, read in place
 // by PNanoVDB: no conversion), and a uniform buffer holding an SdfBlock made by makeSdfBlock.
-// Memory on the GPU: the NanoVDB buffer (SdfField::nanovdbBytes()) plus the 48-byte block.
+// Memory on the GPU: the NanoVDB buffer (SdfField::nanovdbBytes()) plus the 64-byte block.
 //
 // Errors (values): kUnsupported for a grid over GL_MAX_SHADER_STORAGE_BLOCK_SIZE or 4 GiB
 // (PNanoVDB's GLSL path addresses bytes with 32 bits) or a context below 4.3; kBadState when GL
@@ -42,14 +42,20 @@ struct SdfBlock {
   float skipEmpty = 0;      // 0 or 1
   int32_t maxSteps = 0;
   int32_t pad1[3] = {0, 0, 0};
+  float coneTan = 0;          // SdfTraceOptions: the cone estimate (vffSdfVisibility) when either
+  float coneRadiusAtEnd = 0;  // is positive
+  float pad2[2] = {0, 0};
 };
-static_assert(sizeof(SdfBlock) == 48);
+static_assert(sizeof(SdfBlock) == 64);
 
 // The block for a field and the trace options (the CPU tracer's, field by field).
 SdfBlock makeSdfBlock(const SdfField& sdf, const SdfTraceOptions& options);
+// `block` with its trace options replaced (the grid's voxel and band kept).
+SdfBlock withTraceOptions(SdfBlock block, const SdfTraceOptions& options);
 
 // The #define lines vff_sdf.glsl needs, to put after `#version 430`: the grid's PNanoVDB type
-// (VFF_SDF_GRID_TYPE: PNANOVDB_GRID_TYPE_FLOAT 1 or _FP8 14) and VFF_SDF_SKIP_NUDGE (kSdfSkipNudge).
+// (VFF_SDF_GRID_TYPE: PNANOVDB_GRID_TYPE_FLOAT 1 or _FP8 14), VFF_SDF_SKIP_NUDGE (kSdfSkipNudge),
+// VFF_SDF_CONE_DEPTH (kSdfConeDepth) and VFF_SDF_CONE_MIN_DISTANCE (kSdfConeMinDistance).
 std::string sdfShaderDefines(const SdfField& sdf);
 
 // vff_sdf.glsl's text with its `#include "nanovdb/PNanoVDB.h"` line replaced by the header's text
@@ -75,6 +81,8 @@ class GpuSdf {
 
   void bind(const SdfBindings& bindings = {}) const noexcept;
   void release() noexcept;  // deletes the GL objects now (the context must be current)
+  // Replaces the block's trace options (glBufferSubData); kBadState when GL reports an error.
+  vff::Status setTraceOptions(const SdfTraceOptions& options);
 
   const SdfBlock& block() const noexcept { return block_; }
   uint32_t gridBuffer() const noexcept { return gridBuffer_; }

@@ -89,7 +89,7 @@ class Tracer {
       if (cone > 0) {
         // The share of the cone's disc left open, as a ramp over its radius at t: a half when the
         // axis grazes the surface; the trace goes on inside until the disc is covered.
-        *visibility = std::min(*visibility, 0.5f + 0.5f * d / (std::max(t * len, 1e-6f) * cone));
+        *visibility = std::min(*visibility, 0.5f + 0.5f * d / (std::max(t * len, kSdfConeMinDistance) * cone));
         // Deeper inside than the band reaches: the depth is unknown, and the disc taken as covered.
         if (*visibility <= 0.0f || d <= -kSdfConeDepth * band_) {
           h.hit = true;

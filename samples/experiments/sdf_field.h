@@ -58,8 +58,10 @@ inline constexpr uint64_t kSdfMinBudget = 4096;
 // Empty-space skipping lands a little past a block's exit, t * (1 + kSdfSkipNudge) + kSdfSkipNudge,
 // so that the next sample lies outside the block. Also the GLSL tracer's (gpu/glsl/vff_sdf.glsl).
 inline constexpr float kSdfSkipNudge = 1e-6f;
-// The cone estimate takes a sample deeper inside than this share of the band as covered.
+// The cone estimate takes a sample deeper inside than this share of the band as covered, and
+// divides by the cone's radius at t, t (in voxels) no less than kSdfConeMinDistance.
 inline constexpr float kSdfConeDepth = 0.9f;
+inline constexpr float kSdfConeMinDistance = 1e-6f;
 
 struct SdfBuildOptions {
   uint64_t budgetBytes = 1u << 20;  // bytes() at most; kSdfMinBudget at least

@@ -9,8 +9,9 @@
 // (at least minStepVoxels) on the other, and a step whose length rounds differently can land on
 // either side of a block's exit. So: hit flags may differ on at most kMaxFlipShare of the rays; where
 // both hit, t within kTightVoxels voxels on at least kTightShare of them, and within kLooseVoxels
-// (one step below the hit threshold plus the threshold itself) on all. The AO images (same rays:
-// ao_scene.h) within kAoMax levels of 255 per pixel, RMS kAoRms.
+// (one step below the hit threshold plus the threshold itself) on all; the cone estimate within
+// kConeVis on all but kMaxFlipShare of the rays. The AO images (same rays: ao_scene.h) within kAoMax
+// levels of 255 per pixel, RMS kAoRms.
 #include <gtest/gtest.h>
 #include <GL/glcorearb.h>
 
@@ -23,6 +24,7 @@
 #include <vector>
 
 #include "../../gpu/bench/sdf_ao.h"
+#include "common.h"  // samples/experiments: the AO experiments' cone options
 #include "egl_context.h"
 #include "sdf_gl.h"
 #include "vff/bake/mesh.h"
@@ -39,6 +41,7 @@ constexpr double kTightShare = 0.99;
 constexpr double kLooseVoxels = 0.5;
 constexpr double kAoMax = 8.0;  // one ray of 32 answered differently
 constexpr double kAoRms = 0.25;
+constexpr double kConeVis = 1e-4;  // the cone estimate, where the traces agree
 
 #define VFF_REQUIRE_GL()                                                        \
   do {                                                                          \
@@ -56,7 +59,7 @@ void main() {
   if (id >= uint(rays.length())) return;
   TestRay r = rays[id];
   VffSdfHit h = vffSdfIntersect(r.origin.xyz, r.direction.xyz, r.origin.w, r.direction.w);
-  outs[id] = vec4(h.hit ? 1.0 : 0.0, h.t, float(h.steps), 0.0);
+  outs[id] = vec4(h.hit ? 1.0 : 0.0, h.t, float(h.steps), vffSdfVisibility(r.origin.xyz, r.direction.xyz, r.origin.w, r.direction.w));
 }
 )";
 
@@ -112,13 +115,15 @@ GLuint buildSdfProgram(const vffx::SdfField& sdf, const std::string& body) {
   return prog;
 }
 
-// GPU against CPU on `rays` through one grid; prints the counts.
-void compareTracers(const char* what, const vffx::SdfField& sdf, const std::vector<vff::Ray>& rays) {
-  auto gpu = vffx::gl::uploadSdf(sdf);
-  ASSERT_TRUE(gpu) << gpu.error().toString();
+// kRayMain over `rays` with the grid uploaded with `options`: hit, t, steps, visibility per ray.
+std::vector<float> runRays(const vffx::SdfField& sdf, const vffx::SdfTraceOptions& options,
+                           const std::vector<vff::Ray>& rays) {
+  auto gpu = vffx::gl::uploadSdf(sdf, options);
+  EXPECT_TRUE(gpu) << gpu.error().toString();
+  if (!gpu) return {};
   EXPECT_EQ(gpu->gridBytes(), sdf.nanovdbBytes());
   const GLuint prog = buildSdfProgram(sdf, kRayMain);
-  ASSERT_NE(prog, 0u);
+  if (!prog) return {};
   std::vector<float> in(rays.size() * 8);
   for (size_t i = 0; i < rays.size(); ++i) {
     const vff::Ray& r = rays[i];
@@ -142,13 +147,20 @@ void compareTracers(const char* what, const vffx::SdfField& sdf, const std::vect
   glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(out.size() * 4), out.data());
   glDeleteBuffers(2, bufs);
   glDeleteProgram(prog);
-  ASSERT_EQ(glGetError(), GLenum(GL_NO_ERROR));
+  EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
+  return out;
+}
 
+// GPU against CPU on `rays` through one grid; prints the counts.
+void compareTracers(const char* what, const vffx::SdfField& sdf, const std::vector<vff::Ray>& rays) {
+  const std::vector<float> out = runRays(sdf, {}, rays);
+  ASSERT_EQ(out.size(), rays.size() * 4);
   size_t hits = 0, flips = 0, both = 0, tight = 0;
   double worst = 0;
   for (size_t i = 0; i < rays.size(); ++i) {
     const vffx::SdfHit c = sdf.intersect(rays[i]);
     const bool g = out[i * 4] != 0;
+    EXPECT_EQ(out[i * 4 + 3], g ? 0.0f : 1.0f) << "without a cone, visibility is 0 or 1";
     hits += c.hit;
     if (c.hit != g) {
       ++flips;
@@ -190,7 +202,46 @@ TEST(GpuSdf, TracerMatchesCpuOnBunny) {
   compareTracers("stanford bunny", buildSdf(*m, 512 << 10, vffx::SdfValues::kFp8), makeRays(boundingSphere(*m), 1024, 12));
 }
 
-// The ground AO (ao_scene.h) under the torus knot through the GLSL tracer and the CPU one.
+// The cone estimate (vffSdfVisibility with the block's coneTan, then coneRadiusAtEnd) against
+// SdfField::visibility on the same rays: the minimum over the same steps of the same expression,
+// so within rounding where the traces agree.
+TEST(GpuSdf, ConeEstimateMatchesCpu) {
+  VFF_REQUIRE_GL();
+  const vff::bake::Mesh m = vff::bake::makeShape("torus-knot");
+  const vff::Sphere bs = boundingSphere(m);
+  const vffx::SdfField sdf = buildSdf(m, 256 << 10, vffx::SdfValues::kFp8);
+  // A finite tmax on every ray (coneRadiusAtEnd's cone is set by it): 4 R along the ray.
+  std::vector<vff::Ray> rays = makeRays(bs, 2048, 13);
+  for (vff::Ray& r : rays)
+    r.tmax = std::min(r.tmax, 4.0f * bs.radius / std::sqrt(r.direction.x * r.direction.x + r.direction.y * r.direction.y +
+                                                           r.direction.z * r.direction.z));
+  vffx::SdfTraceOptions byTan, byRadius;
+  byTan.coneTan = vffx::hemisphereConeTan(32);
+  byRadius.coneRadiusAtEnd = 0.2f * bs.radius;
+  for (const vffx::SdfTraceOptions& o : {byTan, byRadius}) {
+    const std::vector<float> out = runRays(sdf, o, rays);
+    ASSERT_EQ(out.size(), rays.size() * 4);
+    std::vector<float> cpu(rays.size());
+    sdf.visibility(rays, cpu, o);
+    size_t off = 0, partial = 0;
+    double worst = 0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+      const double e = std::fabs(double(out[i * 4 + 3]) - double(cpu[i]));
+      off += e > kConeVis;
+      partial += cpu[i] > 0 && cpu[i] < 1;
+      worst = std::max(worst, e);
+    }
+    std::printf("[ gpu ] sdf cone estimate (%s): %zu rays, %zu with a partial estimate; %zu differ by over %.0e, "
+                "worst %.3g\n",
+                o.coneTan > 0 ? "coneTan" : "coneRadiusAtEnd", rays.size(), partial, off, kConeVis, worst);
+    EXPECT_GT(partial, rays.size() / 8) << "too few partial estimates for the test to mean anything";
+    EXPECT_LE(double(off), kMaxFlipShare * double(rays.size()));
+  }
+}
+
+// The ground AO (ao_scene.h) under the torus knot through the GLSL tracer and the CPU one: hit or
+// miss (kAoShader's nearest path) and the cone estimate (its interpolated path, the experiments'
+// options: sdfOptions, hemisphereConeTan).
 TEST(GpuSdf, GroundAoMatchesCpu) {
   VFF_REQUIRE_GL();
   const vff::bake::Mesh m = vff::bake::makeShape("torus-knot");
@@ -217,34 +268,39 @@ TEST(GpuSdf, GroundAoMatchesCpu) {
   glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[2]);
   glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(kSize * kSize * 4), nullptr, GL_STREAM_READ);
   for (int b = 0; b < 3; ++b) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, GLuint(5 + b), bufs[b]);
-  gpu->bind();
-  glUseProgram(prog);
-  glUniform1i(0, kSize);
-  glUniform1i(1, kRays);
-  glUniform1i(2, 0);
-  glUniform1f(3, s.eps);
-  glUniform1f(4, s.tmax);
-  glUniform1i(5, 0);
-  glDispatchCompute(kSize / 8, kSize / 8, 1);
-  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  std::vector<float> g(size_t(kSize) * kSize);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[2]);
-  glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(g.size() * 4), g.data());
+  for (const bool cone : {false, true}) {
+    const vffx::SdfTraceOptions so = vffx::sdfOptions(cone, false, vffx::hemisphereConeTan(kRays));
+    ASSERT_TRUE(gpu->setTraceOptions(so));
+    gpu->bind();
+    glUseProgram(prog);
+    glUniform1i(0, kSize);
+    glUniform1i(1, kRays);
+    glUniform1i(2, cone ? 1 : 0);
+    glUniform1f(3, s.eps);
+    glUniform1f(4, s.tmax);
+    glUniform1i(5, 0);
+    glDispatchCompute(kSize / 8, kSize / 8, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    std::vector<float> g(size_t(kSize) * kSize);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[2]);
+    glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(g.size() * 4), g.data());
+    ASSERT_EQ(glGetError(), GLenum(GL_NO_ERROR));
+    const std::vector<float> c =
+        vff::gpubench::cpuAo(vff::gpubench::SdfAoQuery{&sdf, so}, s, kRays, vff::Reconstruction::kNearest, 2);
+    const vff::gpubench::AoDiff d = vff::gpubench::compareAo(c, g);
+    double mean = 0, lo = 1;
+    for (float v : c) mean += v, lo = std::min(lo, double(v));
+    mean /= double(c.size());
+    std::printf("[ gpu ] sdf ground AO %dx%d, %d rays/px, %s: CPU mean AO %.4f (min %.3f); GPU vs CPU on the 8-bit "
+                "scale: max %.0f, RMS %.4f, %llu of %d pixels differ\n",
+                kSize, kSize, kRays, cone ? "cone estimate" : "hit or miss", mean, lo, d.max, d.rms,
+                (unsigned long long)d.differing, kSize * kSize);
+    EXPECT_LT(lo, 0.9) << "the knot should occlude some of the ground";
+    EXPECT_LE(d.max, kAoMax);
+    EXPECT_LE(d.rms, kAoRms);
+  }
   glDeleteBuffers(3, bufs);
   glDeleteProgram(prog);
-  ASSERT_EQ(glGetError(), GLenum(GL_NO_ERROR));
-  const std::vector<float> c =
-      vff::gpubench::cpuAo(vff::gpubench::SdfAoQuery{&sdf, {}}, s, kRays, vff::Reconstruction::kNearest, 2);
-  const vff::gpubench::AoDiff d = vff::gpubench::compareAo(c, g);
-  double mean = 0, lo = 1;
-  for (float v : c) mean += v, lo = std::min(lo, double(v));
-  mean /= double(c.size());
-  std::printf("[ gpu ] sdf ground AO %dx%d, %d rays/px: CPU mean AO %.4f (min %.3f); GPU vs CPU on the 8-bit scale: "
-              "max %.0f, RMS %.4f, %llu of %d pixels differ\n",
-              kSize, kSize, kRays, mean, lo, d.max, d.rms, (unsigned long long)d.differing, kSize * kSize);
-  EXPECT_LT(lo, 0.9) << "the knot should occlude some of the ground";
-  EXPECT_LE(d.max, kAoMax);
-  EXPECT_LE(d.rms, kAoRms);
 }
 
 }  // namespace
