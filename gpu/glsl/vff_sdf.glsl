@@ -20,9 +20,9 @@
 // No #include in GL: the line `#include "nanovdb/PNanoVDB.h"` below is replaced by the header's
 // text (Debian's libnanovdb-dev) by vffx::gl::sdfShaderSource (gpu/sdf/sdf_gl.h), after this file's
 // buffer declaration, which PNanoVDB's GLSL path reads as `pnanovdb_buf_data`. The constants and
-// the trace options come from the C++ side (sdfShaderDefines: VFF_SDF_GRID_TYPE, VFF_SDF_SKIP_NUDGE;
-// the VffSdfBlock uniform block, vffx::gl::SdfBlock, filled from vffx::SdfTraceOptions), never
-// retyped here.
+// the trace options come from the C++ side (sdfShaderDefines: VFF_SDF_GRID_TYPE and sdf_field.h's
+// kSdfSkipNudge, kSdfConeDepth, kSdfConeMinDistance; the VffSdfBlock uniform block,
+// vffx::gl::SdfBlock, filled from vffx::SdfTraceOptions), never retyped here.
 //
 // Resources (defaults; define to move): the grid's bytes as an SSBO at VFF_SDF_GRID_BINDING (8),
 // the uniform block at VFF_SDF_BLOCK_BINDING (9).
