@@ -30,7 +30,8 @@ struct SdfAoQuery {
 // The whole compute shader: "#version 430", the grid's defines, vff_query.glsl (for vffFrame; its
 // field resources are declared but unused), vff_sdf.glsl with PNanoVDB pasted in, kAoShader with
 // its queries as sphere tracing.
-inline std::string sdfAoShaderSource(const vffx::SdfField& sdf, const std::string& queryGlsl, const std::string& sdfGlsl) {
+inline std::string sdfAoShaderSource(const vffx::SdfField& sdf, const std::string& queryGlsl,
+                                     const std::string& sdfGlsl) {
   return "#version 430\n" + vffx::gl::sdfShaderDefines(sdf) + queryGlsl + "\n" + vffx::gl::sdfShaderSource(sdfGlsl) +
          "\n#define AO_OCCLUDED(o, d) vffSdfOccluded(o, d, 0.0, aoTmax)\n"
          "#define AO_VISIBILITY(o, d) vffSdfVisibility(o, d, 0.0, aoTmax)\n" +

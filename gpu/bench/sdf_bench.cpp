@@ -1,4 +1,6 @@
 // sdf_bench.cpp - vff-gpu-bench --sdf (sdf_bench.h).
+#include "sdf_bench.h"
+
 #include <GL/glcorearb.h>
 
 #include <chrono>
@@ -14,7 +16,6 @@
 #include "common.h"  // samples/experiments: the AO experiments' distance-field options
 #include "scene_bench.h"
 #include "sdf_ao.h"
-#include "sdf_bench.h"
 #include "sdf_gl.h"
 
 namespace vff::gpubench {
@@ -22,7 +23,9 @@ namespace vff::gpubench {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); }
+double secondsSince(Clock::time_point a) {
+  return std::chrono::duration<double>(Clock::now() - a).count();
+}
 
 // The query cpuAo calls for the exact image: Embree's occlusion test on the mesh.
 struct ExactAoQuery {
@@ -34,12 +37,14 @@ struct ExactAoQuery {
   }
 };
 
-double mib(uint64_t bytes) { return double(bytes) / 1048576.0; }
+double mib(uint64_t bytes) {
+  return double(bytes) / 1048576.0;
+}
 
 }  // namespace
 
-int benchSdf(const File& file, const FieldQuery& cpu, const bake::Mesh& mesh, float groundY, const gl::GpuField& gpuField,
-             unsigned fieldProgram, const SdfBenchOptions& o) {
+int benchSdf(const File& file, const FieldQuery& cpu, const bake::Mesh& mesh, float groundY,
+             const gl::GpuField& gpuField, unsigned fieldProgram, const SdfBenchOptions& o) {
   const FieldDesc& f = file.field();
   const uint64_t budget = cpu.payloadBytes();
   const auto b0 = Clock::now();
@@ -49,9 +54,10 @@ int benchSdf(const File& file, const FieldQuery& cpu, const bake::Mesh& mesh, fl
     return 4;
   }
   const vffx::SdfField& sdf = *built;
-  std::printf("\ndistance field: fp8, voxel %.4g R, band %.3g voxels, built in %.1f s (%d builds) for the field's payload "
-              "of %.2f MiB\n",
-              double(sdf.voxelSize() / f.sphere.radius), double(sdf.bandVoxels()), secondsSince(b0), sdf.builds(), mib(budget));
+  std::printf(
+      "\ndistance field: fp8, voxel %.4g R, band %.3g voxels, built in %.1f s (%d builds) for the field's payload "
+      "of %.2f MiB\n",
+      double(sdf.voxelSize() / f.sphere.radius), double(sdf.bandVoxels()), secondsSince(b0), sdf.builds(), mib(budget));
   auto gpuSdf = vffx::gl::uploadSdf(sdf);
   if (!gpuSdf) {
     std::fprintf(stderr, "vff-gpu-bench: error: %s\n", gpuSdf.error().toString().c_str());
@@ -84,9 +90,10 @@ int benchSdf(const File& file, const FieldQuery& cpu, const bake::Mesh& mesh, fl
   const std::vector<float> ref = cpuAo(ExactAoQuery{&exact}, s, spp, Reconstruction::kNearest, o.threads);
   const double exactS = secondsSince(c0);
 
-  std::printf("\nground AO %dx%d, %d rays/px, tmax 2 R, at equal memory; max and RMS against the exact image (Embree) on "
-              "the 8-bit scale; CPU: the same image by the same method on %u thread(s)\n",
-              size, size, spp, o.threads);
+  std::printf(
+      "\nground AO %dx%d, %d rays/px, tmax 2 R, at equal memory; max and RMS against the exact image (Embree) on "
+      "the 8-bit scale; CPU: the same image by the same method on %u thread(s)\n",
+      size, size, spp, o.threads);
   std::printf("| AO by | memory | GPU frame s | CPU s | max | RMS |\n|---|---|---|---|---|---|\n");
   std::printf("| exact (Embree) | mesh, %zu triangles | - | %.3f | 0 | 0 |\n", mesh.triangleCount(), exactS);
   glUseProgram(fieldProgram);
@@ -98,7 +105,8 @@ int benchSdf(const File& file, const FieldQuery& cpu, const bake::Mesh& mesh, fl
     const double cpuS = secondsSince(c0);
     const AoDiff d = compareAo(ref, g);
     std::printf("| field GLSL, %s | payload %.2f MiB (texture %.2f MiB) | %.3f | %.3f | %.0f | %.3f |\n",
-                interp ? "interpolated" : "nearest", mib(budget), mib(gpuField.textureBytes()), gpuS, cpuS, d.max, d.rms);
+                interp ? "interpolated" : "nearest", mib(budget), mib(gpuField.textureBytes()), gpuS, cpuS, d.max,
+                d.rms);
     std::fflush(stdout);
   }
   glUseProgram(sdfProgram);

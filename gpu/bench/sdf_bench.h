@@ -28,7 +28,7 @@ struct SdfBenchOptions {
 // `gpu` is the field's upload (vff::gl::GpuField), `fieldProgram` the field's AO program (kAoShader
 // after vff_query.glsl), `mesh` the object the field was baked from (object space). Prints the
 // table; returns an exit code (0, or 4 for a build, GL or shader failure).
-int benchSdf(const File& file, const FieldQuery& cpu, const bake::Mesh& mesh, float groundY, const gl::GpuField& gpuField,
-             unsigned fieldProgram, const SdfBenchOptions& o);
+int benchSdf(const File& file, const FieldQuery& cpu, const bake::Mesh& mesh, float groundY,
+             const gl::GpuField& gpuField, unsigned fieldProgram, const SdfBenchOptions& o);
 
 }  // namespace vff::gpubench

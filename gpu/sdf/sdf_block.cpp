@@ -31,9 +31,10 @@ SdfBlock withTraceOptions(SdfBlock b, const SdfTraceOptions& options) {
 std::string sdfShaderDefines(const SdfField& sdf) {
   char nudge[256];
   // %.9g: a binary32 value round-trips through nine significant digits.
-  std::snprintf(nudge, sizeof nudge,
-                "#define VFF_SDF_SKIP_NUDGE %.9g\n#define VFF_SDF_CONE_DEPTH %.9g\n#define VFF_SDF_CONE_MIN_DISTANCE %.9g\n",
-                double(kSdfSkipNudge), double(kSdfConeDepth), double(kSdfConeMinDistance));
+  std::snprintf(
+      nudge, sizeof nudge,
+      "#define VFF_SDF_SKIP_NUDGE %.9g\n#define VFF_SDF_CONE_DEPTH %.9g\n#define VFF_SDF_CONE_MIN_DISTANCE %.9g\n",
+      double(kSdfSkipNudge), double(kSdfConeDepth), double(kSdfConeMinDistance));
   return std::string("#define VFF_SDF_GRID_TYPE ") +
          (sdf.values() == SdfValues::kFp8 ? "PNANOVDB_GRID_TYPE_FP8\n" : "PNANOVDB_GRID_TYPE_FLOAT\n") + nudge;
 }

@@ -1,12 +1,12 @@
 // sdf_gl.cpp - uploading an SdfField's NanoVDB grid and its trace block (sdf_gl.h).
+#include "sdf_gl.h"
+
 #include <GL/glcorearb.h>
 
 #include <cstdio>
 #include <span>
 #include <string>
 #include <utility>
-
-#include "sdf_gl.h"
 
 namespace vffx::gl {
 
@@ -25,7 +25,9 @@ vff::Error glError(const char* what, GLenum e) {
 }  // namespace
 
 GpuSdf::GpuSdf(GpuSdf&& o) noexcept
-    : block_(o.block_), gridBuffer_(std::exchange(o.gridBuffer_, 0)), blockBuffer_(std::exchange(o.blockBuffer_, 0)),
+    : block_(o.block_),
+      gridBuffer_(std::exchange(o.gridBuffer_, 0)),
+      blockBuffer_(std::exchange(o.blockBuffer_, 0)),
       gridBytes_(std::exchange(o.gridBytes_, 0)) {}
 
 GpuSdf& GpuSdf::operator=(GpuSdf&& o) noexcept {
@@ -39,7 +41,9 @@ GpuSdf& GpuSdf::operator=(GpuSdf&& o) noexcept {
   return *this;
 }
 
-GpuSdf::~GpuSdf() { release(); }
+GpuSdf::~GpuSdf() {
+  release();
+}
 
 void GpuSdf::release() noexcept {
   const GLuint b[2] = {gridBuffer_, blockBuffer_};
@@ -80,10 +84,10 @@ vff::Result<GpuSdf> uploadSdf(const SdfField& sdf, const SdfTraceOptions& option
   GLint64 maxBlock = 0;
   glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxBlock);
   if (bytes.size() > uint64_t(maxBlock) || bytes.size() >= (uint64_t(1) << 32))
-    return vff::makeError(vff::Code::kUnsupported,
-                          "sdf upload: the grid has " + std::to_string(bytes.size()) +
-                              " bytes, more than GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" + std::to_string(maxBlock) +
-                              ") or PNanoVDB's 32-bit addresses allow");
+    return vff::makeError(vff::Code::kUnsupported, "sdf upload: the grid has " + std::to_string(bytes.size()) +
+                                                       " bytes, more than GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" +
+                                                       std::to_string(maxBlock) +
+                                                       ") or PNanoVDB's 32-bit addresses allow");
   GpuSdf g;
   g.block_ = makeSdfBlock(sdf, options);
   GLint oldSsbo = 0, oldUbo = 0;

@@ -31,15 +31,15 @@
 
 namespace vffx::gl {
 
-// The shader's uniform block VffSdfBlock, std140 (three 16-byte rows).
+// The shader's uniform block VffSdfBlock, std140 (four 16-byte rows).
 struct SdfBlock {
-  float voxel = 0;          // object units (SdfField::voxelSize())
-  float bandVoxels = 0;     // SdfField::bandVoxels()
+  float voxel = 0;       // object units (SdfField::voxelSize())
+  float bandVoxels = 0;  // SdfField::bandVoxels()
   float pad0[2] = {0, 0};
-  float hitVoxels = 0;      // SdfTraceOptions, as given
+  float hitVoxels = 0;  // SdfTraceOptions, as given
   float minStepVoxels = 0;
   float startVoxels = 0;
-  float skipEmpty = 0;      // 0 or 1
+  float skipEmpty = 0;  // 0 or 1
   int32_t maxSteps = 0;
   int32_t pad1[3] = {0, 0, 0};
   float coneTan = 0;          // SdfTraceOptions: the cone estimate (vffSdfVisibility) when either

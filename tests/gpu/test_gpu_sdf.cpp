@@ -12,8 +12,8 @@
 // (one step below the hit threshold plus the threshold itself) on all; the cone estimate within
 // kConeVis on all but kMaxFlipShare of the rays. The AO images (same rays: ao_scene.h) within kAoMax
 // levels of 255 per pixel, RMS kAoRms.
-#include <gtest/gtest.h>
 #include <GL/glcorearb.h>
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
@@ -43,9 +43,9 @@ constexpr double kAoMax = 8.0;  // one ray of 32 answered differently
 constexpr double kAoRms = 0.25;
 constexpr double kConeVis = 1e-4;  // the cone estimate, where the traces agree
 
-#define VFF_REQUIRE_GL()                                                        \
-  do {                                                                          \
-    const vff::test::HeadlessGl& gl_ = vff::test::headlessGl();                 \
+#define VFF_REQUIRE_GL()                                                          \
+  do {                                                                            \
+    const vff::test::HeadlessGl& gl_ = vff::test::headlessGl();                   \
     if (!gl_.ok) GTEST_SKIP() << "no headless OpenGL 4.3 context: " << gl_.error; \
   } while (0)
 
@@ -69,7 +69,9 @@ vffx::SdfField buildSdf(const vff::bake::Mesh& m, uint64_t budget, vffx::SdfValu
   return std::move(*sdf);
 }
 
-vff::Sphere boundingSphere(const vff::bake::Mesh& m) { return vff::bake::minimalEnclosingSphere(m.positions); }
+vff::Sphere boundingSphere(const vff::bake::Mesh& m) {
+  return vff::bake::minimalEnclosingSphere(m.positions);
+}
 
 // Rays from outside the sphere aimed at points inside it (3 in 4), and from inside (1 in 4); some
 // with non-unit directions and a finite tmax.
@@ -127,7 +129,8 @@ std::vector<float> runRays(const vffx::SdfField& sdf, const vffx::SdfTraceOption
   std::vector<float> in(rays.size() * 8);
   for (size_t i = 0; i < rays.size(); ++i) {
     const vff::Ray& r = rays[i];
-    const float v[8] = {r.origin.x, r.origin.y, r.origin.z, r.tmin, r.direction.x, r.direction.y, r.direction.z, r.tmax};
+    const float v[8] = {r.origin.x,    r.origin.y,    r.origin.z,    r.tmin,
+                        r.direction.x, r.direction.y, r.direction.z, r.tmax};
     std::copy(v, v + 8, &in[i * 8]);
   }
   GLuint bufs[2];
@@ -176,10 +179,11 @@ void compareTracers(const char* what, const vffx::SdfField& sdf, const std::vect
     tight += dv <= kTightVoxels;
     EXPECT_LE(dv, kLooseVoxels) << what << " ray " << i << ": CPU t " << c.t << ", GPU t " << out[i * 4 + 1];
   }
-  std::printf("[ gpu ] sdf %s (%s, voxel %.4g, NanoVDB %llu bytes): %zu rays, %zu hits; hit flags differ on %zu; "
-              "where both hit (%zu): t within %.0e voxels on %zu, worst %.3g voxels\n",
-              what, sdf.values() == vffx::SdfValues::kFp8 ? "fp8" : "float", double(sdf.voxelSize()),
-              (unsigned long long)sdf.nanovdbBytes(), rays.size(), hits, flips, both, kTightVoxels, tight, worst);
+  std::printf(
+      "[ gpu ] sdf %s (%s, voxel %.4g, NanoVDB %llu bytes): %zu rays, %zu hits; hit flags differ on %zu; "
+      "where both hit (%zu): t within %.0e voxels on %zu, worst %.3g voxels\n",
+      what, sdf.values() == vffx::SdfValues::kFp8 ? "fp8" : "float", double(sdf.voxelSize()),
+      (unsigned long long)sdf.nanovdbBytes(), rays.size(), hits, flips, both, kTightVoxels, tight, worst);
   EXPECT_GT(hits, rays.size() / 4) << "too few hits for the test to mean anything";
   EXPECT_LE(double(flips), kMaxFlipShare * double(rays.size()));
   EXPECT_GE(double(tight), kTightShare * double(both));
@@ -199,7 +203,8 @@ TEST(GpuSdf, TracerMatchesCpuOnBunny) {
   if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not found (the shared test meshes)";
   auto m = vff::bake::loadMesh(path);
   ASSERT_TRUE(m) << m.error().toString();
-  compareTracers("stanford bunny", buildSdf(*m, 512 << 10, vffx::SdfValues::kFp8), makeRays(boundingSphere(*m), 1024, 12));
+  compareTracers("stanford bunny", buildSdf(*m, 512 << 10, vffx::SdfValues::kFp8),
+                 makeRays(boundingSphere(*m), 1024, 12));
 }
 
 // The cone estimate (vffSdfVisibility with the block's coneTan, then coneRadiusAtEnd) against
@@ -213,8 +218,9 @@ TEST(GpuSdf, ConeEstimateMatchesCpu) {
   // A finite tmax on every ray (coneRadiusAtEnd's cone is set by it): 4 R along the ray.
   std::vector<vff::Ray> rays = makeRays(bs, 2048, 13);
   for (vff::Ray& r : rays)
-    r.tmax = std::min(r.tmax, 4.0f * bs.radius / std::sqrt(r.direction.x * r.direction.x + r.direction.y * r.direction.y +
-                                                           r.direction.z * r.direction.z));
+    r.tmax = std::min(r.tmax, 4.0f * bs.radius /
+                                  std::sqrt(r.direction.x * r.direction.x + r.direction.y * r.direction.y +
+                                            r.direction.z * r.direction.z));
   vffx::SdfTraceOptions byTan, byRadius;
   byTan.coneTan = vffx::hemisphereConeTan(32);
   byRadius.coneRadiusAtEnd = 0.2f * bs.radius;
@@ -231,9 +237,10 @@ TEST(GpuSdf, ConeEstimateMatchesCpu) {
       partial += cpu[i] > 0 && cpu[i] < 1;
       worst = std::max(worst, e);
     }
-    std::printf("[ gpu ] sdf cone estimate (%s): %zu rays, %zu with a partial estimate; %zu differ by over %.0e, "
-                "worst %.3g\n",
-                o.coneTan > 0 ? "coneTan" : "coneRadiusAtEnd", rays.size(), partial, off, kConeVis, worst);
+    std::printf(
+        "[ gpu ] sdf cone estimate (%s): %zu rays, %zu with a partial estimate; %zu differ by over %.0e, "
+        "worst %.3g\n",
+        o.coneTan > 0 ? "coneTan" : "coneRadiusAtEnd", rays.size(), partial, off, kConeVis, worst);
     EXPECT_GT(partial, rays.size() / 8) << "too few partial estimates for the test to mean anything";
     EXPECT_LE(double(off), kMaxFlipShare * double(rays.size()));
   }
@@ -291,10 +298,11 @@ TEST(GpuSdf, GroundAoMatchesCpu) {
     double mean = 0, lo = 1;
     for (float v : c) mean += v, lo = std::min(lo, double(v));
     mean /= double(c.size());
-    std::printf("[ gpu ] sdf ground AO %dx%d, %d rays/px, %s: CPU mean AO %.4f (min %.3f); GPU vs CPU on the 8-bit "
-                "scale: max %.0f, RMS %.4f, %llu of %d pixels differ\n",
-                kSize, kSize, kRays, cone ? "cone estimate" : "hit or miss", mean, lo, d.max, d.rms,
-                (unsigned long long)d.differing, kSize * kSize);
+    std::printf(
+        "[ gpu ] sdf ground AO %dx%d, %d rays/px, %s: CPU mean AO %.4f (min %.3f); GPU vs CPU on the 8-bit "
+        "scale: max %.0f, RMS %.4f, %llu of %d pixels differ\n",
+        kSize, kSize, kRays, cone ? "cone estimate" : "hit or miss", mean, lo, d.max, d.rms,
+        (unsigned long long)d.differing, kSize * kSize);
     EXPECT_LT(lo, 0.9) << "the knot should occlude some of the ground";
     EXPECT_LE(d.max, kAoMax);
     EXPECT_LE(d.rms, kAoRms);
