@@ -160,7 +160,19 @@ def parse_gpu(text):
             queries[r[0]]["rms"] = r[5]
     if not gpu or not queries or any("rms" not in q for q in queries.values()):
         raise ParseError("vff-gpu-bench output lacks its GL_RENDERER, its queries or its AO table")
-    return {"gpu": gpu.group(1), "queries": queries}
+    result = {"gpu": gpu.group(1), "queries": queries}
+    # --sdf: the field's GLSL and a distance field's GLSL at equal memory, against the exact AO image.
+    _, found, sdf_text = text.partition("at equal memory; max and RMS against the exact image")
+    if found:
+        m = re.match(r" \(Embree\) on the 8-bit scale; CPU: the same image by the same method on (\d+) thread", sdf_text)
+        head = re.search(r"ground AO (\d+)x\d+, (\d+) rays/px, tmax 2 R, $", text[:len(text) - len(sdf_text) - len(found)])
+        rows = [r for r in md_rows(sdf_text) if len(r) == 6 and r[0] != "AO by"]
+        if not m or not head or len(rows) < 4:
+            raise ParseError("vff-gpu-bench --sdf output lacks its equal-memory AO table")
+        result["sdf"] = {"threads": int(m.group(1)), "size": int(head.group(1)), "spp": int(head.group(2)),
+                         "rows": [{"by": r[0], "memory": r[1], "gpu": r[2], "cpu": float(r[3]), "max": float(r[4]),
+                                   "rms": float(r[5])} for r in rows]}
+    return result
 
 
 def parse_scene(text):
@@ -358,6 +370,14 @@ def gpu_table(g):
     return lines
 
 
+def gpu_sdf_table(d):
+    lines = ["| AO by | memory | GPU frame, s | CPU, s | RMS against exact (8-bit) | max |",
+             "|---|---|---:|---:|---:|---:|"]
+    for r in d["rows"]:
+        lines.append(f"| {r['by']} | {r['memory']} | {r['gpu']} | {fmt(r['cpu'], 3)} | {r['rms']:.3f} | {r['max']:.0f} |")
+    return lines
+
+
 def scene_table(sc):
     lines = ["| moving instances | Embree instancing, ms/frame | vff::Scene, ms/frame | hybrid (Embree top level), "
              "ms/frame | vff::Scene / Embree speed-up | hybrid speed-up | answers equal to Embree's |",
@@ -434,6 +454,11 @@ def sections(machine, steps, heading, queries=None, only=None):
         renderer = steps["gpu"]["gpu"]
         soft = ": Mesa's software rasteriser, on the CPU" if "llvmpipe" in renderer else ""
         out += [f"{heading} GPU query ({renderer}{soft})", "", *gpu_table(steps["gpu"]), ""]
+        if "sdf" in steps["gpu"]:
+            d = steps["gpu"]["sdf"]
+            out += [f"{heading} GPU ground AO, field against a distance field at equal memory ({renderer}{soft}; "
+                    f"{d['size']}x{d['size']}, {d['spp']} rays/px; CPU baseline on {d['threads']} threads)", "",
+                    *gpu_sdf_table(d), ""]
     if "python" in steps:
         p = steps["python"]
         out += [f"{heading} Python and vff-query against the C++ batch ({p['rays']} ao rays, {p['reconstruction']}, "

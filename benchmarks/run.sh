@@ -12,7 +12,9 @@
 #   scene        vff-experiments scene-bench: 1 to 10000 moving instances, Embree instancing vs vff::Scene
 #   triangles    vff-experiments triangle-bench: time per ray from about 10k to 1M triangles
 #   compression  vff-compress --benchmark: the hits-med codec against zstd, xz and OpenEXR's
-#   gpu          vff-gpu-bench, where a headless OpenGL 4.3 context opens (it names the renderer)
+#   gpu          vff-gpu-bench, where a headless OpenGL 4.3 context opens (it names the renderer),
+#                with --sdf: the ground AO by the field's GLSL and by a distance field's GLSL at
+#                equal memory, against the exact image
 #   python       benchmarks/python_query.py, where the Python module is built: a million rays through
 #                vff-query (.npy in and out, end to end) and through the Python batch, each against
 #                the C++ batch on the same rays and field in the same run
@@ -137,7 +139,10 @@ want compression && step compression "$compress" --benchmark "$raw/field.vff" --
 if ! want gpu; then
   :
 elif [[ -x $gpubench ]]; then
-  skip_if="no headless OpenGL" step gpu "$gpubench" --field "$raw/field.vff" "${gpuargs[@]}"
+  # --sdf where the bench was built with the distance-field peer (its usage names the option).
+  gpusdf=()
+  if [[ $("$gpubench" --help 2>&1) == *--sdf* ]]; then gpusdf=(--mesh "$mesh" --sdf); fi
+  skip_if="no headless OpenGL" step gpu "$gpubench" --field "$raw/field.vff" "${gpusdf[@]}" "${gpuargs[@]}"
 else
   echo "vff-gpu-bench is not built (no OpenGL or EGL development files)" >"$raw/gpu.skip"
 fi

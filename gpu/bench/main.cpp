@@ -2,10 +2,13 @@
 // gpu/bench/ao_scene.h) on the GPU through gpu/glsl/vff_query.glsl, with the CPU FieldQuery on the
 // same rays in the same run as the baseline.
 //
-//   vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size 512] [--spp 256] [--threads N] [--scene N]
+//   vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size 512] [--spp 256] [--threads N] [--scene N] [--sdf]
 //
 // --scene N adds the scene benchmark (scene_bench.h): the ground AO under N instances of the field
 // through gpu/glsl/vff_scene.glsl against the CPU vff::Scene, and a frame's instance update.
+// --sdf adds the distance-field peer (sdf_bench.h): the same AO through gpu/glsl/vff_sdf.glsl at the
+// field's memory, both against the exact image (needs the mesh: with --field, --mesh must name the
+// mesh the field was baked from; built with the samples only).
 //
 // Without --field it bakes MESH (default /usr/share/glmark2/models/bunny.obj, else the procedural
 // torus knot) as samples/experiments does: octa-hemi2 n = 32 (4226 maps), 64 x 64, unorm8-diameter.
@@ -31,6 +34,9 @@
 #include "../../tests/gpu/egl_context.h"
 #include "ao_scene.h"
 #include "scene_bench.h"
+#ifdef VFF_GPU_BENCH_SDF
+#include "sdf_bench.h"
+#endif
 #include "vff/bake/baker.h"
 #include "vff/bake/mesh.h"
 #include "vff/bake/procedural.h"
@@ -106,7 +112,11 @@ void parallel(unsigned threads, size_t count, Fn&& fn) {
 }
 
 int usage() {
+#ifdef VFF_GPU_BENCH_SDF
+  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--threads N] [--scene N] [--sdf]\n");
+#else
   std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--threads N] [--scene N]\n");
+#endif
   return 1;
 }
 
@@ -116,6 +126,8 @@ struct BenchOptions {
   std::string fieldPath, meshPath = "/usr/share/glmark2/models/bunny.obj";
   int size = 512, spp = 256;
   int sceneInstances = 0;  // --scene N: also the scene benchmark with N instances
+  bool sdf = false;        // --sdf: also the distance-field peer at equal memory
+  bool meshGiven = false;  // --mesh was given
   unsigned threads = std::max(1u, std::thread::hardware_concurrency());
 };
 
@@ -132,12 +144,15 @@ int parseOptions(int argc, char** argv, BenchOptions* o) {
       o->fieldPath = v;
     } else if (a == "--mesh" && (v = next())) {
       o->meshPath = v;
+      o->meshGiven = true;
     } else if (a == "--size" && (v = next())) {
       o->size = std::atoi(v);
     } else if (a == "--spp" && (v = next())) {
       o->spp = std::atoi(v);
     } else if (a == "--scene" && (v = next())) {
       o->sceneInstances = std::atoi(v);
+    } else if (a == "--sdf") {
+      o->sdf = true;
     } else if (a == "--threads" && (v = next())) {
       o->threads = unsigned(std::max(1, std::atoi(v)));
     } else {
@@ -148,6 +163,16 @@ int parseOptions(int argc, char** argv, BenchOptions* o) {
     std::fprintf(stderr, "vff-gpu-bench: --scene takes a number of instances\n");
     return 1;
   }
+  if (o->sdf && !o->fieldPath.empty() && !o->meshGiven) {
+    std::fprintf(stderr, "vff-gpu-bench: error: --sdf with --field needs --mesh, the mesh the field was baked from\n");
+    return 1;
+  }
+#ifndef VFF_GPU_BENCH_SDF
+  if (o->sdf) {
+    std::fprintf(stderr, "vff-gpu-bench: error: --sdf: built without the samples (VFF_BUILD_SAMPLES), no distance field\n");
+    return 1;
+  }
+#endif
   if (o->size < 8 || o->size % 8 != 0 || o->spp < 1) {
     std::fprintf(stderr, "vff-gpu-bench: --size must be a positive multiple of 8 and --spp positive\n");
     return 1;
@@ -163,10 +188,10 @@ int fail(const vff::Error& e, int code) {
 }
 
 // Bakes MESH (or the procedural torus knot when it does not exist) as samples/experiments does, into
-// *file, with the ground height (the mesh's lowest point). Returns an exit code, 0 on success.
-int bakeField(const std::string& meshPath, vff::Result<vff::File>* file, float* groundY) {
+// *file (the mesh in *meshOut), with the ground height (the mesh's lowest point). Returns an exit code, 0 on success.
+int bakeField(const std::string& meshPath, vff::Result<vff::File>* file, float* groundY, vff::bake::Mesh* meshOut) {
   using namespace vff;
-  bake::Mesh mesh;
+  bake::Mesh& mesh = *meshOut;
   std::string name = meshPath;
   if (std::filesystem::exists(meshPath)) {
     auto m = bake::loadMesh(meshPath);
@@ -196,8 +221,13 @@ int bakeField(const std::string& meshPath, vff::Result<vff::File>* file, float* 
 }
 
 // --field's file, or the baked default, with the ground height. Returns an exit code, 0 on success.
-int openField(const BenchOptions& o, vff::Result<vff::File>* file, float* groundY) {
-  if (o.fieldPath.empty()) return bakeField(o.meshPath, file, groundY);
+int openField(const BenchOptions& o, vff::Result<vff::File>* file, float* groundY, vff::bake::Mesh* mesh) {
+  if (o.fieldPath.empty()) return bakeField(o.meshPath, file, groundY, mesh);
+  if (o.sdf) {  // the distance field's mesh
+    auto m = vff::bake::loadMesh(o.meshPath);
+    if (!m) return fail(m.error(), 2);
+    *mesh = std::move(*m);
+  }
   *file = vff::File::open(o.fieldPath);
   if (!*file) return fail(file->error(), 2);
   *groundY = (*file)->field().sphere.center[1] - (*file)->field().sphere.radius;
@@ -365,7 +395,8 @@ int main(int argc, char** argv) {
 
   Result<File> file = makeError(Code::kInvalidArgument, "no field");
   float groundY = 0;
-  if (const int code = openField(o, &file, &groundY); code != 0) return code;
+  bake::Mesh mesh;  // when baked
+  if (const int code = openField(o, &file, &groundY, &mesh); code != 0) return code;
   if (!file) return 4;
   const FieldDesc& f = file->field();
   std::printf("  %u maps, %ux%u, distance encoding %u, R = %g\n", f.mapCount, f.mapResolution, f.mapResolution,
@@ -391,6 +422,12 @@ int main(int argc, char** argv) {
     const gpubench::SceneBenchOptions so{.instances = o.sceneInstances, .size = o.size, .spp = o.spp, .threads = o.threads};
     if (const int code = gpubench::benchScene(*file, *cpu, groundY, so); code != 0) return code;
   }
+#ifdef VFF_GPU_BENCH_SDF
+  if (o.sdf) {
+    const gpubench::SdfBenchOptions so{.size = o.size, .spp = o.spp, .threads = o.threads};
+    if (const int code = gpubench::benchSdf(*file, *cpu, mesh, groundY, *gpu, aoProg, so); code != 0) return code;
+  }
+#endif
   glDeleteProgram(rayProg);
   glDeleteProgram(aoProg);
   if (glGetError() != GL_NO_ERROR) {

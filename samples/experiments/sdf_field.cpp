@@ -89,9 +89,9 @@ class Tracer {
       if (cone > 0) {
         // The share of the cone's disc left open, as a ramp over its radius at t: a half when the
         // axis grazes the surface; the trace goes on inside until the disc is covered.
-        *visibility = std::min(*visibility, 0.5f + 0.5f * d / (std::max(t * len, 1e-6f) * cone));
+        *visibility = std::min(*visibility, 0.5f + 0.5f * d / (std::max(t * len, kSdfConeMinDistance) * cone));
         // Deeper inside than the band reaches: the depth is unknown, and the disc taken as covered.
-        if (*visibility <= 0.0f || d <= -0.9f * band_) {
+        if (*visibility <= 0.0f || d <= -kSdfConeDepth * band_) {
           h.hit = true;
           h.t = t;
           *visibility = 0.0f;
@@ -130,7 +130,7 @@ class Tracer {
       const float bound = dir[a] > 0 ? base + float(dim) - 0.5f : base - 0.5f;
       exit = std::min(exit, (bound - org[a]) / dir[a]);
     }
-    return std::isfinite(exit) ? exit * (1.0f + 1e-6f) + 1e-6f : 0.0f;
+    return std::isfinite(exit) ? exit * (1.0f + kSdfSkipNudge) + kSdfSkipNudge : 0.0f;
   }
 
   // The unit world-space normal at index point p: the distance's central differences.
@@ -226,5 +226,8 @@ SdfValues SdfField::values() const { return impl_->values; }
 int SdfField::builds() const { return impl_->builds; }
 double SdfField::buildSeconds() const { return impl_->seconds; }
 float SdfField::bandVoxels() const { return impl_->band; }
+std::span<const uint8_t> SdfField::gridBuffer() const {
+  return {static_cast<const uint8_t*>(impl_->handle.data()), size_t(impl_->handle.size())};
+}
 
 }  // namespace vffx

@@ -55,6 +55,14 @@ enum class SdfValues : uint8_t { kFp8, kFloat };
 // The smallest budget a build accepts: a few bricks.
 inline constexpr uint64_t kSdfMinBudget = 4096;
 
+// Empty-space skipping lands a little past a block's exit, t * (1 + kSdfSkipNudge) + kSdfSkipNudge,
+// so that the next sample lies outside the block. Also the GLSL tracer's (gpu/glsl/vff_sdf.glsl).
+inline constexpr float kSdfSkipNudge = 1e-6f;
+// The cone estimate takes a sample deeper inside than this share of the band as covered, and
+// divides by the cone's radius at t, t (in voxels) no less than kSdfConeMinDistance.
+inline constexpr float kSdfConeDepth = 0.9f;
+inline constexpr float kSdfConeMinDistance = 1e-6f;
+
 struct SdfBuildOptions {
   uint64_t budgetBytes = 1u << 20;  // bytes() at most; kSdfMinBudget at least
   SdfValues values = SdfValues::kFp8;
@@ -110,6 +118,9 @@ class SdfField {
   int builds() const;           // meshToVolume runs the budget search took
   double buildSeconds() const;
   float bandVoxels() const;
+  // The NanoVDB grid's bytes (one grid, object space; values(): nanovdb::Fp8 or float), as a GPU
+  // tracer reads them (gpu/sdf/sdf_gl.h); valid as long as this field.
+  std::span<const uint8_t> gridBuffer() const;
 
   struct Impl;
 
