@@ -78,14 +78,15 @@ if ((quick)); then
   benchargs=(--config 290x16x16 --bench-rays 20000 --repeat 1) bakerepeat=1 compressrepeat=1
   sceneargs=(--config 290x16x16 --instances 1 10 --scene-rays 4096 --frames 1)
   triangleargs=(--config 290x16x16 --bench-rays 4096 --min-triangles 500 --max-triangles 8000 --repeat 1)
-  gpuargs=(--size 64 --spp 4) pyargs=(--quick)
+  gpuargs=(--size 64 --spp 4) gpusdfargs=() pyargs=(--quick)
   sdfargs=(--config 290x16x16 --bench-rays 20000 --repeat 1)
 else
   # The paper's configuration: octa-hemi2 n = 32 (4226 maps) of 64 x 64, unorm8-diameter.
   config=(-n 32 -m 64) field=4226x64x64 expargs=()
   benchargs=(--repeat 5) bakerepeat=3 compressrepeat=3
   sceneargs=(--frames 5) triangleargs=(--repeat 5)
-  gpuargs=() pyargs=()
+  # The distance field's GLSL at a quarter of the pixels and rays (sphere tracing on llvmpipe).
+  gpuargs=() gpusdfargs=(--sdf-size 256 --sdf-spp 64) pyargs=()
   # shellcheck disable=SC2206  # the memory list is words
   sdfargs=(--repeat 3 --sdf-memory $sdfmemory)
 fi
@@ -141,7 +142,7 @@ if ! want gpu; then
 elif [[ -x $gpubench ]]; then
   # --sdf where the bench was built with the distance-field peer (its usage names the option).
   gpusdf=()
-  if [[ $("$gpubench" --help 2>&1) == *--sdf* ]]; then gpusdf=(--mesh "$mesh" --sdf); fi
+  if [[ $("$gpubench" --help 2>&1) == *--sdf* ]]; then gpusdf=(--mesh "$mesh" --sdf "${gpusdfargs[@]}"); fi
   skip_if="no headless OpenGL" step gpu "$gpubench" --field "$raw/field.vff" "${gpusdf[@]}" "${gpuargs[@]}"
 else
   echo "vff-gpu-bench is not built (no OpenGL or EGL development files)" >"$raw/gpu.skip"

@@ -2,13 +2,16 @@
 // gpu/bench/ao_scene.h) on the GPU through gpu/glsl/vff_query.glsl, with the CPU FieldQuery on the
 // same rays in the same run as the baseline.
 //
-//   vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size 512] [--spp 256] [--threads N] [--scene N] [--sdf]
+//   vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size 512] [--spp 256] [--threads N] [--scene N]
+//                 [--sdf [--sdf-size N] [--sdf-spp N]]
 //
 // --scene N adds the scene benchmark (scene_bench.h): the ground AO under N instances of the field
 // through gpu/glsl/vff_scene.glsl against the CPU vff::Scene, and a frame's instance update.
 // --sdf adds the distance-field peer (sdf_bench.h): the same AO through gpu/glsl/vff_sdf.glsl at the
 // field's memory, both against the exact image (needs the mesh: with --field, --mesh must name the
-// mesh the field was baked from; built with the samples only).
+// mesh the field was baked from; built with the samples only), rendered at --sdf-size with --sdf-spp
+// rays per pixel (default: --size and --spp; sphere tracing on a software renderer takes minutes
+// at the full size).
 //
 // Without --field it bakes MESH (default /usr/share/glmark2/models/bunny.obj, else the procedural
 // torus knot) as samples/experiments does: octa-hemi2 n = 32 (4226 maps), 64 x 64, unorm8-diameter.
@@ -113,7 +116,7 @@ void parallel(unsigned threads, size_t count, Fn&& fn) {
 
 int usage() {
 #ifdef VFF_GPU_BENCH_SDF
-  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--threads N] [--scene N] [--sdf]\n");
+  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--threads N] [--scene N] [--sdf [--sdf-size N] [--sdf-spp N]]\n");
 #else
   std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--threads N] [--scene N]\n");
 #endif
@@ -127,6 +130,7 @@ struct BenchOptions {
   int size = 512, spp = 256;
   int sceneInstances = 0;  // --scene N: also the scene benchmark with N instances
   bool sdf = false;        // --sdf: also the distance-field peer at equal memory
+  int sdfSize = 0, sdfSpp = 0;  // its image and rays per pixel (0: --size and --spp)
   bool meshGiven = false;  // --mesh was given
   unsigned threads = std::max(1u, std::thread::hardware_concurrency());
 };
@@ -153,6 +157,10 @@ int parseOptions(int argc, char** argv, BenchOptions* o) {
       o->sceneInstances = std::atoi(v);
     } else if (a == "--sdf") {
       o->sdf = true;
+    } else if (a == "--sdf-size" && (v = next())) {
+      o->sdfSize = std::atoi(v);
+    } else if (a == "--sdf-spp" && (v = next())) {
+      o->sdfSpp = std::atoi(v);
     } else if (a == "--threads" && (v = next())) {
       o->threads = unsigned(std::max(1, std::atoi(v)));
     } else {
@@ -173,8 +181,10 @@ int parseOptions(int argc, char** argv, BenchOptions* o) {
     return 1;
   }
 #endif
-  if (o->size < 8 || o->size % 8 != 0 || o->spp < 1) {
-    std::fprintf(stderr, "vff-gpu-bench: --size must be a positive multiple of 8 and --spp positive\n");
+  if (o->sdfSize == 0) o->sdfSize = o->size;
+  if (o->sdfSpp == 0) o->sdfSpp = o->spp;
+  if (o->size < 8 || o->size % 8 != 0 || o->spp < 1 || o->sdfSize < 8 || o->sdfSize % 8 != 0 || o->sdfSpp < 1) {
+    std::fprintf(stderr, "vff-gpu-bench: --size and --sdf-size must be positive multiples of 8, --spp and --sdf-spp positive\n");
     return 1;
   }
   return -1;
@@ -424,7 +434,7 @@ int main(int argc, char** argv) {
   }
 #ifdef VFF_GPU_BENCH_SDF
   if (o.sdf) {
-    const gpubench::SdfBenchOptions so{.size = o.size, .spp = o.spp, .threads = o.threads};
+    const gpubench::SdfBenchOptions so{.size = o.sdfSize, .spp = o.sdfSpp, .threads = o.threads};
     if (const int code = gpubench::benchSdf(*file, *cpu, mesh, groundY, *gpu, aoProg, so); code != 0) return code;
   }
 #endif
