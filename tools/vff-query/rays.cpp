@@ -195,27 +195,6 @@ std::optional<std::string> parseColumns(std::string_view list, std::vector<Colum
 
 namespace {
 
-// Every column's value of answer i as a .npy float (kColumns order).
-void rowValues(const Answers& a, size_t i, float* v) {
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  const QueryHit& h = a.hits[i];
-  v[0] = h.hit ? 1.0f : 0.0f;
-  v[1] = h.t;
-  v[2] = h.hit ? h.point.x : nan;
-  v[3] = h.hit ? h.point.y : nan;
-  v[4] = h.hit ? h.point.z : nan;
-  v[5] = h.hasNormal ? h.normal.x : nan;
-  v[6] = h.hasNormal ? h.normal.y : nan;
-  v[7] = h.hasNormal ? h.normal.z : nan;
-  v[8] = h.inside ? 1.0f : 0.0f;
-  // (sample indices stay below 2^24, so float32 holds them exactly)
-  const LookupSite s = a.sites.empty() ? LookupSite{} : a.sites[i];
-  v[9] = s.valid ? float(s.sample) : -1.0f;
-  v[10] = s.valid ? float(s.i) : -1.0f;
-  v[11] = s.valid ? float(s.j) : -1.0f;
-  v[12] = a.visibility.empty() ? 1.0f : a.visibility[i];
-}
-
 // One CSV field of answer i.
 void appendCsv(std::string& out, const Answers& a, size_t i, Column c) {
   const QueryHit& h = a.hits[i];
@@ -240,14 +219,35 @@ void appendCsv(std::string& out, const Answers& a, size_t i, Column c) {
 }  // namespace
 
 void answerRows(const Answers& a, float* rows) {
-  const size_t cols = a.columns.size();
-  uint8_t pick[kAllColumns];
-  for (size_t c = 0; c < cols; ++c) pick[c] = uint8_t(a.columns[c]);
-  for (size_t i = 0; i < a.hits.size(); ++i) {
-    float v[kAllColumns];
-    rowValues(a, i, v);
-    float* r = rows + i * cols;
-    for (size_t c = 0; c < cols; ++c) r[c] = v[pick[c]];
+  // Column by column, each a loop of its own: a run asks for a few columns or all of them, and
+  // each loop does one column's work only.
+  const size_t cols = a.columns.size(), n = a.hits.size();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  auto fill = [&](size_t c, auto value) {
+    for (size_t i = 0; i < n; ++i) rows[i * cols + c] = value(a.hits[i], i);
+  };
+  auto site = [&](size_t i) { return a.sites.empty() ? LookupSite{} : a.sites[i]; };
+  // (sample indices stay below 2^24, so float32 holds them exactly)
+  for (size_t c = 0; c < cols; ++c) {
+    switch (a.columns[c]) {
+      case Column::kHit: fill(c, [](const QueryHit& h, size_t) { return h.hit ? 1.0f : 0.0f; }); break;
+      case Column::kT: fill(c, [](const QueryHit& h, size_t) { return h.t; }); break;
+      case Column::kX: fill(c, [&](const QueryHit& h, size_t) { return h.hit ? h.point.x : nan; }); break;
+      case Column::kY: fill(c, [&](const QueryHit& h, size_t) { return h.hit ? h.point.y : nan; }); break;
+      case Column::kZ: fill(c, [&](const QueryHit& h, size_t) { return h.hit ? h.point.z : nan; }); break;
+      case Column::kNx: fill(c, [&](const QueryHit& h, size_t) { return h.hasNormal ? h.normal.x : nan; }); break;
+      case Column::kNy: fill(c, [&](const QueryHit& h, size_t) { return h.hasNormal ? h.normal.y : nan; }); break;
+      case Column::kNz: fill(c, [&](const QueryHit& h, size_t) { return h.hasNormal ? h.normal.z : nan; }); break;
+      case Column::kInside: fill(c, [](const QueryHit& h, size_t) { return h.inside ? 1.0f : 0.0f; }); break;
+      case Column::kSample:
+        fill(c, [&](const QueryHit&, size_t i) { return site(i).valid ? float(site(i).sample) : -1.0f; });
+        break;
+      case Column::kI: fill(c, [&](const QueryHit&, size_t i) { return site(i).valid ? float(site(i).i) : -1.0f; }); break;
+      case Column::kJ: fill(c, [&](const QueryHit&, size_t i) { return site(i).valid ? float(site(i).j) : -1.0f; }); break;
+      case Column::kVisibility:
+        fill(c, [&](const QueryHit&, size_t i) { return a.visibility.empty() ? 1.0f : a.visibility[i]; });
+        break;
+    }
   }
 }
 
