@@ -463,8 +463,8 @@ def sections(machine, steps, heading, queries=None, only=None):
         p = steps["python"]
         out += [f"{heading} Python and vff-query against the C++ batch ({p['rays']} ao rays, {p['reconstruction']}, "
                 f"{p['threads']} threads)", "", *python_table(p), "",
-                "Each ratio: the path's rate over the C++ batch's (FieldQuery::intersect on the same rays and field, "
-                "warm, answers dropped), each the best of its runs, taken alternately in the same run.", ""]
+                "Each ratio: the path's rate over the first row's (the C++ batch, FieldQuery::intersect on the same "
+                "rays and field, warm), each the best of its runs, taken alternately in the same run.", ""]
     if "library" in steps:
         out += [f"{heading} Library bake (vff-library against the same bakes one after another)", "",
                 *library_table(steps["library"]), ""]
