@@ -35,6 +35,7 @@
 #include <vector>
 
 #include "../../tests/gpu/egl_context.h"
+#include "ao_gl.h"
 #include "ao_scene.h"
 #include "scene_bench.h"
 #ifdef VFF_GPU_BENCH_SDF
@@ -45,37 +46,6 @@
 #include "vff/bake/procedural.h"
 #include "vff/gl/loader.h"
 #include "vff/vff.h"
-
-namespace vff::gpubench {
-
-// (scene_bench.h)
-double renderGpuAo(const AoScene& s, int spp, int interp, unsigned imageBuffer, std::vector<float>* image) {
-  const int size = s.size;
-  glUniform1i(0, size);
-  glUniform1i(1, spp);
-  glUniform1i(2, interp);
-  glUniform1f(3, s.eps);
-  glUniform1f(4, s.tmax);
-  // A warm-up dispatch (drivers such as llvmpipe compile the shader at its first use), then
-  // bands of 64 rows per dispatch (keeps single dispatches short on slow drivers).
-  glUniform1i(5, 0);
-  glDispatchCompute(1, 1, 1);
-  glFinish();
-  const auto t0 = std::chrono::steady_clock::now();
-  for (int row = 0; row < size; row += 64) {
-    glUniform1i(5, row);
-    glDispatchCompute(GLuint(size / 8), GLuint(std::min(64, size - row) / 8), 1);
-  }
-  glFinish();
-  const double gpuS = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  image->assign(size_t(size) * size, 0.0f);
-  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, imageBuffer);
-  glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(image->size() * 4), image->data());
-  return gpuS;
-}
-
-}  // namespace vff::gpubench
 
 namespace {
 
@@ -360,15 +330,7 @@ void benchAo(const vff::FieldDesc& f, float groundY, const vff::gl::GpuField& gp
   using namespace vff;
   const int size = o.size, spp = o.spp;
   const gpubench::AoScene s = gpubench::makeAoScene(f, groundY, size);
-  GLuint bufs[3];
-  glGenBuffers(3, bufs);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[0]);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(s.gbuffer.size() * 4), s.gbuffer.data(), GL_STATIC_DRAW);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(s.directions.size() * 4), s.directions.data(), GL_STATIC_DRAW);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[2]);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(size_t(size) * size * 4), nullptr, GL_STREAM_READ);
-  for (int b = 0; b < 3; ++b) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, GLuint(5 + b), bufs[b]);
+  const gpubench::AoBuffers aoBuffers(s);
   gpu.bind();
   glUseProgram(aoProg);
   std::printf("\nground AO %dx%d, %d rays/px (%.3g rays), tmax 2 R; GPU vs CPU image on the 8-bit scale\n", size, size,
@@ -376,7 +338,7 @@ void benchAo(const vff::FieldDesc& f, float groundY, const vff::gl::GpuField& gp
   std::printf("| query | GPU s | CPU s | GPU/CPU | max | RMS |\n|---|---|---|---|---|---|\n");
   for (int interp = 0; interp < 2; ++interp) {
     std::vector<float> g;
-    const double gpuS = gpubench::renderGpuAo(s, spp, interp, bufs[2], &g);
+    const double gpuS = gpubench::renderAo(s, aoBuffers, spp, interp, &g);
     const auto c0 = Clock::now();
     const std::vector<float> cimg =
         gpubench::cpuAo(cpu, s, spp, interp ? Reconstruction::kInterpolated : Reconstruction::kNearest, o.threads);
@@ -386,7 +348,6 @@ void benchAo(const vff::FieldDesc& f, float groundY, const vff::gl::GpuField& gp
                 cpuS, cpuS / gpuS, d.max, d.rms);
     std::fflush(stdout);
   }
-  glDeleteBuffers(3, bufs);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // scene_bench.cpp - vff-gpu-bench --scene N (scene_bench.h): N instances of the field on a grid over
 // the ground, turned and scaled at random; the ground AO of the scene on the GPU (vff_scene.glsl)
 // against the CPU vff::Scene's batch visibility, and a frame's instance update on both sides.
+#include "ao_gl.h"
 #include "scene_bench.h"
 
 #include <GL/glcorearb.h>
@@ -89,19 +90,12 @@ int benchScene(const File& file, const FieldQuery& cpu, float groundY, const Sce
     std::fprintf(stderr, "vff-gpu-bench: scene shader: %s\n", log.c_str());
     return 4;
   }
-  GLuint bufs[3];
-  glGenBuffers(3, bufs);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[0]);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(ao.gbuffer.size() * 4), ao.gbuffer.data(), GL_STATIC_DRAW);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(ao.directions.size() * 4), ao.directions.data(), GL_STATIC_DRAW);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[2]);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(size_t(o.size) * o.size * 4), nullptr, GL_STREAM_READ);
+  const AoBuffers aoBuffers(ao);
   gl::SceneBindings b;
   b.instances = 10;
   b.nodes = 11;
   gpu->bind(b);
-  for (int i = 0; i < 3; ++i) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, GLuint(5 + i), bufs[i]);
+  aoBuffers.bind();
   glUseProgram(prog);
   std::printf("\nscene: %d instances of the field on a %dx%d grid; a frame moves all of them: CPU commit %.3g ms, "
               "GPU update %.3g ms (mean of %d)\n",
@@ -111,7 +105,7 @@ int benchScene(const File& file, const FieldQuery& cpu, float groundY, const Sce
   std::printf("| query | GPU s | CPU s | GPU/CPU | mean AO | max | RMS |\n|---|---|---|---|---|---|---|\n");
   for (int interp = 0; interp < 2; ++interp) {
     std::vector<float> g;
-    const double gpuS = renderGpuAo(ao, o.spp, interp, bufs[2], &g);
+    const double gpuS = renderAo(ao, aoBuffers, o.spp, interp, &g);
     const auto c0 = Clock::now();
     const std::vector<float> c =
         cpuAo(scene, ao, o.spp, interp ? Reconstruction::kInterpolated : Reconstruction::kNearest, o.threads);
@@ -124,7 +118,6 @@ int benchScene(const File& file, const FieldQuery& cpu, float groundY, const Sce
                 interp ? "interpolated visibility" : "nearest occluded", gpuS, cpuS, cpuS / gpuS, mean, d.max, d.rms);
     std::fflush(stdout);
   }
-  glDeleteBuffers(3, bufs);
   glDeleteProgram(prog);
   return glGetError() == GL_NO_ERROR ? 0 : 4;
 }

@@ -18,10 +18,6 @@ struct SceneBenchOptions {
   unsigned threads = 1;
 };
 
-// Runs the AO shader program in use (uniforms as kAoShader's; buffers bound at 5, 6, 7) over the
-// scene's pixels in bands; the image in *image; returns the seconds of the dispatches (main.cpp).
-double renderGpuAo(const AoScene& s, int spp, int interp, unsigned imageBuffer, std::vector<float>* image);
-
 // Prints the scene's table; returns an exit code (0, or 4 for a GL or shader failure).
 int benchScene(const File& file, const FieldQuery& cpu, float groundY, const SceneBenchOptions& o);
 

@@ -14,6 +14,7 @@
 #include "../../tests/common/embree_reference.h"
 #include "../../tests/gpu/egl_context.h"
 #include "common.h"  // samples/experiments: the AO experiments' distance-field options
+#include "ao_gl.h"
 #include "scene_bench.h"
 #include "sdf_ao.h"
 #include "sdf_gl.h"
@@ -73,15 +74,7 @@ int benchSdf(const File& file, const FieldQuery& cpu, const bake::Mesh& mesh, fl
 
   const int size = o.size, spp = o.spp;
   const AoScene s = makeAoScene(f, groundY, size);
-  GLuint bufs[3];
-  glGenBuffers(3, bufs);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[0]);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(s.gbuffer.size() * 4), s.gbuffer.data(), GL_STATIC_DRAW);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(s.directions.size() * 4), s.directions.data(), GL_STATIC_DRAW);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[2]);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(size_t(size) * size * 4), nullptr, GL_STREAM_READ);
-  for (int b = 0; b < 3; ++b) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, GLuint(5 + b), bufs[b]);
+  const AoBuffers aoBuffers(s);
   gpuField.bind();
   gpuSdf->bind();
 
@@ -99,7 +92,7 @@ int benchSdf(const File& file, const FieldQuery& cpu, const bake::Mesh& mesh, fl
   glUseProgram(fieldProgram);
   for (int interp = 0; interp < 2; ++interp) {
     std::vector<float> g;
-    const double gpuS = renderGpuAo(s, spp, interp, bufs[2], &g);
+    const double gpuS = renderAo(s, aoBuffers, spp, interp, &g);
     c0 = Clock::now();
     (void)cpuAo(cpu, s, spp, interp ? Reconstruction::kInterpolated : Reconstruction::kNearest, o.threads);
     const double cpuS = secondsSince(c0);
@@ -120,7 +113,7 @@ int benchSdf(const File& file, const FieldQuery& cpu, const bake::Mesh& mesh, fl
     }
     gpuSdf->bind();
     std::vector<float> g;
-    const double gpuS = renderGpuAo(s, spp, cone ? 1 : 0, bufs[2], &g);
+    const double gpuS = renderAo(s, aoBuffers, spp, cone ? 1 : 0, &g);
     c0 = Clock::now();
     (void)cpuAo(SdfAoQuery{&sdf, so}, s, spp, Reconstruction::kNearest, o.threads);
     const double cpuS = secondsSince(c0);
@@ -130,7 +123,6 @@ int benchSdf(const File& file, const FieldQuery& cpu, const bake::Mesh& mesh, fl
                 d.rms);
     std::fflush(stdout);
   }
-  glDeleteBuffers(3, bufs);
   glDeleteProgram(sdfProgram);
   if (const GLenum e = glGetError(); e != GL_NO_ERROR) {
     std::fprintf(stderr, "vff-gpu-bench: error: --sdf: GL error 0x%04x\n", unsigned(e));

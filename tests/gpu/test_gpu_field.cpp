@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "../../gpu/bench/ao_gl.h"
 #include "../../gpu/bench/ao_scene.h"
 #include "baked_fields.h"
 #include "egl_context.h"
@@ -306,30 +307,13 @@ TEST(GpuAo, GroundAoMatchesCpu) {
   ASSERT_TRUE(cpu.ok());
   const GLuint prog = buildProgram("", gpubench::kAoShader);
   ASSERT_NE(prog, 0u);
-  GLuint bufs[3];
-  glGenBuffers(3, bufs);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[0]);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(s.gbuffer.size() * 4), s.gbuffer.data(), GL_STATIC_DRAW);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(s.directions.size() * 4), s.directions.data(), GL_STATIC_DRAW);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[2]);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(kSize * kSize * 4), nullptr, GL_STREAM_READ);
-  for (int b = 0; b < 3; ++b) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, GLuint(5 + b), bufs[b]);
+  const gpubench::AoBuffers aoBuffers(s);
   gpu->bind();
   glUseProgram(prog);
   for (Reconstruction r : {Reconstruction::kNearest, Reconstruction::kInterpolated}) {
     const bool interp = r == Reconstruction::kInterpolated;
-    glUniform1i(0, kSize);
-    glUniform1i(1, kRays);
-    glUniform1i(2, interp ? 1 : 0);
-    glUniform1f(3, s.eps);
-    glUniform1f(4, s.tmax);
-    glUniform1i(5, 0);
-    glDispatchCompute(kSize / 8, kSize / 8, 1);
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    std::vector<float> g(size_t(kSize) * kSize);
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[2]);
-    glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(g.size() * 4), g.data());
+    std::vector<float> g;
+    (void)gpubench::renderAo(s, aoBuffers, kRays, interp ? 1 : 0, &g);
     const std::vector<float> c = gpubench::cpuAo(*cpu, s, kRays, r, 2);
     const gpubench::AoDiff d = gpubench::compareAo(c, g);
     double mean = 0;
@@ -345,7 +329,6 @@ TEST(GpuAo, GroundAoMatchesCpu) {
     EXPECT_LE(d.rms, interp ? 0.1 : 0.25);
     EXPECT_LT(mean, 0.99);  // the object does occlude the ground
   }
-  glDeleteBuffers(3, bufs);
   glDeleteProgram(prog);
   EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
 }

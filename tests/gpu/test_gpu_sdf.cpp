@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "../../gpu/bench/ao_gl.h"
 #include "../../gpu/bench/sdf_ao.h"
 #include "common.h"  // samples/experiments: the AO experiments' cone options
 #include "egl_context.h"
@@ -266,31 +267,14 @@ TEST(GpuSdf, GroundAoMatchesCpu) {
       vff::gpubench::sdfAoShaderSource(sdf, vff::test::readGlsl("vff_query.glsl"), vff::test::readGlsl("vff_sdf.glsl")),
       &log);
   ASSERT_NE(prog, 0u) << log;
-  GLuint bufs[3];
-  glGenBuffers(3, bufs);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[0]);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(s.gbuffer.size() * 4), s.gbuffer.data(), GL_STATIC_DRAW);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(s.directions.size() * 4), s.directions.data(), GL_STATIC_DRAW);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[2]);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(kSize * kSize * 4), nullptr, GL_STREAM_READ);
-  for (int b = 0; b < 3; ++b) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, GLuint(5 + b), bufs[b]);
+  const vff::gpubench::AoBuffers aoBuffers(s);
   for (const bool cone : {false, true}) {
     const vffx::SdfTraceOptions so = vffx::sdfOptions(cone, false, vffx::hemisphereConeTan(kRays));
     ASSERT_TRUE(gpu->setTraceOptions(so));
     gpu->bind();
     glUseProgram(prog);
-    glUniform1i(0, kSize);
-    glUniform1i(1, kRays);
-    glUniform1i(2, cone ? 1 : 0);
-    glUniform1f(3, s.eps);
-    glUniform1f(4, s.tmax);
-    glUniform1i(5, 0);
-    glDispatchCompute(kSize / 8, kSize / 8, 1);
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    std::vector<float> g(size_t(kSize) * kSize);
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[2]);
-    glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(g.size() * 4), g.data());
+    std::vector<float> g;
+    (void)vff::gpubench::renderAo(s, aoBuffers, kRays, cone ? 1 : 0, &g);
     ASSERT_EQ(glGetError(), GLenum(GL_NO_ERROR));
     const std::vector<float> c =
         vff::gpubench::cpuAo(vff::gpubench::SdfAoQuery{&sdf, so}, s, kRays, vff::Reconstruction::kNearest, 2);
@@ -307,7 +291,6 @@ TEST(GpuSdf, GroundAoMatchesCpu) {
     EXPECT_LE(d.max, kAoMax);
     EXPECT_LE(d.rms, kAoRms);
   }
-  glDeleteBuffers(3, bufs);
   glDeleteProgram(prog);
 }
 
