@@ -81,7 +81,11 @@ def main():
         base = [a.query, a.field, "-i", rays, "-j", str(a.threads), *extra]
         cmd = base + ["-o", out]
         for _ in range(a.repeat):
+            # os.sync() after each run that writes a file, outside the timed parts: the kernel then
+            # writes the dirty pages back now, not in the background during the next measurement
+            # (on a machine of few cores that stole a share of the next path's time).
             r = subprocess.run(cmd + ["--timing"], capture_output=True, text=True, check=True)
+            os.sync()
             m = re.search(r"batch, answers kept, warm: [0-9.]+ s \(([0-9.]+) Mrays/s\)", r.stderr)
             best["cpp"] = max(best["cpp"], float(m.group(1)))
             m = re.search(r"batch alone, warm: [0-9.]+ s \(([0-9.]+) Mrays/s\)", r.stderr)
@@ -89,12 +93,15 @@ def main():
             t0 = time.perf_counter()
             subprocess.run(cmd, check=True)
             best["cli"] = max(best["cli"], a.rays / 1e6 / (time.perf_counter() - t0))
+            os.sync()
             t0 = time.perf_counter()
             subprocess.run(base + ["--no-sites", "-o", out_nosites], check=True)
             best["nosites"] = max(best["nosites"], a.rays / 1e6 / (time.perf_counter() - t0))
+            os.sync()
             t0 = time.perf_counter()
             subprocess.run(base + ["--columns", "hit,t", "-o", out_hitt], check=True)
             best["hitt"] = max(best["hitt"], a.rays / 1e6 / (time.perf_counter() - t0))
+            os.sync()
             # The floor under vff-query's I/O: read the rays file and write as many bytes as its
             # answers (12 float32 columns), through the page cache, and nothing else.
             t0 = time.perf_counter()
@@ -104,6 +111,7 @@ def main():
                 fout.write(answer_bytes)
             best["floor"] = max(best["floor"], a.rays / 1e6 / (time.perf_counter() - t0))
             os.remove(floor_out)
+            os.sync()
             t0 = time.perf_counter()
             h = q.intersect(o, d, interpolated=a.interpolated, threads=a.threads)
             best["py"] = max(best["py"], a.rays / 1e6 / (time.perf_counter() - t0))
