@@ -161,10 +161,12 @@ void main() {
 }
 )";
 
-// |a - b| on the 8-bit scale (round(255 clamp(v)), as samples/experiments' PNGs).
+// |a - b| on the 8-bit scale (round(255 clamp(v)), as samples/experiments' PNGs), and the mean
+// and least AO of a (the reference image: whether the objects occlude the ground at all).
 struct AoDiff {
   double max = 0, rms = 0;
   uint64_t differing = 0;
+  double meanA = 0, minA = 1;
 };
 inline AoDiff compareAo(const std::vector<float>& a, const std::vector<float>& b) {
   AoDiff d;
@@ -176,7 +178,9 @@ inline AoDiff compareAo(const std::vector<float>& a, const std::vector<float>& b
     sum += e * e;
     d.differing += e > 0;
   }
+  for (float v : a) d.meanA += v, d.minA = std::min(d.minA, double(v));
   d.rms = a.empty() ? 0.0 : std::sqrt(sum / double(a.size()));
+  d.meanA = a.empty() ? 0.0 : d.meanA / double(a.size());
   return d;
 }
 

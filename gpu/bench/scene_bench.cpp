@@ -111,11 +111,8 @@ int benchScene(const File& file, const FieldQuery& cpu, float groundY, const Sce
         cpuAo(scene, ao, o.spp, interp ? Reconstruction::kInterpolated : Reconstruction::kNearest, o.threads);
     const double cpuS = seconds(c0, Clock::now());
     const AoDiff d = compareAo(c, g);
-    double mean = 0;
-    for (float v : c) mean += v;
-    mean /= double(std::max<size_t>(1, c.size()));
     std::printf("| %s | %.2f | %.2f | %.2f | %.4f | %.0f | %.4f |\n",
-                interp ? "interpolated visibility" : "nearest occluded", gpuS, cpuS, cpuS / gpuS, mean, d.max, d.rms);
+                interp ? "interpolated visibility" : "nearest occluded", gpuS, cpuS, cpuS / gpuS, d.meanA, d.max, d.rms);
     std::fflush(stdout);
   }
   glDeleteProgram(prog);

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "baked_fields.h"
+#include "dispatch.h"
 #include "egl_context.h"
 #include "vff/bake/baker.h"
 #include "vff/bake/procedural.h"
@@ -99,22 +100,9 @@ std::string buildProgram(const File& file, GLuint* program) {
 
 // Runs the rays through the shader.
 std::vector<GpuOut> runGpu(const gl::GpuField& field, GLuint program, const std::vector<GpuRay>& rays) {
-  GLuint bufs[2];
-  glGenBuffers(2, bufs);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[0]);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(rays.size() * sizeof(GpuRay)), rays.data(), GL_STATIC_DRAW);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
-  std::vector<GpuOut> out(rays.size());
-  glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(out.size() * sizeof(GpuOut)), nullptr, GL_STREAM_READ);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bufs[0]);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, bufs[1]);
   field.bind();
   glUseProgram(program);
-  glDispatchCompute(GLuint((rays.size() + 63) / 64), 1, 1);
-  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
-  glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(out.size() * sizeof(GpuOut)), out.data());
-  glDeleteBuffers(2, bufs);
+  std::vector<GpuOut> out = test::dispatchRays<GpuOut>(std::span<const GpuRay>(rays), rays.size(), 1, 3, 4);
   EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
   return out;
 }
