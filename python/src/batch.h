@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #include "arrays.h"
@@ -183,24 +184,28 @@ inline Hits hitsFor(const py::object& out, size_t count) {
   return h;
 }
 
-template <class Target>
-Hits intersectBatch(const Target& target, const RayBatch& b, const py::object& reuse) {
-  Hits h = hitsFor(reuse, b.n);
+// Answers the batch into h: Hit is QueryHit (a FieldQuery's or an Instance's answers) or SceneHit (a
+// Scene's, whose instance ids go to h.instance).
+template <class Hit, class Target>
+Hits fillHits(const Target& target, const RayBatch& b, Hits h) {
   bool* hit = h.hit.mutable_data();
   float* t = h.t.mutable_data();
   float* point = h.point.mutable_data();
   float* normal = h.normal.mutable_data();
   bool* inside = h.inside.mutable_data();
+  int32_t* instance = nullptr;
+  if constexpr (std::is_same_v<Hit, SceneHit>) instance = h.instance.template cast<py::array_t<int32_t>>().mutable_data();
   const QueryOptions qo = b.options;
   parallel(b, [&](size_t first, std::span<const Ray> rays) {
-    thread_local std::vector<QueryHit> out;
+    thread_local std::vector<Hit> out;
     out.resize(rays.size());
-    target.intersect(rays, out, qo);
+    (void)target.intersect(rays, out, qo);
     const float nan = std::numeric_limits<float>::quiet_NaN();
     for (size_t k = 0; k < rays.size(); ++k) {
-      const QueryHit& q = out[k];
+      const Hit& q = out[k];
       const size_t i = first + k;
       hit[i] = q.hit, t[i] = q.t, inside[i] = q.inside;
+      if constexpr (std::is_same_v<Hit, SceneHit>) instance[i] = q.instance == kNoInstance ? -1 : int32_t(q.instance);
       float* p = point + 3 * i;
       float* nm = normal + 3 * i;
       p[0] = q.hit ? q.point.x : nan, p[1] = q.hit ? q.point.y : nan, p[2] = q.hit ? q.point.z : nan;
@@ -208,6 +213,11 @@ Hits intersectBatch(const Target& target, const RayBatch& b, const py::object& r
     }
   });
   return h;
+}
+
+template <class Target>
+Hits intersectBatch(const Target& target, const RayBatch& b, const py::object& reuse) {
+  return fillHits<QueryHit>(target, b, hitsFor(reuse, b.n));
 }
 
 template <class Target>

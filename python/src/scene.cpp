@@ -56,31 +56,7 @@ Hits sceneHitsFor(const py::object& out, size_t count) {
 }
 
 Hits sceneIntersect(const Scene& scene, const RayBatch& b, const py::object& reuse) {
-  Hits h = sceneHitsFor(reuse, b.n);
-  bool* hit = h.hit.mutable_data();
-  float* t = h.t.mutable_data();
-  float* point = h.point.mutable_data();
-  float* normal = h.normal.mutable_data();
-  bool* inside = h.inside.mutable_data();
-  int32_t* instance = h.instance.cast<py::array_t<int32_t>>().mutable_data();
-  const QueryOptions qo = b.options;
-  parallel(b, [&](size_t first, std::span<const Ray> rays) {
-    thread_local std::vector<SceneHit> out;
-    out.resize(rays.size());
-    (void)scene.intersect(rays, out, qo);
-    const float nan = std::numeric_limits<float>::quiet_NaN();
-    for (size_t k = 0; k < rays.size(); ++k) {
-      const SceneHit& q = out[k];
-      const size_t i = first + k;
-      hit[i] = q.hit, t[i] = q.t, inside[i] = q.inside;
-      instance[i] = q.instance == kNoInstance ? -1 : int32_t(q.instance);
-      float* p = point + 3 * i;
-      float* nm = normal + 3 * i;
-      p[0] = q.hit ? q.point.x : nan, p[1] = q.hit ? q.point.y : nan, p[2] = q.hit ? q.point.z : nan;
-      nm[0] = q.hasNormal ? q.normal.x : nan, nm[1] = q.hasNormal ? q.normal.y : nan, nm[2] = q.hasNormal ? q.normal.z : nan;
-    }
-  });
-  return h;
+  return fillHits<SceneHit>(scene, b, sceneHitsFor(reuse, b.n));
 }
 
 Ray rayOf(const py::object& o, const py::object& d, float tmin, float tmax) {
