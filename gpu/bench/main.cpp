@@ -10,8 +10,8 @@
 // --sdf adds the distance-field peer (sdf_bench.h): the same AO through gpu/glsl/vff_sdf.glsl at the
 // field's memory, both against the exact image (needs the mesh: with --field, --mesh must name the
 // mesh the field was baked from; built with the samples only), rendered at --sdf-size with --sdf-spp
-// rays per pixel (default: --size and --spp; sphere tracing on a software renderer takes minutes
-// at the full size).
+// rays per pixel (default: --size and --spp; sphere tracing costs a software renderer many times
+// the field's lookups, so a smaller image keeps the run short).
 //
 // Without --field it bakes MESH (default /usr/share/glmark2/models/bunny.obj, else the procedural
 // torus knot) as samples/experiments does: octa-hemi2 n = 32 (4226 maps), 64 x 64, unorm8-diameter.

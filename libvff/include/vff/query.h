@@ -37,7 +37,9 @@
 // (point = origin + t * direction). Results are approximate: see spec/geometry.md section 7.2.
 //
 // Threads. A FieldQuery is immutable after creation: every member function is const and may be
-// called from many threads at once. The batch functions run on the calling thread.
+// called from many threads at once. The batch functions run on the calling thread. (The first
+// kInterpolated call builds the neighbour lists that reconstruction reads, once, whichever
+// thread makes it; kNearest never needs them.)
 //
 // Speed. Call the batch functions (FieldQuery's or Instance's): they answer kNearest rays 32 at a
 // time, in AVX-512 or AVX2 vectors where the CPU has them (8 in SSE2 vectors on other x86-64

@@ -57,7 +57,9 @@
 // hierarchy(): gpu/glsl/vff_scene.glsl, vff/gl/scene_loader.h.
 //
 // Threads. The query functions are const and may run on many threads at once; add(),
-// setTransform() and commit() must not run while any query does.
+// setTransform() and commit() must not run while any query does. A batch call's working memory
+// is the scene's, kept for the next calls (one per call running at once), so threads made for
+// each call do not fault it in again.
 #pragma once
 
 #include <cstdint>
