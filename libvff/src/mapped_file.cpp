@@ -14,7 +14,7 @@ MappedFile::~MappedFile() {
   if (map_) munmap(map_, size_);
 }
 
-Status MappedFile::open(const std::string& path) {
+Status MappedFile::open(const std::string& path, bool populate) {
   int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) return makeError(Code::kIoOpen, path + ": " + std::strerror(errno));
   struct stat st {};
@@ -29,7 +29,7 @@ Status MappedFile::open(const std::string& path) {
   }
   size_ = size_t(st.st_size);
   if (size_ > 0) {
-    void* m = mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd, 0);
+    void* m = mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | (populate ? MAP_POPULATE : 0), fd, 0);
     if (m == MAP_FAILED) {
       int e = errno;
       ::close(fd);

@@ -15,7 +15,9 @@ class MappedFile {
   MappedFile(const MappedFile&) = delete;
   MappedFile& operator=(const MappedFile&) = delete;
   ~MappedFile();
-  Status open(const std::string& path);
+  // `populate`: the caller reads the whole file at once (verifying every checksum), so the mapping
+  // gets its page tables in one go (MAP_POPULATE) instead of a page fault per few pages.
+  Status open(const std::string& path, bool populate = false);
   std::span<const uint8_t> bytes() const noexcept { return {data_, size_}; }
 
  private:

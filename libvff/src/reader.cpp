@@ -127,7 +127,7 @@ Result<File> finishOpen(std::unique_ptr<File::Impl> impl, const ReadOptions& opt
 
 Result<File> File::open(const std::string& path, const ReadOptions& options) {
   auto impl = std::make_unique<Impl>();
-  Status st = impl->mapped.open(path);
+  Status st = impl->mapped.open(path, options.checksums == ChecksumPolicy::kVerifyAll);
   if (!st) return std::move(st).error();
   impl->bytes = impl->mapped.bytes();
   return finishOpen(std::move(impl), options, [](std::unique_ptr<Impl> i) -> Result<File> { return File(std::move(i)); });

@@ -219,34 +219,37 @@ void appendCsv(std::string& out, const Answers& a, size_t i, Column c) {
 }  // namespace
 
 void answerRows(const Answers& a, float* rows) {
-  // Column by column, each a loop of its own: a run asks for a few columns or all of them, and
-  // each loop does one column's work only.
+  // Row by row: every column's value of a ray computed with selects, not branches (whether a ray
+  // hit is as good as random), then the asked-for ones copied out in the asked-for order.
   const size_t cols = a.columns.size(), n = a.hits.size();
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  auto fill = [&](size_t c, auto value) {
-    for (size_t i = 0; i < n; ++i) rows[i * cols + c] = value(a.hits[i], i);
-  };
-  auto site = [&](size_t i) { return a.sites.empty() ? LookupSite{} : a.sites[i]; };
-  // (sample indices stay below 2^24, so float32 holds them exactly)
-  for (size_t c = 0; c < cols; ++c) {
-    switch (a.columns[c]) {
-      case Column::kHit: fill(c, [](const QueryHit& h, size_t) { return h.hit ? 1.0f : 0.0f; }); break;
-      case Column::kT: fill(c, [](const QueryHit& h, size_t) { return h.t; }); break;
-      case Column::kX: fill(c, [&](const QueryHit& h, size_t) { return h.hit ? h.point.x : nan; }); break;
-      case Column::kY: fill(c, [&](const QueryHit& h, size_t) { return h.hit ? h.point.y : nan; }); break;
-      case Column::kZ: fill(c, [&](const QueryHit& h, size_t) { return h.hit ? h.point.z : nan; }); break;
-      case Column::kNx: fill(c, [&](const QueryHit& h, size_t) { return h.hasNormal ? h.normal.x : nan; }); break;
-      case Column::kNy: fill(c, [&](const QueryHit& h, size_t) { return h.hasNormal ? h.normal.y : nan; }); break;
-      case Column::kNz: fill(c, [&](const QueryHit& h, size_t) { return h.hasNormal ? h.normal.z : nan; }); break;
-      case Column::kInside: fill(c, [](const QueryHit& h, size_t) { return h.inside ? 1.0f : 0.0f; }); break;
-      case Column::kSample:
-        fill(c, [&](const QueryHit&, size_t i) { return site(i).valid ? float(site(i).sample) : -1.0f; });
-        break;
-      case Column::kI: fill(c, [&](const QueryHit&, size_t i) { return site(i).valid ? float(site(i).i) : -1.0f; }); break;
-      case Column::kJ: fill(c, [&](const QueryHit&, size_t i) { return site(i).valid ? float(site(i).j) : -1.0f; }); break;
-      case Column::kVisibility:
-        fill(c, [&](const QueryHit&, size_t i) { return a.visibility.empty() ? 1.0f : a.visibility[i]; });
-        break;
+  uint8_t pick[kAllColumns];
+  constexpr size_t kDefaultColumns = size_t(Column::kVisibility);  // hit .. j
+  bool leading = true;  // the columns are the first `cols` of the full row, in order
+  for (size_t c = 0; c < cols; ++c) pick[c] = uint8_t(a.columns[c]), leading = leading && pick[c] == c;
+  const bool sites = !a.sites.empty(), vis = !a.visibility.empty();
+  for (size_t i = 0; i < n; ++i) {
+    const QueryHit& h = a.hits[i];
+    const LookupSite s = sites ? a.sites[i] : LookupSite{};
+    // (sample indices stay below 2^24, so float32 holds them exactly)
+    const float row[kAllColumns] = {h.hit ? 1.0f : 0.0f,
+                                    h.t,
+                                    h.hit ? h.point.x : nan,
+                                    h.hit ? h.point.y : nan,
+                                    h.hit ? h.point.z : nan,
+                                    h.hasNormal ? h.normal.x : nan,
+                                    h.hasNormal ? h.normal.y : nan,
+                                    h.hasNormal ? h.normal.z : nan,
+                                    h.inside ? 1.0f : 0.0f,
+                                    s.valid ? float(s.sample) : -1.0f,
+                                    s.valid ? float(s.i) : -1.0f,
+                                    s.valid ? float(s.j) : -1.0f,
+                                    vis ? a.visibility[i] : 1.0f};
+    float* out = rows + i * cols;
+    if (leading && cols == kDefaultColumns) {
+      std::memcpy(out, row, kDefaultColumns * sizeof(float));  // (a constant size: plain stores)
+    } else {
+      for (size_t c = 0; c < cols; ++c) out[c] = row[pick[c]];
     }
   }
 }
