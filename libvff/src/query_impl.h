@@ -51,11 +51,15 @@ namespace {
 // toObjectPoint compute, inlined. The group kernel repeats these operations lane by lane
 // (GroupTables::toObject).
 struct ToObject {
-  const float (&r)[3][3];  // the inverse rotation is the transpose
+  float r[3][3];  // the inverse rotation is the transpose
   Vec3 translation;
   float invScale;
   explicit ToObject(const RigidTransform& x) noexcept
-      : r(x.rotation), translation(x.translation), invScale(1.0f / x.scale) {}
+      : r{{x.rotation[0][0], x.rotation[0][1], x.rotation[0][2]},
+          {x.rotation[1][0], x.rotation[1][1], x.rotation[1][2]},
+          {x.rotation[2][0], x.rotation[2][1], x.rotation[2][2]}},
+        translation(x.translation),
+        invScale(1.0f / x.scale) {}
   Vec3 vector(Vec3 v) const noexcept {
     return Vec3{r[0][0] * v.x + r[1][0] * v.y + r[2][0] * v.z, r[0][1] * v.x + r[1][1] * v.y + r[2][1] * v.z,
                 r[0][2] * v.x + r[1][2] * v.y + r[2][2] * v.z} *

@@ -106,6 +106,9 @@ Status Scene::commit() {
     m.maxRadius = std::max(m.maxRadius, r);
   }
   m.bvh.build(boxes);
+  m.toObject.clear();
+  m.toObject.reserve(m.instances.size());
+  for (const Instance& x : m.instances) m.toObject.emplace_back(x.transform);
   // Grouped by field, in the order in which each field first appears (so that the grouping does
   // not depend on where the fields lie in memory). Instances are only ever appended and keep their
   // field, so the grouping changes only when instances were added: a frame that only moves them

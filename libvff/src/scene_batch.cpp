@@ -17,7 +17,9 @@ namespace vff {
 
 namespace {
 
-constexpr size_t kChunk = 32768;  // rays a chunk
+// Rays a chunk: few enough that a chunk's rays, box rays, traversal lists and pairs stay in the
+// core's own caches; the field's batch path still gets the pairs of all its instances at once.
+constexpr size_t kChunk = 4096;
 
 using Pairs = detail::ScenePairs;
 using Scratch = detail::SceneScratch;
@@ -53,8 +55,7 @@ class ScratchLease {
 
 void pairUp(const Scene::Impl& m, std::span<const Ray> chunk, Scratch* s) {
   Pairs* p = &s->pairs;
-  s->boxRays.resize(chunk.size());
-  for (size_t r = 0; r < chunk.size(); ++r) s->boxRays[r] = detail::boxRay(chunk[r]);
+  s->boxRays.assign(chunk);
   const detail::RayLists& l = s->lists;
   m.bvh.collect(s->boxRays, &s->lists);
   p->count.assign(m.instances.size(), 0);
@@ -69,7 +70,7 @@ void pairUp(const Scene::Impl& m, std::span<const Ray> chunk, Scratch* s) {
   p->rays.resize(at);
   for (size_t c = 0; c < l.prim.size(); ++c) {
     const uint32_t id = l.prim[c], to = p->first[id];
-    const detail::ToObject x(m.instances[id].transform);
+    const detail::ToObject& x = m.toObject[id];
     for (uint32_t k = 0; k < l.count[c]; ++k) {
       const uint32_t r = l.rays[l.first[c] + k];
       p->ray[to + k] = r;

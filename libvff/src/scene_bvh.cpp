@@ -1,6 +1,9 @@
 // scene_bvh.cpp - building and testing the scene's top-level hierarchy (scene_bvh.h).
 #include "scene_bvh.h"
 
+#include "cpu_features.h"
+#include "query_group.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -10,7 +13,9 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr int kBins = 16;
-constexpr uint32_t kLeafSize = 2;
+// One instance a leaf: a batch pairs a ray with every instance of a leaf it reaches, so a larger
+// leaf pairs rays with neighbours whose own boxes they miss.
+constexpr uint32_t kLeafSize = 1;
 
 Box emptyBox() { return Box{{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}}; }
 
@@ -38,6 +43,7 @@ struct Builder {
   std::vector<float> centre;  // 3 per primitive
   std::vector<uint32_t>& prims;
   std::vector<BNode> nodes;
+  std::vector<uint32_t> scratch;  // the right side of a partition
 
   uint32_t build(uint32_t start, uint32_t count, int depth) {
     const uint32_t id = uint32_t(nodes.size());
@@ -100,8 +106,15 @@ struct Builder {
           bestSplit = b;
         }
       }
-      if (bestSplit > 0) {
-        mid = uint32_t(std::stable_partition(p, p + count, [&](uint32_t q) { return binOf(q) < bestSplit; }) - p);
+      if (bestSplit > 0) {  // a stable partition, through the builder's scratch (no allocation per node)
+        scratch.clear();
+        uint32_t* left = p;
+        for (uint32_t i = 0; i < count; ++i) {
+          if (binOf(p[i]) < bestSplit) *left++ = p[i];
+          else scratch.push_back(p[i]);
+        }
+        std::copy(scratch.begin(), scratch.end(), left);
+        mid = uint32_t(left - p);
       }
     }
     if (mid == 0 || mid == count) {
@@ -141,7 +154,7 @@ void Bvh4::build(const std::vector<Box>& boxes) {
   prims_.resize(boxes.size());
   for (uint32_t i = 0; i < prims_.size(); ++i) prims_[i] = i;
   if (boxes.empty()) return;
-  Builder b{boxes, std::vector<float>(3 * boxes.size()), prims_, {}};
+  Builder b{boxes, std::vector<float>(3 * boxes.size()), prims_, {}, {}};
   b.nodes.reserve(2 * boxes.size());
   for (size_t i = 0; i < boxes.size(); ++i)
     for (int a = 0; a < 3; ++a) b.centre[3 * i + a] = 0.5f * (boxes[i].lo[a] + boxes[i].hi[a]);
@@ -202,14 +215,73 @@ void Bvh4::build(const std::vector<Box>& boxes) {
   }
 }
 
-void Bvh4::collect(std::span<const BoxRay> rays, RayLists* out) const {
+void BoxRays::assign(std::span<const Ray> rays) {
+  data.resize(rays.size());
+  size_t r = 0;
+#if VFF_SCENE_SSE2
+  // Four rays at a time, as boxRay makes each (a division rounds the same in any lane): their
+  // halves transposed into components, the direction's inverted, and transposed back.
+  static_assert(sizeof(Ray) == 8 * sizeof(float) && sizeof(BoxRay) == 8 * sizeof(float));
+  const float* in = reinterpret_cast<const float*>(rays.data());
+  float* out = reinterpret_cast<float*>(data.data());
+  const __m128 zero = _mm_setzero_ps(), tiny = _mm_set1_ps(1e-30f), one = _mm_set1_ps(1.0f);
+  auto inverse = [&](__m128 d) {
+    const __m128 isZero = _mm_cmpeq_ps(d, zero);
+    return _mm_div_ps(one, _mm_or_ps(_mm_and_ps(isZero, tiny), _mm_andnot_ps(isZero, d)));
+  };
+  for (; r + 4 <= rays.size(); r += 4) {
+    const float* p = in + 8 * r;
+    __m128 ox = _mm_loadu_ps(p), oy = _mm_loadu_ps(p + 8), oz = _mm_loadu_ps(p + 16), dx = _mm_loadu_ps(p + 24);
+    __m128 dy = _mm_loadu_ps(p + 4), dz = _mm_loadu_ps(p + 12), tmin = _mm_loadu_ps(p + 20), tmax = _mm_loadu_ps(p + 28);
+    _MM_TRANSPOSE4_PS(ox, oy, oz, dx);
+    _MM_TRANSPOSE4_PS(dy, dz, tmin, tmax);
+    __m128 ix = inverse(dx), iy = inverse(dy), iz = inverse(dz), unused = zero;
+    _MM_TRANSPOSE4_PS(ox, oy, oz, ix);          // each ray's origin and inverse x
+    _MM_TRANSPOSE4_PS(iy, iz, tmax, unused);  // each ray's inverse y, z, tmax
+    float* q = out + 8 * r;
+    _mm_storeu_ps(q, ox), _mm_storeu_ps(q + 4, iy), _mm_storeu_ps(q + 8, oy), _mm_storeu_ps(q + 12, iz);
+    _mm_storeu_ps(q + 16, oz), _mm_storeu_ps(q + 20, tmax), _mm_storeu_ps(q + 24, ix), _mm_storeu_ps(q + 28, unused);
+  }
+#endif
+  for (; r < rays.size(); ++r) data[r] = boxRay(rays[r]);
+}
+
+void collectNodeScalar(const Node4& node, const float* rays, const uint32_t* in, uint32_t m, uint32_t* list,
+                       size_t stride, uint32_t* count) noexcept {
+  const BoxRay* boxRays = reinterpret_cast<const BoxRay*>(rays);
+  float entry[4];
+  for (uint32_t i = 0; i < m; ++i) {
+    const uint32_t r = in[i];
+    const unsigned mask = hitNode4(node, boxRays[r], boxRays[r].tmax, entry) & node.valid;
+    for (uint32_t c = 0; c < 4; ++c) {  // no branch per child: the masks are random bits
+      list[c * stride + count[c]] = r;
+      count[c] += (mask >> c) & 1u;
+    }
+  }
+}
+
+#if defined(VFF_HAVE_AVX512_COLLECT)
+void collectNodeAvx512(const Node4& node, const float* rays, const uint32_t* in, uint32_t m, uint32_t* list,
+                       size_t stride, uint32_t* count) noexcept;
+CollectNodeFn collectNodeAvx512Fn() noexcept {
+  const KernelChoice k = kernelOverride();
+  if (k != KernelChoice::kAuto && k != KernelChoice::kAvx512) return nullptr;
+  return cpuFeatures().avx512 ? collectNodeAvx512 : nullptr;
+}
+#else
+CollectNodeFn collectNodeAvx512Fn() noexcept { return nullptr; }
+#endif
+
+void Bvh4::collect(const BoxRays& rays, RayLists* out, CollectNodeFn step) const {
   out->prim.clear();
   out->first.clear();
   out->count.clear();
   out->rays.clear();
-  if (nodes_.empty() || rays.empty()) return;
+  if (nodes_.empty() || rays.data.empty()) return;
+  if (!step) step = collectNodeAvx512Fn();
+  if (!step) step = collectNodeScalar;
   std::vector<uint32_t>& arena = out->arena;
-  const uint32_t n = uint32_t(rays.size());
+  const uint32_t n = uint32_t(rays.data.size());
   if (arena.size() < n) arena.resize(n);
   for (uint32_t r = 0; r < n; ++r) arena[r] = r;
   out->stack.assign(1, {0, 0, n});
@@ -218,30 +290,22 @@ void Bvh4::collect(std::span<const BoxRay> rays, RayLists* out) const {
     out->stack.pop_back();
     // Depth first: everything in the arena above this item's rays belongs to items already done.
     const uint32_t m = it.end - it.begin;
-    const size_t base = it.end;
-    if (arena.size() < base + 4 * size_t(m)) arena.resize(base + 4 * size_t(m));
+    const size_t base = it.end, stride = size_t(m) + 16;
+    if (arena.size() < base + 4 * stride) arena.resize(base + 4 * stride);
     const uint32_t* in = arena.data() + it.begin;
-    uint32_t* list = arena.data() + base;  // child c's rays at list[c * m ...]
+    uint32_t* list = arena.data() + base;  // child c's rays at list[c * stride ...]
     const Node4& node = nodes_[it.node];
     uint32_t count[4] = {0, 0, 0, 0};
-    float entry[4];
-    for (uint32_t i = 0; i < m; ++i) {
-      const uint32_t r = in[i];
-      const unsigned mask = hitNode4(node, rays[r], rays[r].tmax, entry) & node.valid;
-      for (uint32_t c = 0; c < 4; ++c) {  // no branch per child: the masks are random bits
-        list[c * m + count[c]] = r;
-        count[c] += (mask >> c) & 1u;
-      }
-    }
+    step(node, reinterpret_cast<const float*>(rays.data.data()), in, m, list, stride, count);
     for (uint32_t c = 0; c < 4; ++c) {
       if (count[c] == 0) continue;
-      const uint32_t begin = uint32_t(base + c * size_t(m));
+      const uint32_t begin = uint32_t(base + c * stride);
       if (node.count[c] == 0) {
         out->stack.push_back({node.child[c], begin, begin + count[c]});
         continue;
       }
       const uint32_t at = uint32_t(out->rays.size());
-      out->rays.insert(out->rays.end(), list + size_t(c) * m, list + size_t(c) * m + count[c]);
+      out->rays.insert(out->rays.end(), list + c * stride, list + c * stride + count[c]);
       for (uint32_t i = 0; i < node.count[c]; ++i) {
         out->prim.push_back(prims_[node.child[c] + i]);
         out->first.push_back(at);

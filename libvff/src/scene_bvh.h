@@ -32,13 +32,34 @@ struct alignas(16) Node4 {
   unsigned valid;  // bit c: child c exists
 };
 
-// A ray prepared for the box tests.
-struct BoxRay {
+// A ray prepared for the box tests: eight floats, so that a vector kernel loads a ray in one go.
+struct alignas(32) BoxRay {
   float origin[3], inv[3];
   float tmax;
+  float unused = 0;
 };
 
 BoxRay boxRay(const Ray& ray) noexcept;
+
+// A batch's rays for Bvh4::collect, each as boxRay makes it.
+struct BoxRays {
+  std::vector<BoxRay> data;
+  void assign(std::span<const Ray> rays);
+};
+
+// One node's step of Bvh4::collect: the rays in[0, m) (indices into `rays`, a BoxRays' data as
+// eight floats a ray) tested against the node's four boxes as hitNode4 tests them, each with its
+// own tmax; those that reach child c are appended, in their order, to list + c * stride from
+// count[c] on (count[c] grows by their number). A kernel may write up to 15 entries past a list's
+// new end: stride is at least m + 16. Plain pointers: a kernel compiled for wider instructions
+// instantiates no inline function of the baseline's.
+using CollectNodeFn = void (*)(const Node4& node, const float* rays, const uint32_t* in, uint32_t m, uint32_t* list,
+                               size_t stride, uint32_t* count);
+void collectNodeScalar(const Node4& node, const float* rays, const uint32_t* in, uint32_t m, uint32_t* list,
+                       size_t stride, uint32_t* count) noexcept;
+// The same in AVX-512 lanes, sixteen rays at a time (scene_bvh_avx512.cpp), where this CPU and build
+// have AVX-512 and forceGroupKernel (query_group.h) asks for no narrower kernel; else null.
+CollectNodeFn collectNodeAvx512Fn() noexcept;
 
 // What Bvh4::collect finds for a batch of rays: call c says that the rays
 // rays[first[c], first[c] + count[c]) (indices into the batch, ascending) reach primitive prim[c];
@@ -71,7 +92,9 @@ class Bvh4 {
   // for all of them at once: the batch goes down the tree as a stream, each node testing the rays
   // that reached it against its four boxes, so that a node is read once for the batch and no ray
   // keeps a stack of its own.
-  void collect(std::span<const BoxRay> rays, RayLists* out) const;
+  // `node` steps each node (collectNodeScalar or a vector kernel of the same answers; null: the
+  // widest this CPU runs).
+  void collect(const BoxRays& rays, RayLists* out, CollectNodeFn node = nullptr) const;
 
  private:
   std::vector<Node4> nodes_;

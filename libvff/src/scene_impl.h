@@ -6,6 +6,7 @@
 #include <mutex>
 #include <vector>
 
+#include "query_impl.h"
 #include "scene_bvh.h"
 #include "vff/scene.h"
 
@@ -26,7 +27,7 @@ struct ScenePairs {
 // would fault in and zero on every call.
 struct SceneScratch {
   ScenePairs pairs;
-  std::vector<BoxRay> boxRays;
+  BoxRays boxRays;
   RayLists lists;
   std::vector<QueryHit> hits;
   std::vector<uint8_t> blocked;
@@ -37,6 +38,9 @@ struct SceneScratch {
 
 struct Scene::Impl {
   std::vector<Instance> instances;
+  // Each instance's world-to-object step, taken apart at commit (the batches take every pair's ray
+  // into its instance's object space with it).
+  std::vector<detail::ToObject> toObject;
   detail::Bvh4 bvh;
   float maxRadius = 0;  // the largest enlarged world radius
   // The instance ids grouped by field (ascending id within a group), and where each group starts
