@@ -64,7 +64,7 @@ int main(int argc, char** argv) {
   app.add_option("--batch", o.benchBatch, "bench: rays per batch call in (b), (d) and (e) (a renderer's call: a tile, a pixel)")
       ->capture_default_str()
       ->check(CLI::Range(1u, 1u << 26));
-  app.add_option("--repeat", o.repeat, "bench: repetitions (best is reported)")->capture_default_str()
+  app.add_option("--repeat", o.repeat, "bench, scene-bench, triangle-bench, sdf-bench: repetitions (best is reported)")->capture_default_str()
       ->check(CLI::Range(1, 100));
   app.add_flag("--sdf,!--no-sdf", o.sdf,
                "image experiments: also render the signed distance field (OpenVDB level set, NanoVDB, sphere "
