@@ -88,7 +88,8 @@ bool Scene::committed() const noexcept { return !impl_ || impl_->committed; }
 
 Status Scene::commit() {
   Impl& m = Impl::of(impl_);
-  std::vector<detail::Box> boxes(m.instances.size());
+  std::vector<detail::Box>& boxes = m.boxes;
+  boxes.resize(m.instances.size());
   m.maxRadius = 0;
   for (size_t i = 0; i < boxes.size(); ++i) {
     const Sphere s = m.instances[i].worldSphere();

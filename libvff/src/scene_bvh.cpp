@@ -32,28 +32,33 @@ float area(const Box& b) {
   return x * y + y * z + z * x;
 }
 
-struct BNode {
-  Box box;
-  uint32_t left = 0, right = 0;  // children, for inner nodes
-  uint32_t start = 0, count = 0;  // primitives, for leaves (count > 0)
-};
-
 struct Builder {
   const std::vector<Box>& boxes;
-  std::vector<float> centre;  // 3 per primitive
   std::vector<uint32_t>& prims;
-  std::vector<BNode> nodes;
-  std::vector<uint32_t> scratch;  // the right side of a partition
+  std::vector<float>& centre;         // 3 per primitive
+  std::vector<BinaryNode>& nodes;
+  std::vector<uint32_t>& scratch;     // the right side of a partition
+  std::vector<uint8_t>& binIds;       // each primitive's bin, by position in the node's range
 
-  uint32_t build(uint32_t start, uint32_t count, int depth) {
+  Box centreBox(uint32_t prim) const {
+    const float* c = &centre[3 * size_t(prim)];
+    return Box{{c[0], c[1], c[2]}, {c[0], c[1], c[2]}};
+  }
+  // The box around primitives [start, start + count) and the box around their centres.
+  void bounds(uint32_t start, uint32_t count, Box* box, Box* cbox) const {
+    *box = emptyBox(), *cbox = emptyBox();
+    for (uint32_t i = start; i < start + count; ++i) {
+      grow(box, boxes[prims[i]]);
+      grow(cbox, centreBox(prims[i]));
+    }
+  }
+
+  // The node over primitives [start, start + count), whose bounds are `box` and `cbox` (a split
+  // hands its children theirs, from the bins: each primitive is visited twice a level, to bin it
+  // and to move it).
+  uint32_t build(uint32_t start, uint32_t count, int depth, const Box& box, const Box& cbox) {
     const uint32_t id = uint32_t(nodes.size());
     nodes.emplace_back();
-    Box box = emptyBox(), cbox = emptyBox();
-    for (uint32_t i = start; i < start + count; ++i) {
-      grow(&box, boxes[prims[i]]);
-      const float* c = &centre[3 * prims[i]];
-      grow(&cbox, Box{{c[0], c[1], c[2]}, {c[0], c[1], c[2]}});
-    }
     nodes[id].box = box;
     if (count <= kLeafSize) {
       nodes[id].start = start;
@@ -66,51 +71,59 @@ struct Builder {
       if (cbox.hi[a] - cbox.lo[a] > cbox.hi[axis] - cbox.lo[axis]) axis = a;
     const float extent = cbox.hi[axis] - cbox.lo[axis];
     uint32_t* p = prims.data() + start;
-    if (extent > 0 && depth < 48) {
+    Box side[2][2];  // [left, right][box, centre box] of the chosen split
+    // (Two primitives: the split binning would find, when it finds one, is the middle split's.)
+    if (extent > 0 && depth < 48 && count > 2) {
       // Binned SAH on the widest centroid axis.
-      Box binBox[kBins];
+      Box binBox[kBins], binCentres[kBins];
       uint32_t binCount[kBins] = {};
       std::fill_n(binBox, kBins, emptyBox());
+      std::fill_n(binCentres, kBins, emptyBox());
       const float scale = kBins / extent;
-      auto binOf = [&](uint32_t prim) {
-        // Written so that a huge or NaN product (a tiny extent) never reaches the conversion.
-        const float f = (centre[3 * prim + axis] - cbox.lo[axis]) * scale;
-        return f >= float(kBins - 1) ? kBins - 1 : (f > 0 ? int(f) : 0);
-      };
+      binIds.resize(count);
       for (uint32_t i = 0; i < count; ++i) {
-        const int b = binOf(p[i]);
-        ++binCount[b];
-        grow(&binBox[b], boxes[p[i]]);
+        // Written so that a huge or NaN product (a tiny extent) never reaches the conversion.
+        const float f = (centre[3 * size_t(p[i]) + axis] - cbox.lo[axis]) * scale;
+        const int bin = f >= float(kBins - 1) ? kBins - 1 : (f > 0 ? int(f) : 0);
+        binIds[i] = uint8_t(bin);
+        ++binCount[bin];
+        grow(&binBox[bin], boxes[p[i]]);
+        grow(&binCentres[bin], centreBox(p[i]));
       }
       float rightArea[kBins];
       uint32_t rightCount[kBins];
-      Box acc = emptyBox();
+      Box rightBox[kBins], rightCentres[kBins];
+      Box acc = emptyBox(), accCentres = emptyBox();
       uint32_t n = 0;
       for (int b = kBins - 1; b > 0; --b) {
         grow(&acc, binBox[b]);
+        grow(&accCentres, binCentres[b]);
         n += binCount[b];
         rightArea[b] = area(acc);
         rightCount[b] = n;
+        rightBox[b] = acc, rightCentres[b] = accCentres;
       }
-      acc = emptyBox();
+      acc = emptyBox(), accCentres = emptyBox();
       n = 0;
       float best = kInf;
       int bestSplit = -1;
       for (int b = 1; b < kBins; ++b) {
         grow(&acc, binBox[b - 1]);
+        grow(&accCentres, binCentres[b - 1]);
         n += binCount[b - 1];
         if (n == 0 || rightCount[b] == 0) continue;
         const float cost = area(acc) * float(n) + rightArea[b] * float(rightCount[b]);
         if (cost < best) {
           best = cost;
           bestSplit = b;
+          side[0][0] = acc, side[0][1] = accCentres, side[1][0] = rightBox[b], side[1][1] = rightCentres[b];
         }
       }
       if (bestSplit > 0) {  // a stable partition, through the builder's scratch (no allocation per node)
         scratch.clear();
         uint32_t* left = p;
         for (uint32_t i = 0; i < count; ++i) {
-          if (binOf(p[i]) < bestSplit) *left++ = p[i];
+          if (binIds[i] < bestSplit) *left++ = p[i];
           else scratch.push_back(p[i]);
         }
         std::copy(scratch.begin(), scratch.end(), left);
@@ -121,12 +134,14 @@ struct Builder {
       // Coincident centroids or a deep branch: split in the middle, in a fixed order.
       mid = count / 2;
       std::nth_element(p, p + mid, p + count, [&](uint32_t a, uint32_t b) {
-        const float ca = centre[3 * a + axis], cb = centre[3 * b + axis];
+        const float ca = centre[3 * size_t(a) + axis], cb = centre[3 * size_t(b) + axis];
         return ca < cb || (ca == cb && a < b);
       });
+      bounds(start, mid, &side[0][0], &side[0][1]);
+      bounds(start + mid, count - mid, &side[1][0], &side[1][1]);
     }
-    const uint32_t l = build(start, mid, depth + 1);
-    const uint32_t r = build(start + mid, count - mid, depth + 1);
+    const uint32_t l = build(start, mid, depth + 1, side[0][0], side[0][1]);
+    const uint32_t r = build(start + mid, count - mid, depth + 1, side[1][0], side[1][1]);
     nodes[id].left = l;
     nodes[id].right = r;
     return id;
@@ -154,23 +169,27 @@ void Bvh4::build(const std::vector<Box>& boxes) {
   prims_.resize(boxes.size());
   for (uint32_t i = 0; i < prims_.size(); ++i) prims_[i] = i;
   if (boxes.empty()) return;
-  Builder b{boxes, std::vector<float>(3 * boxes.size()), prims_, {}, {}};
-  b.nodes.reserve(2 * boxes.size());
+  BuildMemory& mem = memory_;
+  mem.centre.resize(3 * boxes.size());
+  mem.nodes.clear();
+  mem.nodes.reserve(2 * boxes.size());
+  Builder b{boxes, prims_, mem.centre, mem.nodes, mem.scratch, mem.binIds};
   for (size_t i = 0; i < boxes.size(); ++i)
     for (int a = 0; a < 3; ++a) b.centre[3 * i + a] = 0.5f * (boxes[i].lo[a] + boxes[i].hi[a]);
-  b.build(0, uint32_t(boxes.size()), 0);
+  Box all, allCentres;
+  b.bounds(0, uint32_t(boxes.size()), &all, &allCentres);
+  b.build(0, uint32_t(boxes.size()), 0, all, allCentres);
   // Collapse to four children a node: open the child of largest area until there are four.
-  struct Pending {
-    uint32_t binary, slot;
-  };
-  std::vector<Pending> work{{0, 0}};
+  using Pending = BuildMemory::Pending;
+  std::vector<Pending>& work = mem.work;
+  work.assign(1, {0, 0});
   nodes_.reserve(b.nodes.size() / 2 + 1);
   while (!work.empty()) {
     const Pending w = work.back();
     work.pop_back();
     uint32_t kids[4];
     int k = 0;
-    const BNode& root = b.nodes[w.binary];
+    const BinaryNode& root = b.nodes[w.binary];
     if (root.count > 0) {
       kids[k++] = w.binary;  // a lone leaf (a scene of one or two instances)
     } else {
@@ -185,7 +204,7 @@ void Bvh4::build(const std::vector<Box>& boxes) {
             open = i;
           }
         if (open < 0) break;
-        const BNode& o = b.nodes[kids[open]];
+        const BinaryNode& o = b.nodes[kids[open]];
         kids[open] = o.left;
         kids[k++] = o.right;
       }
@@ -204,7 +223,7 @@ void Bvh4::build(const std::vector<Box>& boxes) {
       n.child[c] = 0;
       n.count[c] = 0;
       if (c >= k) continue;
-      const BNode& kid = b.nodes[kids[c]];
+      const BinaryNode& kid = b.nodes[kids[c]];
       if (kid.count > 0) {
         n.child[c] = kid.start;
         n.count[c] = kid.count;

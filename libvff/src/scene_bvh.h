@@ -73,6 +73,14 @@ struct RayLists {
   std::vector<Item> stack;
 };
 
+// A node of the binary hierarchy Bvh4::build makes first (and then collapses to four children a
+// node): inner with children left and right, or a leaf of primitives prims[start, start + count).
+struct BinaryNode {
+  Box box;
+  uint32_t left = 0, right = 0;
+  uint32_t start = 0, count = 0;  // count > 0: a leaf
+};
+
 class Bvh4 {
  public:
   static constexpr int kMaxDepth = 96;
@@ -99,6 +107,18 @@ class Bvh4 {
  private:
   std::vector<Node4> nodes_;
   std::vector<uint32_t> prims_;
+  // The builder's working memory, kept between builds: a scene rebuilt every frame then finds it
+  // already faulted in.
+  struct BuildMemory {
+    std::vector<float> centre;
+    std::vector<BinaryNode> nodes;
+    std::vector<uint32_t> scratch;
+    std::vector<uint8_t> binIds;
+    struct Pending {
+      uint32_t binary, slot;
+    };
+    std::vector<Pending> work;
+  } memory_;
 };
 
 // The entry distances of the ray into the four boxes of a node, and which it reaches within

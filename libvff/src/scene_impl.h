@@ -42,6 +42,7 @@ struct Scene::Impl {
   // into its instance's object space with it).
   std::vector<detail::ToObject> toObject;
   detail::Bvh4 bvh;
+  std::vector<detail::Box> boxes;  // the commit's, kept for the next
   float maxRadius = 0;  // the largest enlarged world radius
   // The instance ids grouped by field (ascending id within a group), and where each group starts
   // in it (fieldStart.back() == instances.size()): the batches ask each field once for the rays
