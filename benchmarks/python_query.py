@@ -17,6 +17,7 @@ Makes `--rays` ambient-occlusion rays about the field (origins on a disc around 
   I/O floor    reading the rays file and writing the answers' bytes, through the page cache, in
                Python: what vff-query's reading and writing cannot beat
   Python       FieldQuery.intersect(origins, directions) on numpy arrays (threads as vff-query's),
+               warm (after an untimed call), with new answer arrays and with out= (arrays reused),
                and FieldQuery.occluded for reference
 and prints each in Mrays/s with its ratio to the C++ batch, naming the CPU. Each ratio is the
 path's rate over the C++ batch's, on the same rays and the same field, both the best of --repeat
@@ -122,6 +123,9 @@ def main():
             best["floor"] = max(best["floor"], a.rays / 1e6 / (time.perf_counter() - t0))
             os.remove(floor_out)
             os.sync()
+            # Warm, as the C++ batch is measured: one call untimed first, so that the field is back
+            # in the caches the subprocesses above went through.
+            q.intersect(o, d, interpolated=a.interpolated, threads=a.threads, out=reuse)
             t0 = time.perf_counter()
             h = q.intersect(o, d, interpolated=a.interpolated, threads=a.threads)
             best["py"] = max(best["py"], a.rays / 1e6 / (time.perf_counter() - t0))

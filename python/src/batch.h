@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <optional>
@@ -24,7 +25,9 @@ namespace vff::python {
 namespace py = pybind11;
 
 
-inline constexpr size_t kChunk = 4096;  // rays per batch call on one thread (its rays and answers stay in L2)
+// Rays per batch call on one thread: the larger of the sizes measured best around the copies in
+// and out of numpy (benchmarks/python_query.py), which stream.
+inline constexpr size_t kChunk = 16384;
 
 struct PyQuery {
   py::object owner;  // the vff.File whose maps the query borrows
@@ -200,16 +203,24 @@ Hits fillHits(const Target& target, const RayBatch& b, Hits h) {
     thread_local std::vector<Hit> out;
     out.resize(rays.size());
     (void)target.intersect(rays, out, qo);
-    const float nan = std::numeric_limits<float>::quiet_NaN();
+    // Selects by bit masks, not branches: whether a ray hit is as good as random, and a
+    // mispredicted branch a ray cost more than the rest of this loop.
+    const uint32_t nan = 0x7fc00000u;  // the quiet NaN's bits
+    auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
     for (size_t k = 0; k < rays.size(); ++k) {
       const Hit& q = out[k];
       const size_t i = first + k;
       hit[i] = q.hit, t[i] = q.t, inside[i] = q.inside;
       if constexpr (std::is_same_v<Hit, SceneHit>) instance[i] = q.instance == kNoInstance ? -1 : int32_t(q.instance);
+      const uint32_t hm = 0u - uint32_t(q.hit), nm = 0u - uint32_t(q.hasNormal);
       float* p = point + 3 * i;
-      float* nm = normal + 3 * i;
-      p[0] = q.hit ? q.point.x : nan, p[1] = q.hit ? q.point.y : nan, p[2] = q.hit ? q.point.z : nan;
-      nm[0] = q.hasNormal ? q.normal.x : nan, nm[1] = q.hasNormal ? q.normal.y : nan, nm[2] = q.hasNormal ? q.normal.z : nan;
+      float* pn = normal + 3 * i;
+      p[0] = std::bit_cast<float>((bits(q.point.x) & hm) | (nan & ~hm));
+      p[1] = std::bit_cast<float>((bits(q.point.y) & hm) | (nan & ~hm));
+      p[2] = std::bit_cast<float>((bits(q.point.z) & hm) | (nan & ~hm));
+      pn[0] = std::bit_cast<float>((bits(q.normal.x) & nm) | (nan & ~nm));
+      pn[1] = std::bit_cast<float>((bits(q.normal.y) & nm) | (nan & ~nm));
+      pn[2] = std::bit_cast<float>((bits(q.normal.z) & nm) | (nan & ~nm));
     }
   });
   return h;
