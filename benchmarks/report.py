@@ -179,10 +179,11 @@ def parse_scene(text):
     rows = md_rows(text)
     if len(rows) < 2 or rows[0][0] != "instances":
         raise ParseError("no scene-bench table")
-    m = re.search(r"(\d+) AO rays per frame.*?(\d+) frames, (\d+) threads", text)
+    m = re.search(r"(\d+) AO rays per frame.*?(\d+) frames(?: \(rays best of (\d+)\))?, (\d+) threads", text)
     if not m:
         raise ParseError("no 'N AO rays per frame ... F frames, T threads' line")
-    out = {"rays": int(m.group(1)), "frames": int(m.group(2)), "threads": int(m.group(3)), "rows": []}
+    out = {"rays": int(m.group(1)), "frames": int(m.group(2)), "best_of": int(m.group(3) or 1),
+           "threads": int(m.group(4)), "rows": []}
     for r in rows[1:]:
         out["rows"].append({"instances": int(r[0]), "exact": number(r[1]) + number(r[2]),
                             "scene": number(r[3]) + number(r[4]), "hybrid": number(r[5]) + number(r[6]),
@@ -435,7 +436,8 @@ def sections(machine, steps, heading, queries=None, only=None):
             out += ["Distance-field rows: nearest is sphere tracing's hit or miss, interpolated its cone estimate.", ""]
     if "scene" in steps:
         sc = steps["scene"]
-        out += [f"{heading} Scenes: time per frame against moving instances ({sc['rays']} AO rays per frame, "
+        best = f", rays best of {sc['best_of']}" if sc["best_of"] > 1 else ""
+        out += [f"{heading} Scenes: time per frame against moving instances ({sc['rays']} AO rays per frame{best}, "
                 f"{sc['threads']} threads)", "", *scene_table(sc), ""]
     if "triangles" in steps:
         t = steps["triangles"]
