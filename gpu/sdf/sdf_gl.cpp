@@ -24,50 +24,22 @@ vff::Error glError(const char* what, GLenum e) {
 
 }  // namespace
 
-GpuSdf::GpuSdf(GpuSdf&& o) noexcept
-    : block_(o.block_),
-      gridBuffer_(std::exchange(o.gridBuffer_, 0)),
-      blockBuffer_(std::exchange(o.blockBuffer_, 0)),
-      gridBytes_(std::exchange(o.gridBytes_, 0)) {}
-
-GpuSdf& GpuSdf::operator=(GpuSdf&& o) noexcept {
-  if (this != &o) {
-    release();
-    block_ = o.block_;
-    gridBuffer_ = std::exchange(o.gridBuffer_, 0);
-    blockBuffer_ = std::exchange(o.blockBuffer_, 0);
-    gridBytes_ = std::exchange(o.gridBytes_, 0);
-  }
-  return *this;
-}
-
-GpuSdf::~GpuSdf() {
-  release();
-}
-
-void GpuSdf::release() noexcept {
-  const GLuint b[2] = {gridBuffer_, blockBuffer_};
-  if (b[0] || b[1]) glDeleteBuffers(2, b);
-  gridBuffer_ = blockBuffer_ = 0;
-  gridBytes_ = 0;
-}
-
 vff::Status GpuSdf::setTraceOptions(const SdfTraceOptions& options) {
-  const SdfBlock b = withTraceOptions(block_, options);
+  const SdfBlock b = withTraceOptions(s_.block, options);
   glGetError();
   GLint old = 0;
   glGetIntegerv(GL_UNIFORM_BUFFER_BINDING, &old);
-  glBindBuffer(GL_UNIFORM_BUFFER, blockBuffer_);
+  glBindBuffer(GL_UNIFORM_BUFFER, s_.blockBuffer.get());
   glBufferSubData(GL_UNIFORM_BUFFER, 0, GLsizeiptr(sizeof b), &b);
   glBindBuffer(GL_UNIFORM_BUFFER, GLuint(old));
   if (const GLenum e = glGetError(); e != GL_NO_ERROR) return glError("glBufferSubData", e);
-  block_ = b;
+  s_.block = b;
   return {};
 }
 
 void GpuSdf::bind(const SdfBindings& bindings) const noexcept {
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, bindings.grid, gridBuffer_);
-  glBindBufferBase(GL_UNIFORM_BUFFER, bindings.block, blockBuffer_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, bindings.grid, s_.grid.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, bindings.block, s_.blockBuffer.get());
 }
 
 vff::Result<GpuSdf> uploadSdf(const SdfField& sdf, const SdfTraceOptions& options) {
@@ -89,22 +61,20 @@ vff::Result<GpuSdf> uploadSdf(const SdfField& sdf, const SdfTraceOptions& option
                                                        std::to_string(maxBlock) +
                                                        ") or PNanoVDB's 32-bit addresses allow");
   GpuSdf g;
-  g.block_ = makeSdfBlock(sdf, options);
+  g.s_.block = makeSdfBlock(sdf, options);
   GLint oldSsbo = 0, oldUbo = 0;
   glGetIntegerv(GL_SHADER_STORAGE_BUFFER_BINDING, &oldSsbo);
   glGetIntegerv(GL_UNIFORM_BUFFER_BINDING, &oldUbo);
-  GLuint b[2] = {0, 0};
-  glGenBuffers(2, b);
-  g.gridBuffer_ = b[0];
-  g.blockBuffer_ = b[1];
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, g.gridBuffer_);
+  glGenBuffers(1, g.s_.grid.out());
+  glGenBuffers(1, g.s_.blockBuffer.out());
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, g.s_.grid.get());
   glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(bytes.size()), bytes.data(), GL_STATIC_DRAW);
-  glBindBuffer(GL_UNIFORM_BUFFER, g.blockBuffer_);
-  glBufferData(GL_UNIFORM_BUFFER, GLsizeiptr(sizeof(SdfBlock)), &g.block_, GL_STATIC_DRAW);
+  glBindBuffer(GL_UNIFORM_BUFFER, g.s_.blockBuffer.get());
+  glBufferData(GL_UNIFORM_BUFFER, GLsizeiptr(sizeof(SdfBlock)), &g.s_.block, GL_STATIC_DRAW);
   glBindBuffer(GL_SHADER_STORAGE_BUFFER, GLuint(oldSsbo));
   glBindBuffer(GL_UNIFORM_BUFFER, GLuint(oldUbo));
   if (const GLenum e = glGetError(); e != GL_NO_ERROR) return glError("glBufferData", e);
-  g.gridBytes_ = bytes.size();
+  g.s_.gridBytes = bytes.size();
   return g;
 }
 

@@ -25,9 +25,11 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 
 #include "sdf_field.h"
 #include "vff/error.h"
+#include "vff/gl/gl_name.h"
 
 namespace vffx::gl {
 
@@ -70,30 +72,34 @@ struct SdfBindings {
   uint32_t block = 9;  // uniform buffer (VFF_SDF_BLOCK_BINDING)
 };
 
+// Move-only (a moved-from GpuSdf is empty); the destructor deletes the GL objects (the context
+// must be current).
 class GpuSdf {
  public:
   GpuSdf() = default;
-  GpuSdf(GpuSdf&& o) noexcept;
-  GpuSdf& operator=(GpuSdf&& o) noexcept;
-  GpuSdf(const GpuSdf&) = delete;
-  GpuSdf& operator=(const GpuSdf&) = delete;
-  ~GpuSdf();
+  GpuSdf(GpuSdf&& o) noexcept : s_(std::exchange(o.s_, {})) {}
+  GpuSdf& operator=(GpuSdf&& o) noexcept {
+    s_ = std::exchange(o.s_, {});  // (the objects held before are deleted)
+    return *this;
+  }
 
   void bind(const SdfBindings& bindings = {}) const noexcept;
-  void release() noexcept;  // deletes the GL objects now (the context must be current)
+  void release() noexcept { s_ = {}; }  // deletes the GL objects now (the context must be current)
   // Replaces the block's trace options (glBufferSubData); kBadState when GL reports an error.
   vff::Status setTraceOptions(const SdfTraceOptions& options);
 
-  const SdfBlock& block() const noexcept { return block_; }
-  uint32_t gridBuffer() const noexcept { return gridBuffer_; }
-  uint32_t blockBuffer() const noexcept { return blockBuffer_; }
-  uint64_t gridBytes() const noexcept { return gridBytes_; }  // bytes in the storage buffer
+  const SdfBlock& block() const noexcept { return s_.block; }
+  uint32_t gridBuffer() const noexcept { return s_.grid.get(); }
+  uint32_t blockBuffer() const noexcept { return s_.blockBuffer.get(); }
+  uint64_t gridBytes() const noexcept { return s_.gridBytes; }  // bytes in the storage buffer
 
  private:
   friend vff::Result<GpuSdf> uploadSdf(const SdfField& sdf, const SdfTraceOptions& options);
-  SdfBlock block_;
-  uint32_t gridBuffer_ = 0, blockBuffer_ = 0;
-  uint64_t gridBytes_ = 0;
+  struct State {
+    SdfBlock block;
+    vff::gl::GlName grid{vff::gl::GlName::Kind::kBuffer}, blockBuffer{vff::gl::GlName::Kind::kBuffer};
+    uint64_t gridBytes = 0;
+  } s_;
 };
 
 // Uploads the field's grid and block (see the top of this file).

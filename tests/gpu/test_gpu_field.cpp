@@ -281,6 +281,39 @@ INSTANTIATE_TEST_SUITE_P(Fields, GpuField, ::testing::ValuesIn(fieldCases()),
 
 // ---- Ground AO ---------------------------------------------------------------------------------------
 
+// GpuField owns its GL objects through vff::gl::GlName: a move leaves the source empty and the
+// objects alive in the target; assigning over a field and release() delete its objects.
+TEST(GpuFieldObjects, MovesKeepAndReleaseDeletes) {
+  VFF_REQUIRE_GL();
+  const gputest::FieldCase c{PositionScheme::kOctaHemi2, DirectionScheme::kHemiOctahedral,
+                                DistanceEncoding::kUnorm8Diameter};
+  auto file = gputest::bakeFile(c, true);
+  ASSERT_TRUE(file.ok()) << file.error().toString();
+  auto loaded = gl::loadField(*file);
+  ASSERT_TRUE(loaded.ok()) << loaded.error().toString();
+  gl::GpuField a = std::move(*loaded);
+  const GLuint maps = a.mapsTexture(), normals = a.normalsTexture(), block = a.fieldBuffer(),
+               positions = a.positionsBuffer();
+  ASSERT_NE(maps, 0u);
+  ASSERT_NE(normals, 0u);
+  EXPECT_EQ(loaded->mapsTexture(), 0u);  // the moved-from field holds nothing
+  EXPECT_EQ(loaded->textureBytes(), 0u);
+  gl::GpuField b(std::move(a));
+  EXPECT_EQ(a.mapsTexture(), 0u);
+  EXPECT_EQ(a.fieldBuffer(), 0u);
+  EXPECT_EQ(b.mapsTexture(), maps);
+  EXPECT_TRUE(glIsTexture(maps) && glIsTexture(normals) && glIsBuffer(block) && glIsBuffer(positions));
+  auto other = gl::loadField(*file);
+  ASSERT_TRUE(other.ok());
+  b = std::move(*other);  // b's first objects are deleted
+  EXPECT_FALSE(glIsTexture(maps) || glIsTexture(normals) || glIsBuffer(block) || glIsBuffer(positions));
+  const GLuint second = b.mapsTexture();
+  EXPECT_TRUE(glIsTexture(second));
+  b.release();
+  EXPECT_EQ(b.mapsTexture(), 0u);
+  EXPECT_FALSE(glIsTexture(second));
+}
+
 TEST(GpuAo, GroundAoMatchesCpu) {
   VFF_REQUIRE_GL();
   const bake::Mesh mesh = bake::makeShape("torus-knot");

@@ -274,49 +274,22 @@ Status makeBuffer(GLenum target, const void* data, size_t size, GLuint* buffer, 
 
 using namespace detail;
 
-GpuField::GpuField(GpuField&& o) noexcept
-    : block_(o.block_),
-      mapsTexture_(std::exchange(o.mapsTexture_, 0)),
-      mapsTarget_(std::exchange(o.mapsTarget_, 0)),
-      fieldBuffer_(std::exchange(o.fieldBuffer_, 0)),
-      positionsBuffer_(std::exchange(o.positionsBuffer_, 0)),
-      normalsTexture_(std::exchange(o.normalsTexture_, 0)),
-      textureBytes_(std::exchange(o.textureBytes_, 0)) {}
-
-GpuField& GpuField::operator=(GpuField&& o) noexcept {
-  if (this != &o) {
-    release();
-    block_ = o.block_;
-    mapsTexture_ = std::exchange(o.mapsTexture_, 0);
-    mapsTarget_ = std::exchange(o.mapsTarget_, 0);
-    fieldBuffer_ = std::exchange(o.fieldBuffer_, 0);
-    positionsBuffer_ = std::exchange(o.positionsBuffer_, 0);
-    normalsTexture_ = std::exchange(o.normalsTexture_, 0);
-    textureBytes_ = std::exchange(o.textureBytes_, 0);
-  }
-  return *this;
-}
-
-GpuField::~GpuField() { release(); }
-
-void GpuField::release() noexcept {
-  if (mapsTexture_) glDeleteTextures(1, &mapsTexture_);
-  if (fieldBuffer_) glDeleteBuffers(1, &fieldBuffer_);
-  if (positionsBuffer_) glDeleteBuffers(1, &positionsBuffer_);
-  if (normalsTexture_) glDeleteTextures(1, &normalsTexture_);
-  mapsTexture_ = fieldBuffer_ = positionsBuffer_ = mapsTarget_ = normalsTexture_ = 0;
-  textureBytes_ = 0;
+void GlName::reset() noexcept {
+  if (!name_) return;
+  if (kind_ == Kind::kTexture) glDeleteTextures(1, &name_);
+  else glDeleteBuffers(1, &name_);
+  name_ = 0;
 }
 
 void GpuField::bind(const Bindings& b) const noexcept {
-  glBindBufferBase(GL_UNIFORM_BUFFER, b.field, fieldBuffer_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b.positions, positionsBuffer_);
-  if (normalsTexture_) {
+  glBindBufferBase(GL_UNIFORM_BUFFER, b.field, s_.fieldBuffer.get());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b.positions, s_.positionsBuffer.get());
+  if (s_.normalsTexture) {
     glActiveTexture(GL_TEXTURE0 + b.normals);
-    glBindTexture(mapsTarget_ ? mapsTarget_ : GL_TEXTURE_2D_ARRAY, normalsTexture_);
+    glBindTexture(s_.mapsTarget ? s_.mapsTarget : GL_TEXTURE_2D_ARRAY, s_.normalsTexture.get());
   }
   glActiveTexture(GL_TEXTURE0 + b.maps);
-  glBindTexture(mapsTarget_ ? mapsTarget_ : GL_TEXTURE_2D_ARRAY, mapsTexture_);
+  glBindTexture(s_.mapsTarget ? s_.mapsTarget : GL_TEXTURE_2D_ARRAY, s_.mapsTexture.get());
 }
 
 Result<GpuField> loadField(const File& file, const LoadOptions& options) {
@@ -333,24 +306,24 @@ Result<GpuField> loadField(const File& file, const LoadOptions& options) {
 
   SavedState saved;
   GpuField out;
-  out.block_ = *block;
-  out.mapsTarget_ = layout.target == LayoutTarget::kTexture3D ? GL_TEXTURE_3D : GL_TEXTURE_2D_ARRAY;
-  if (Status s = makeTexture(out.mapsTarget_, format->internalFormat, width, layout.sliceHeight, layout.sliceCount,
-                             &out.mapsTexture_, "glTexStorage3D");
+  out.s_.block = *block;
+  out.s_.mapsTarget = layout.target == LayoutTarget::kTexture3D ? GL_TEXTURE_3D : GL_TEXTURE_2D_ARRAY;
+  if (Status s = makeTexture(out.s_.mapsTarget, format->internalFormat, width, layout.sliceHeight, layout.sliceCount,
+                             out.s_.mapsTexture.out(), "glTexStorage3D");
       !s)
     return s.error();
   setUnpackDefaults();
-  if (Status s = uploadDistance(file, out.mapsTarget_, *format, 0, &out.textureBytes_); !s) return s.error();
+  if (Status s = uploadDistance(file, out.s_.mapsTarget, *format, 0, &out.s_.textureBytes); !s) return s.error();
   if (file.hasNormals()) {
     if (Status s = checkNormals(file); !s) return s.error();
-    if (Status s = makeTexture(out.mapsTarget_, GL_RG16I, layout.sliceWidth, layout.sliceHeight, layout.sliceCount,
-                               &out.normalsTexture_, "glTexStorage3D (normals)");
+    if (Status s = makeTexture(out.s_.mapsTarget, GL_RG16I, layout.sliceWidth, layout.sliceHeight, layout.sliceCount,
+                               out.s_.normalsTexture.out(), "glTexStorage3D (normals)");
         !s)
       return s.error();
-    if (Status s = uploadNormals(file, out.mapsTarget_, 0, &out.textureBytes_); !s) return s.error();
+    if (Status s = uploadNormals(file, out.s_.mapsTarget, 0, &out.s_.textureBytes); !s) return s.error();
   }
   // The field block (with where the neighbour lists start in the positions buffer).
-  if (Status s = makeBuffer(GL_UNIFORM_BUFFER, &out.block_, sizeof(FieldBlock), &out.fieldBuffer_,
+  if (Status s = makeBuffer(GL_UNIFORM_BUFFER, &out.s_.block, sizeof(FieldBlock), out.s_.fieldBuffer.out(),
                             "uploading the field block");
       !s)
     return s.error();
@@ -358,7 +331,7 @@ Result<GpuField> loadField(const File& file, const LoadOptions& options) {
   auto positions = makePositionsBuffer(field);
   if (!positions) return positions.error();
   if (Status s = makeBuffer(GL_SHADER_STORAGE_BUFFER, positions->data(), positions->size() * sizeof(float),
-                            &out.positionsBuffer_, "uploading the sample positions");
+                            out.s_.positionsBuffer.out(), "uploading the sample positions");
       !s)
     return s.error();
   return out;

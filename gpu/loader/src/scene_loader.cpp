@@ -19,9 +19,9 @@ using namespace detail;
 namespace {
 
 // Replaces the contents of *buffer (bound to GL_SHADER_STORAGE_BUFFER), growing it when needed.
-Status fillBuffer(uint32_t* buffer, uint64_t* allocated, const void* data, size_t size, const char* what) {
-  if (!*buffer) glGenBuffers(1, buffer);
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, *buffer);
+Status fillBuffer(GlName* buffer, uint64_t* allocated, const void* data, size_t size, const char* what) {
+  if (!*buffer) glGenBuffers(1, buffer->out());
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, buffer->get());
   const size_t want = std::max<size_t>(size, 16);
   if (want > *allocated) {
     glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(want), nullptr, GL_DYNAMIC_DRAW);
@@ -33,51 +33,17 @@ Status fillBuffer(uint32_t* buffer, uint64_t* allocated, const void* data, size_
 
 }  // namespace
 
-GpuScene::GpuScene(GpuScene&& o) noexcept { *this = std::move(o); }
-
-GpuScene& GpuScene::operator=(GpuScene&& o) noexcept {
-  if (this != &o) {
-    release();
-    plan_ = std::move(o.plan_);
-    queries_ = std::move(o.queries_);
-    maps_ = std::exchange(o.maps_, 0);
-    normals_ = std::exchange(o.normals_, 0);
-    positions_ = std::exchange(o.positions_, 0);
-    fields_ = std::exchange(o.fields_, 0);
-    instances_ = std::exchange(o.instances_, 0);
-    nodes_ = std::exchange(o.nodes_, 0);
-    instancesSize_ = std::exchange(o.instancesSize_, 0);
-    nodesSize_ = std::exchange(o.nodesSize_, 0);
-    instanceCount_ = std::exchange(o.instanceCount_, 0);
-    textureBytes_ = std::exchange(o.textureBytes_, 0);
-  }
-  return *this;
-}
-
-GpuScene::~GpuScene() { release(); }
-
-void GpuScene::release() noexcept {
-  if (maps_) glDeleteTextures(1, &maps_);
-  if (normals_) glDeleteTextures(1, &normals_);
-  for (uint32_t* b : {&positions_, &fields_, &instances_, &nodes_})
-    if (*b) glDeleteBuffers(1, b);
-  maps_ = normals_ = positions_ = fields_ = instances_ = nodes_ = 0;
-  instancesSize_ = nodesSize_ = 0;
-  instanceCount_ = 0;
-  textureBytes_ = 0;
-}
-
 void GpuScene::bind(const SceneBindings& b) const noexcept {
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b.positions, positions_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b.fields, fields_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b.instances, instances_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b.nodes, nodes_);
-  if (normals_) {
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b.positions, s_.positions.get());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b.fields, s_.fields.get());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b.instances, s_.instances.get());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b.nodes, s_.nodes.get());
+  if (s_.normals) {
     glActiveTexture(GL_TEXTURE0 + b.normals);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, normals_);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, s_.normals.get());
   }
   glActiveTexture(GL_TEXTURE0 + b.maps);
-  glBindTexture(GL_TEXTURE_2D_ARRAY, maps_);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, s_.maps.get());
 }
 
 Status GpuScene::update(const Scene& scene) {
@@ -88,7 +54,7 @@ Status GpuScene::update(const Scene& scene) {
                                              " levels; the shader's stack (VFF_SCENE_STACK " +
                                              std::to_string(kSceneStack) + ") holds " +
                                              std::to_string((kSceneStack - 1) / 3));
-  auto inst = makeSceneInstances(scene, *h, queries_);
+  auto inst = makeSceneInstances(scene, *h, s_.queries);
   if (!inst) return std::move(inst).error();
   std::vector<uint8_t> nodes(sizeof(SceneNodesHeader) + h->nodes.size() * sizeof(SceneNode));
   SceneNodesHeader head;
@@ -101,11 +67,11 @@ Status GpuScene::update(const Scene& scene) {
   glGetError();  // a caller's stale error is not ours
   GLint saved = 0;
   glGetIntegerv(GL_SHADER_STORAGE_BUFFER_BINDING, &saved);
-  Status s = fillBuffer(&instances_, &instancesSize_, inst->data(), inst->size() * sizeof(SceneInstanceBlock),
+  Status s = fillBuffer(&s_.instances, &s_.instancesSize, inst->data(), inst->size() * sizeof(SceneInstanceBlock),
                         "uploading the scene's instances");
-  if (s) s = fillBuffer(&nodes_, &nodesSize_, nodes.data(), nodes.size(), "uploading the scene's hierarchy");
+  if (s) s = fillBuffer(&s_.nodes, &s_.nodesSize, nodes.data(), nodes.size(), "uploading the scene's hierarchy");
   glBindBuffer(GL_SHADER_STORAGE_BUFFER, GLuint(saved));
-  if (s) instanceCount_ = uint32_t(inst->size());
+  if (s) s_.instanceCount = uint32_t(inst->size());
   return s;
 }
 
@@ -123,7 +89,7 @@ Result<GpuScene> loadScene(std::span<const SceneField> fields, const LoadOptions
                                                      std::to_string(g));
     descs.push_back(fields[f].file->field());
     layouts.push_back(fields[f].file->layout());
-    out.queries_.push_back(fields[f].query);
+    out.s_.queries.push_back(fields[f].query);
   }
   auto plan = planScene(descs, layouts);
   if (!plan) return plan.error();
@@ -140,12 +106,12 @@ Result<GpuScene> loadScene(std::span<const SceneField> fields, const LoadOptions
     return makeError(Code::kUnsupported, "the scene's fields need " + std::to_string(plan->mapsLayers) +
                                              " slices in one texture; GL_MAX_ARRAY_TEXTURE_LAYERS is " +
                                              std::to_string(maxLayers));
-  out.plan_ = std::move(*plan);
-  const ScenePlan& p = out.plan_;
+  out.s_.plan = std::move(*plan);
+  const ScenePlan& p = out.s_.plan;
 
   SavedState saved;
   if (Status s = makeTexture(GL_TEXTURE_2D_ARRAY, p.wideTexels ? GL_R16UI : GL_R8UI, p.mapsWidth, p.mapsHeight,
-                             p.mapsLayers, &out.maps_, "glTexStorage3D (scene maps)");
+                             p.mapsLayers, out.s_.maps.out(), "glTexStorage3D (scene maps)");
       !s)
     return s.error();
   setUnpackDefaults();
@@ -155,28 +121,28 @@ Result<GpuScene> loadScene(std::span<const SceneField> fields, const LoadOptions
     auto format = mapsFormat(*fields[f].file, width);
     if (!format) return format.error();
     if (Status s = uploadDistance(*fields[f].file, GL_TEXTURE_2D_ARRAY, *format, p.fields[f].mapsLayer,
-                                  &out.textureBytes_);
+                                  &out.s_.textureBytes);
         !s)
       return s.error();
   }
   if (p.normalsLayers > 0) {
     if (Status s = makeTexture(GL_TEXTURE_2D_ARRAY, GL_RG16I, p.normalsWidth, p.normalsHeight, p.normalsLayers,
-                               &out.normals_, "glTexStorage3D (scene normals)");
+                               out.s_.normals.out(), "glTexStorage3D (scene normals)");
         !s)
       return s.error();
     for (size_t f = 0; f < fields.size(); ++f) {
       if (!fields[f].file->hasNormals()) continue;
-      if (Status s = uploadNormals(*fields[f].file, GL_TEXTURE_2D_ARRAY, p.fields[f].normalsLayer, &out.textureBytes_);
+      if (Status s = uploadNormals(*fields[f].file, GL_TEXTURE_2D_ARRAY, p.fields[f].normalsLayer, &out.s_.textureBytes);
           !s)
         return s.error();
     }
   }
   if (Status s = makeBuffer(GL_SHADER_STORAGE_BUFFER, p.positions.data(), p.positions.size() * sizeof(float),
-                            &out.positions_, "uploading the scene's sample positions");
+                            out.s_.positions.out(), "uploading the scene's sample positions");
       !s)
     return s.error();
   if (Status s = makeBuffer(GL_SHADER_STORAGE_BUFFER, p.fields.data(), p.fields.size() * sizeof(SceneFieldBlock),
-                            &out.fields_, "uploading the scene's field table");
+                            out.s_.fields.out(), "uploading the scene's field table");
       !s)
     return s.error();
   return out;

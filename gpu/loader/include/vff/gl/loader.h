@@ -39,9 +39,11 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "vff/error.h"
+#include "vff/gl/gl_name.h"
 #include "vff/format.h"
 #include "vff/query.h"
 #include "vff/reader.h"
@@ -115,35 +117,40 @@ struct Bindings {
   uint32_t normals = 3;    // texture unit (VFF_NORMALS_BINDING)
 };
 
-// A field on the GPU. Move-only; the destructor deletes the GL objects (the context must be current).
+// A field on the GPU. Move-only (a moved-from GpuField is empty); the destructor deletes the GL
+// objects (the context must be current).
 class GpuField {
  public:
   GpuField() = default;
-  GpuField(GpuField&& o) noexcept;
-  GpuField& operator=(GpuField&& o) noexcept;
-  GpuField(const GpuField&) = delete;
-  GpuField& operator=(const GpuField&) = delete;
-  ~GpuField();
+  GpuField(GpuField&& o) noexcept : s_(std::exchange(o.s_, {})) {}
+  GpuField& operator=(GpuField&& o) noexcept {
+    s_ = std::exchange(o.s_, {});  // (the objects held before are deleted)
+    return *this;
+  }
 
   // Binds the resources (the normal texture only when the field has one). Leaves the active
   // texture unit at `maps`.
   void bind(const Bindings& bindings = {}) const noexcept;
   // Deletes the GL objects now (the context must be current); the object becomes empty.
-  void release() noexcept;
+  void release() noexcept { s_ = {}; }
 
-  const FieldBlock& block() const noexcept { return block_; }
-  uint32_t mapsTexture() const noexcept { return mapsTexture_; }  // GL texture name
-  uint32_t mapsTarget() const noexcept { return mapsTarget_; }    // GL_TEXTURE_2D_ARRAY or GL_TEXTURE_3D
-  uint32_t normalsTexture() const noexcept { return normalsTexture_; }  // 0 without a normal plane
-  uint32_t fieldBuffer() const noexcept { return fieldBuffer_; }
-  uint32_t positionsBuffer() const noexcept { return positionsBuffer_; }
-  uint64_t textureBytes() const noexcept { return textureBytes_; }  // bytes uploaded to the texture
+  const FieldBlock& block() const noexcept { return s_.block; }
+  uint32_t mapsTexture() const noexcept { return s_.mapsTexture.get(); }  // GL texture name
+  uint32_t mapsTarget() const noexcept { return s_.mapsTarget; }          // GL_TEXTURE_2D_ARRAY or GL_TEXTURE_3D
+  uint32_t normalsTexture() const noexcept { return s_.normalsTexture.get(); }  // 0 without a normal plane
+  uint32_t fieldBuffer() const noexcept { return s_.fieldBuffer.get(); }
+  uint32_t positionsBuffer() const noexcept { return s_.positionsBuffer.get(); }
+  uint64_t textureBytes() const noexcept { return s_.textureBytes; }  // bytes uploaded to the texture
 
  private:
   friend Result<GpuField> loadField(const File& file, const LoadOptions& options);
-  FieldBlock block_;
-  uint32_t mapsTexture_ = 0, mapsTarget_ = 0, fieldBuffer_ = 0, positionsBuffer_ = 0, normalsTexture_ = 0;
-  uint64_t textureBytes_ = 0;
+  struct State {
+    FieldBlock block;
+    GlName mapsTexture{GlName::Kind::kTexture}, normalsTexture{GlName::Kind::kTexture};
+    GlName fieldBuffer{GlName::Kind::kBuffer}, positionsBuffer{GlName::Kind::kBuffer};
+    uint32_t mapsTarget = 0;
+    uint64_t textureBytes = 0;
+  } s_;
 };
 
 // Uploads the file's distance plane, field block and sample positions (see the top of this file).

@@ -40,6 +40,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "vff/gl/loader.h"
@@ -121,15 +122,16 @@ struct SceneBindings {
   uint32_t nodes = 6;      // storage buffer (VFF_SCENE_NODES_BINDING)
 };
 
-// A scene on the GPU. Move-only; the destructor deletes the GL objects (the context must be current).
+// A scene on the GPU. Move-only (a moved-from GpuScene is empty); the destructor deletes the GL
+// objects (the context must be current).
 class GpuScene {
  public:
   GpuScene() = default;
-  GpuScene(GpuScene&& o) noexcept;
-  GpuScene& operator=(GpuScene&& o) noexcept;
-  GpuScene(const GpuScene&) = delete;
-  GpuScene& operator=(const GpuScene&) = delete;
-  ~GpuScene();
+  GpuScene(GpuScene&& o) noexcept : s_(std::exchange(o.s_, {})) {}
+  GpuScene& operator=(GpuScene&& o) noexcept {
+    s_ = std::exchange(o.s_, {});  // (the objects held before are deleted)
+    return *this;
+  }
 
   // Uploads the committed scene's instances and hierarchy (see the top of this file).
   Status update(const Scene& scene);
@@ -137,20 +139,24 @@ class GpuScene {
   // texture unit at `maps`.
   void bind(const SceneBindings& bindings = {}) const noexcept;
   // Deletes the GL objects now; the object becomes empty.
-  void release() noexcept;
+  void release() noexcept { s_ = {}; }
 
-  const ScenePlan& plan() const noexcept { return plan_; }
-  uint32_t instanceCount() const noexcept { return instanceCount_; }
-  uint64_t textureBytes() const noexcept { return textureBytes_; }
+  const ScenePlan& plan() const noexcept { return s_.plan; }
+  uint32_t instanceCount() const noexcept { return s_.instanceCount; }
+  uint64_t textureBytes() const noexcept { return s_.textureBytes; }
 
  private:
   friend Result<GpuScene> loadScene(std::span<const SceneField> fields, const LoadOptions& options);
-  ScenePlan plan_;
-  std::vector<const FieldQuery*> queries_;
-  uint32_t maps_ = 0, normals_ = 0, positions_ = 0, fields_ = 0, instances_ = 0, nodes_ = 0;
-  uint64_t instancesSize_ = 0, nodesSize_ = 0;  // bytes allocated
-  uint32_t instanceCount_ = 0;
-  uint64_t textureBytes_ = 0;
+  struct State {
+    ScenePlan plan;
+    std::vector<const FieldQuery*> queries;
+    GlName maps{GlName::Kind::kTexture}, normals{GlName::Kind::kTexture};
+    GlName positions{GlName::Kind::kBuffer}, fields{GlName::Kind::kBuffer};
+    GlName instances{GlName::Kind::kBuffer}, nodes{GlName::Kind::kBuffer};
+    uint64_t instancesSize = 0, nodesSize = 0;  // bytes allocated
+    uint32_t instanceCount = 0;
+    uint64_t textureBytes = 0;
+  } s_;
 };
 
 // Uploads the fields (see the top of this file); update() then uploads a scene's instances.
