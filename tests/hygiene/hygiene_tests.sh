@@ -10,8 +10,8 @@ set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/../common/cli_harness.sh"
 
 # The files compiled for an instruction set beyond the baseline (libvff/src/cpu_features.h: the
-# group kernel's query_group_avx2.cpp and query_group_avx512.cpp, the filter's
-# filter_simd_ssse3.cpp) define no weak symbol: an inline or template function emitted there is
+# group kernel's query_group_avx2.cpp and query_group_avx512.cpp, the scene traversal's
+# scene_bvh_avx512.cpp, the filter's filter_simd_ssse3.cpp) define no weak symbol: an inline or template function emitted there is
 # code for that instruction set, and the linker may pick that copy for callers that run on any
 # x86-64 CPU (the rule at the top of libvff/src/query_group_kernel.h). A std::initializer_list in
 # a range-for did so at -O0.
@@ -20,7 +20,7 @@ test_kernel_objects_define_no_weak_symbols() {
   IFS=':' read -ra objects <<< "$VFF_OBJECTS"
   for o in "${objects[@]}"; do
     case "$o" in
-      *query_group_avx2.cpp.o | *query_group_avx512.cpp.o | *filter_simd_ssse3.cpp.o) ;;
+      *query_group_avx2.cpp.o | *query_group_avx512.cpp.o | *scene_bvh_avx512.cpp.o | *filter_simd_ssse3.cpp.o) ;;
       *) continue ;;
     esac
     kernels=$((kernels + 1))
