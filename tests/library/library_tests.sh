@@ -122,13 +122,17 @@ test_manifest_errors() {
 test_gltf_external_buffer_change_rebakes() {
   mkdir -p "$WORK/lib"
   "$MESHGEN" --gltf-scene "$WORK/lib/s.gltf"
+  # The URI "s+data%2Ebin" names "s data.bin" to tinygltf's loader ('+' is a space there); a decoy
+  # "s+data.bin" beside it must not stand in for it in the cache's note.
   python3 - "$WORK/lib/s.gltf" <<'PY'
 import base64, json, sys
 path = sys.argv[1]
 d = json.load(open(path))
 assert len(d["buffers"]) == 1 and d["buffers"][0]["uri"].startswith("data:"), d["buffers"]
-open(path[:-5] + " data.bin", "wb").write(base64.b64decode(d["buffers"][0]["uri"].split(",", 1)[1]))
-d["buffers"][0]["uri"] = "s%20data.bin"
+data = base64.b64decode(d["buffers"][0]["uri"].split(",", 1)[1])
+open(path[:-5] + " data.bin", "wb").write(data)
+open(path[:-5] + "+data.bin", "wb").write(data)
+d["buffers"][0]["uri"] = "s+data%2Ebin"
 json.dump(d, open(path, "w"))
 PY
   echo '{"vffLibrary": 1, "defaults": {"count": 2, "map-size": 8}, "entries": [{"mesh": "s.gltf", "split": "mesh"}]}' \

@@ -8,7 +8,6 @@
 #include <xxhash.h>
 
 #include <atomic>
-#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -108,6 +107,31 @@ std::optional<std::string> statLine(const std::string& path) {
          std::to_string(st.st_mtim.tv_sec) + "." + std::to_string(st.st_mtim.tv_nsec);
 }
 
+// A buffer's or image's URI as the file name the bake opens: decoded as tinygltf 2.7's loader
+// decodes it (its dlib::urldecode, which is not part of its interface): '+' is a space and each
+// "%XY" one byte (a character that is not a hex digit counting as 0), so that the note names the
+// very files the bake reads.
+std::string gltfUriPath(const std::string& uri) {
+  auto hex = [](char c) -> int {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return 0;
+  };
+  std::string path;
+  for (size_t i = 0; i < uri.size(); ++i) {
+    if (uri[i] == '+') {
+      path += ' ';
+    } else if (uri[i] == '%' && uri.size() > i + 2) {
+      path += char((hex(uri[i + 1]) << 4) | hex(uri[i + 2]));
+      i += 2;
+    } else {
+      path += uri[i];
+    }
+  }
+  return path;
+}
+
 // The identities of the files a .gltf reads besides itself (its buffers and images not inlined as
 // data: URIs), one line each; nothing for other formats. None when the .gltf cannot be read as
 // JSON or a file it names is missing: the entry is then read anew (and the bake says what is wrong).
@@ -123,15 +147,7 @@ std::optional<std::string> referencedFiles(const std::string& mesh) {
       if (!item.is_object() || !item.contains("uri") || !item["uri"].is_string()) continue;
       const std::string uri = item["uri"].get<std::string>();
       if (uri.rfind("data:", 0) == 0) continue;
-      std::string path;  // percent-decoded, relative to the .gltf
-      for (size_t i = 0; i < uri.size(); ++i) {
-        if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit(uint8_t(uri[i + 1])) && std::isxdigit(uint8_t(uri[i + 2]))) {
-          path += char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
-          i += 2;
-        } else {
-          path += uri[i];
-        }
-      }
+      const std::string path = gltfUriPath(uri);  // relative to the .gltf
       const std::string full = (fs::path(mesh).parent_path() / path).string();
       const auto id = statLine(full);
       if (!id) return std::nullopt;
