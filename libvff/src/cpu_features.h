@@ -3,8 +3,8 @@
 //
 // libvff selects ISA code one way: each file of code for an instruction set beyond the build's
 // baseline is compiled alone with that set's flags (libvff/CMakeLists.txt: query_group_avx2.cpp,
-// query_group_avx512.cpp, scene_bvh_avx512.cpp, filter_simd_ssse3.cpp), and its callers reach it through a pointer
-// chosen by these flags, so that none of its code runs on a CPU without the set.
+// query_group_avx512.cpp, scene_bvh_avx512.cpp, filter_simd_ssse3.cpp), and its callers reach it
+// through a pointer chosen by these flags, so that none of its code runs on a CPU without the set.
 #pragma once
 
 namespace vff::detail {
@@ -12,7 +12,8 @@ namespace vff::detail {
 struct CpuFeatures {
   bool ssse3 = false;   // filter_simd_ssse3.cpp
   bool avx2 = false;    // query_group_avx2.cpp
-  bool avx512 = false;  // query_group_avx512.cpp, scene_bvh_avx512.cpp: AVX-512 F, DQ, VL and BW, and BMI2
+  // query_group_avx512.cpp, scene_bvh_avx512.cpp: AVX-512 F, DQ, VL and BW, and BMI2
+  bool avx512 = false;
 };
 
 // Checked once (and including the OS's support for the registers: libgcc's and compiler-rt's

@@ -90,7 +90,6 @@ struct Builder {
         grow(&binBox[bin], boxes[p[i]]);
         grow(&binCentres[bin], centreBox(p[i]));
       }
-      float rightArea[kBins];
       uint32_t rightCount[kBins];
       Box rightBox[kBins], rightCentres[kBins];
       Box acc = emptyBox(), accCentres = emptyBox();
@@ -99,7 +98,6 @@ struct Builder {
         grow(&acc, binBox[b]);
         grow(&accCentres, binCentres[b]);
         n += binCount[b];
-        rightArea[b] = area(acc);
         rightCount[b] = n;
         rightBox[b] = acc, rightCentres[b] = accCentres;
       }
@@ -112,7 +110,7 @@ struct Builder {
         grow(&accCentres, binCentres[b - 1]);
         n += binCount[b - 1];
         if (n == 0 || rightCount[b] == 0) continue;
-        const float cost = area(acc) * float(n) + rightArea[b] * float(rightCount[b]);
+        const float cost = area(acc) * float(n) + area(rightBox[b]) * float(rightCount[b]);
         if (cost < best) {
           best = cost;
           bestSplit = b;

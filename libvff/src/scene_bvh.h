@@ -100,9 +100,9 @@ class Bvh4 {
   // for all of them at once: the batch goes down the tree as a stream, each node testing the rays
   // that reached it against its four boxes, so that a node is read once for the batch and no ray
   // keeps a stack of its own.
-  // `node` steps each node (collectNodeScalar or a vector kernel of the same answers; null: the
+  // `step` steps each node (collectNodeScalar or a vector kernel of the same answers; null: the
   // widest this CPU runs).
-  void collect(const BoxRays& rays, RayLists* out, CollectNodeFn node = nullptr) const;
+  void collect(const BoxRays& rays, RayLists* out, CollectNodeFn step = nullptr) const;
 
  private:
   std::vector<Node4> nodes_;

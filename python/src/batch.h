@@ -25,8 +25,8 @@ namespace vff::python {
 namespace py = pybind11;
 
 
-// Rays per batch call on one thread: the larger of the sizes measured best around the copies in
-// and out of numpy (benchmarks/python_query.py), which stream.
+// Rays per batch call on one thread: the smallest of the sizes that measured best around the
+// copies in and out of numpy (benchmarks/python_query.py), which stream.
 inline constexpr size_t kChunk = 16384;
 
 struct PyQuery {
@@ -206,7 +206,9 @@ Hits fillHits(const Target& target, const RayBatch& b, Hits h) {
     // Selects by bit masks, not branches: whether a ray hit is as good as random, and a
     // mispredicted branch a ray cost more than the rest of this loop.
     const uint32_t nan = 0x7fc00000u;  // the quiet NaN's bits
-    auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
+    auto orNan = [nan](uint32_t mask, float v) {  // v where mask is all ones, else NaN
+      return std::bit_cast<float>((std::bit_cast<uint32_t>(v) & mask) | (nan & ~mask));
+    };
     for (size_t k = 0; k < rays.size(); ++k) {
       const Hit& q = out[k];
       const size_t i = first + k;
@@ -215,12 +217,8 @@ Hits fillHits(const Target& target, const RayBatch& b, Hits h) {
       const uint32_t hm = 0u - uint32_t(q.hit), nm = 0u - uint32_t(q.hasNormal);
       float* p = point + 3 * i;
       float* pn = normal + 3 * i;
-      p[0] = std::bit_cast<float>((bits(q.point.x) & hm) | (nan & ~hm));
-      p[1] = std::bit_cast<float>((bits(q.point.y) & hm) | (nan & ~hm));
-      p[2] = std::bit_cast<float>((bits(q.point.z) & hm) | (nan & ~hm));
-      pn[0] = std::bit_cast<float>((bits(q.normal.x) & nm) | (nan & ~nm));
-      pn[1] = std::bit_cast<float>((bits(q.normal.y) & nm) | (nan & ~nm));
-      pn[2] = std::bit_cast<float>((bits(q.normal.z) & nm) | (nan & ~nm));
+      p[0] = orNan(hm, q.point.x), p[1] = orNan(hm, q.point.y), p[2] = orNan(hm, q.point.z);
+      pn[0] = orNan(nm, q.normal.x), pn[1] = orNan(nm, q.normal.y), pn[2] = orNan(nm, q.normal.z);
     }
   });
   return h;
