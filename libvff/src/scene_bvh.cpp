@@ -74,17 +74,19 @@ struct Builder {
     Box side[2][2];  // [left, right][box, centre box] of the chosen split
     // (Two primitives: the split binning would find, when it finds one, is the middle split's.)
     if (extent > 0 && depth < 48 && count > 2) {
-      // Binned SAH on the widest centroid axis.
+      // Binned SAH on the widest centroid axis, with fewer bins for fewer primitives (a node's
+      // sweeps cost as much per bin as its binning costs per primitive).
+      const int bins = count < uint32_t(kBins) ? std::max(4, int(count)) : kBins;
       Box binBox[kBins], binCentres[kBins];
       uint32_t binCount[kBins] = {};
-      std::fill_n(binBox, kBins, emptyBox());
-      std::fill_n(binCentres, kBins, emptyBox());
-      const float scale = kBins / extent;
+      std::fill_n(binBox, bins, emptyBox());
+      std::fill_n(binCentres, bins, emptyBox());
+      const float scale = float(bins) / extent;
       binIds.resize(count);
       for (uint32_t i = 0; i < count; ++i) {
         // Written so that a huge or NaN product (a tiny extent) never reaches the conversion.
         const float f = (centre[3 * size_t(p[i]) + axis] - cbox.lo[axis]) * scale;
-        const int bin = f >= float(kBins - 1) ? kBins - 1 : (f > 0 ? int(f) : 0);
+        const int bin = f >= float(bins - 1) ? bins - 1 : (f > 0 ? int(f) : 0);
         binIds[i] = uint8_t(bin);
         ++binCount[bin];
         grow(&binBox[bin], boxes[p[i]]);
@@ -94,7 +96,7 @@ struct Builder {
       Box rightBox[kBins], rightCentres[kBins];
       Box acc = emptyBox(), accCentres = emptyBox();
       uint32_t n = 0;
-      for (int b = kBins - 1; b > 0; --b) {
+      for (int b = bins - 1; b > 0; --b) {
         grow(&acc, binBox[b]);
         grow(&accCentres, binCentres[b]);
         n += binCount[b];
@@ -105,7 +107,7 @@ struct Builder {
       n = 0;
       float best = kInf;
       int bestSplit = -1;
-      for (int b = 1; b < kBins; ++b) {
+      for (int b = 1; b < bins; ++b) {
         grow(&acc, binBox[b - 1]);
         grow(&accCentres, binCentres[b - 1]);
         n += binCount[b - 1];
@@ -117,15 +119,21 @@ struct Builder {
           side[0][0] = acc, side[0][1] = accCentres, side[1][0] = rightBox[b], side[1][1] = rightCentres[b];
         }
       }
-      if (bestSplit > 0) {  // a stable partition, through the builder's scratch (no allocation per node)
-        scratch.clear();
-        uint32_t* left = p;
+      if (bestSplit > 0) {
+        // A stable partition through the builder's scratch, without a branch: each primitive is
+        // written to both sides and only its own side's end moves (the sides are random bits,
+        // which a branch mispredicts half the time).
+        scratch.resize(count);
+        uint32_t nLeft = 0, nRight = 0;
         for (uint32_t i = 0; i < count; ++i) {
-          if (binIds[i] < bestSplit) *left++ = p[i];
-          else scratch.push_back(p[i]);
+          const uint32_t prim = p[i], right = binIds[i] >= bestSplit ? 1u : 0u;
+          p[nLeft] = prim;
+          scratch[nRight] = prim;
+          nLeft += 1u - right;
+          nRight += right;
         }
-        std::copy(scratch.begin(), scratch.end(), left);
-        mid = uint32_t(left - p);
+        std::copy(scratch.begin(), scratch.begin() + nRight, p + nLeft);
+        mid = nLeft;
       }
     }
     if (mid == 0 || mid == count) {
