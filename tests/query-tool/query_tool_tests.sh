@@ -310,6 +310,19 @@ test_errors_and_exit_codes() {
   expect_err "$WORK/none.csv"
   query "$VECTORS/bit1-stored.vff" --ray 0 0 5 0 0 -1 -o "$WORK/no/such/dir/out.csv"
   expect_rc 2
+  # A folder where a file is expected: the field, and the rays.
+  mkdir -p "$WORK/folder.vff"
+  query "$WORK/folder.vff" --ray 0 0 5 0 0 -1
+  expect_rc 2
+  expect_err "$WORK/folder.vff: not a regular file"
+  query "$VECTORS/bit1-stored.vff" -i "$WORK/folder.vff"
+  expect_rc 2
+  expect_err "cannot read $WORK/folder.vff"
+  # An empty field file is not a field (nothing is read past its end).
+  : >"$WORK/empty.vff"
+  query "$WORK/empty.vff" --ray 0 0 5 0 0 -1
+  expect_rc 3
+  expect_err "vff-query: error: $WORK/empty.vff"
 }
 
 run_test "$1"

@@ -6,12 +6,11 @@
 //   vff-query bunny.vff -i rays.csv --interpolated --visibility --rotate 0 1 0 0.5 --translate 2 0 0
 //
 // Every answer is the C++ batch query's (FieldQuery or Instance), split over threads in chunks;
-// the answers do not depend on the thread count. A .npy input is read in place (mapped) and turned
-// into rays chunk by chunk on the threads that answer them; a .npy output file is written by those
+// the answers do not depend on the thread count. A .npy input is read whole (file_bytes.h) and
+// turned into rays chunk by chunk on the threads that answer them; a .npy output file is written by those
 // threads too, each chunk's rows at their offset, so that no whole copy of the rays or answers is
 // ever made.
 #include <fcntl.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -26,6 +25,7 @@
 #include <utility>
 
 #include "cli.h"
+#include "file_bytes.h"
 #include "npy.h"
 #include "rays.h"
 #include "vff/vff.h"
@@ -113,8 +113,8 @@ void addOptions(CLI::App& app, Options& o) {
                "whole and of the batch calls alone on warm memory (run 3 more times; for benchmarks)");
 }
 
-// The bytes of an input: a regular file is mapped read-only (no copy), standard input ("-") and
-// other files are read whole.
+// The bytes of an input, read whole: a regular file as FileBytes reads it, standard input ("-")
+// and other files (pipes) as they come.
 class Input {
  public:
   static Result<Input> open(const std::string& path) {
@@ -128,14 +128,12 @@ class Input {
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd < 0) return makeError(Code::kIoOpen, "cannot open " + path + ": " + std::strerror(errno));
     struct stat st {};
-    if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
-      void* p = ::mmap(nullptr, size_t(st.st_size), PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
-      if (p != MAP_FAILED) {
-        ::close(fd);
-        in.map_ = static_cast<const uint8_t*>(p);
-        in.mapSize_ = size_t(st.st_size);
-        return in;
-      }
+    if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode)) {
+      ::close(fd);
+      auto file = FileBytes::read(path);
+      if (!file) return std::move(file).error();
+      in.file_ = std::move(*file);
+      return in;
     }
     uint8_t buf[1 << 16];
     ssize_t n;
@@ -145,18 +143,11 @@ class Input {
     if (n < 0) return makeError(Code::kIoRead, "cannot read " + path + ": " + std::strerror(err));
     return in;
   }
-  Input() = default;
-  Input(Input&& o) noexcept : owned_(std::move(o.owned_)), map_(std::exchange(o.map_, nullptr)), mapSize_(o.mapSize_) {}
-  Input& operator=(Input&&) = delete;
-  ~Input() {
-    if (map_) ::munmap(const_cast<uint8_t*>(map_), mapSize_);
-  }
-  std::span<const uint8_t> bytes() const { return map_ ? std::span(map_, mapSize_) : std::span<const uint8_t>(owned_); }
+  std::span<const uint8_t> bytes() const { return file_.bytes().empty() ? std::span<const uint8_t>(owned_) : file_.bytes(); }
 
  private:
   std::vector<uint8_t> owned_;
-  const uint8_t* map_ = nullptr;
-  size_t mapSize_ = 0;
+  FileBytes file_;
 };
 
 // Where the rays of a run come from: the rows of a .npy matrix, read in place (each chunk turned
@@ -296,7 +287,10 @@ int run(int argc, char** argv) {
   ro.checksums = o.checksums == "none" ? ChecksumPolicy::kNone
                  : o.checksums == "lazy" ? ChecksumPolicy::kLazy
                                          : ChecksumPolicy::kVerifyAll;
-  auto file = File::open(o.field, ro);
+  // Read whole into memory of its own (file_bytes.h), which the File and the query borrow.
+  auto fieldBytes = FileBytes::read(o.field);
+  if (!fieldBytes) return cli::reportError(kProg, o.field, fieldBytes.error());
+  auto file = File::openMemory(fieldBytes->bytes(), ro);
   if (!file) return cli::reportError(kProg, o.field, file.error());
   auto q = FieldQuery::fromFile(*file);
   if (!q) return cli::reportError(kProg, o.field, q.error());
@@ -433,7 +427,15 @@ int run(int argc, char** argv) {
     // vff::Ray, warm (best of 3 each), over the same threads in the same chunks: the batch calls
     // as a library caller makes them, every answer kept in an array of all of them; and the batch
     // calls alone, each chunk's answers dropped (a bound no caller reaches: its answers never
-    // leave the cache). Intersect only: no lookup sites, no visibility.
+    // leave the cache). Intersect only: no lookup sites, no visibility. The field as a library
+    // caller (and the Python module) opens it: File::open's mapping, not this tool's copy.
+    auto mappedFile = File::open(o.field, ro);
+    if (!mappedFile) return cli::reportError(kProg, o.field, mappedFile.error());
+    auto mapped = FieldQuery::fromFile(*mappedFile);
+    if (!mapped) return cli::reportError(kProg, o.field, mapped.error());
+    std::optional<Instance> mappedInstance;
+    if (inst) mappedInstance = Instance{&*mapped, inst->transform};
+    const Target baseline{&*mapped, mappedInstance};
     std::vector<Ray> held(src.rows ? src.size : 0);
     for (size_t i = 0; i < held.size(); ++i) held[i] = src.row(i);
     const std::span<const Ray> warmRays = src.rows ? std::span<const Ray>(held) : src.rays;
@@ -444,11 +446,11 @@ int run(int argc, char** argv) {
     for (int r = 0; r < 3; ++r) {
       auto b0 = std::chrono::steady_clock::now();
       inChunks(src.size, threads, [&](size_t first, size_t count) {
-        target.intersect(warmRays.subspan(first, count), std::span(kept).subspan(first, count), qo);
+        baseline.intersect(warmRays.subspan(first, count), std::span(kept).subspan(first, count), qo);
       });
       keptBatch = std::min(keptBatch, sec(b0, std::chrono::steady_clock::now()));
       b0 = std::chrono::steady_clock::now();
-      answer(target, warm, qo, hitColumns, threads, [](size_t, const Answers&) {});
+      answer(baseline, warm, qo, hitColumns, threads, [](size_t, const Answers&) {});
       batch = std::min(batch, sec(b0, std::chrono::steady_clock::now()));
     }
     std::fprintf(stderr,
