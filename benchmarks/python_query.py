@@ -7,7 +7,8 @@
 Makes `--rays` ambient-occlusion rays about the field (origins on a disc around its foot, up to
 2R, cosine-weighted; as vff-experiments bench's "ao" set) and writes them as an (N, 6) float32
 .npy. Then, best of --repeat each, alternating:
-  C++ batch    vff-query --timing: FieldQuery::intersect on the rays as vff::Ray in memory, in chunks
+  C++ batch    vff-query --timing: FieldQuery::intersect on the rays as vff::Ray in memory, the field
+               opened by File::open (mapped, as a C++ caller and the Python module open it), in chunks
                over its threads, every answer kept in an array of all of them (as a C++ caller
                holds them), warm: the baseline of every ratio; and the same calls with each chunk's
                answers dropped (they never leave the cache: a bound, not a use)
@@ -16,6 +17,9 @@ Makes `--rays` ambient-occlusion rays about the field (origins on a disc around 
                sites (the default), with --no-sites, and with --columns hit,t (the least to write)
   I/O floor    reading the rays file and writing the answers' bytes, through the page cache, in
                Python: what vff-query's reading and writing cannot beat
+  one ray      vff-query answering one --ray: its fixed cost (process start, the field opened and
+               its checksums verified); with the I/O floor and the C++ batch, the bound on any
+               vff-query's end-to-end rate here
   Python       FieldQuery.intersect(origins, directions) on numpy arrays (threads as vff-query's),
                warm (after an untimed call), with new answer arrays and with out= (arrays reused),
                and FieldQuery.occluded for reference
@@ -69,7 +73,7 @@ def main():
     o, d = ao_rays(f, a.rays)
     extra = ["--interpolated"] if a.interpolated else []
     best = {"cpp": 0.0, "dropped": 0.0, "cli": 0.0, "nosites": 0.0, "hitt": 0.0, "floor": 0.0, "py": 0.0, "reuse": 0.0,
-            "occ": 0.0}
+            "occ": 0.0, "one": float("inf")}
     reuse = q.intersect(o, d, interpolated=a.interpolated, threads=a.threads)
     with tempfile.TemporaryDirectory() as tmp:
         rays = os.path.join(tmp, "rays.npy")
@@ -80,6 +84,9 @@ def main():
         answer_bytes = bytes(a.rays * 12 * 4)
         np.save(rays, np.hstack([o, d]))
         base = [a.query, a.field, "-i", rays, "-j", str(a.threads), *extra]
+        c = f.center
+        one_ray = [a.query, a.field, "--ray", *(str(v) for v in (c[0], c[1], c[2] + 3 * f.radius, 0, 0, -1)),
+                   "-j", str(a.threads), *extra]
         cmd = base + ["-o", out]
         def fresh(*paths):
             # Each timed run writes a new file, as the I/O floor does: the previous run's answers
@@ -123,6 +130,11 @@ def main():
             best["floor"] = max(best["floor"], a.rays / 1e6 / (time.perf_counter() - t0))
             os.remove(floor_out)
             os.sync()
+            # vff-query's fixed cost: the same command answering one ray given on the command line
+            # (process start, opening the field and verifying its checksums, one answer printed).
+            t0 = time.perf_counter()
+            subprocess.run(one_ray, check=True, stdout=subprocess.DEVNULL)
+            best["one"] = min(best["one"], time.perf_counter() - t0)
             # Warm, as the C++ batch is measured: one call untimed first, so that the field is back
             # in the caches the subprocesses above went through.
             q.intersect(o, d, interpolated=a.interpolated, threads=a.threads, out=reuse)
@@ -155,6 +167,11 @@ def main():
         best["hitt"], best["hitt"] / best["cpp"]))
     print("| I/O floor: read the rays .npy, write the answers' bytes (no query) | %.1f | %.2f |" % (
         best["floor"], best["floor"] / best["cpp"]))
+    # What no vff-query can beat here: its fixed cost, the I/O floor and the C++ batch, one after
+    # another (each part's best time from this run).
+    bound = a.rays / 1e6 / (best["one"] + a.rays / 1e6 / best["floor"] + a.rays / 1e6 / best["cpp"])
+    print("| bound for vff-query: its one-ray run (%.1f ms: process start, field opened and verified), "
+          "the I/O floor and the C++ batch, one after another | %.1f | %.2f |" % (1e3 * best["one"], bound, bound / best["cpp"]))
     print("| Python FieldQuery.intersect, numpy in and out | %.1f | %.2f |" % (best["py"], best["py"] / best["cpp"]))
     print("| Python FieldQuery.intersect, out= (arrays reused) | %.1f | %.2f |" % (best["reuse"], best["reuse"] / best["cpp"]))
     print("| Python FieldQuery.occluded (a byte per ray out; no C++ baseline here) | %.1f | - |" % best["occ"])
