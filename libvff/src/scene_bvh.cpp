@@ -19,97 +19,133 @@ constexpr uint32_t kLeafSize = 1;
 
 Box emptyBox() { return Box{{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}}; }
 
-void grow(Box* b, const Box& o) {
-  for (int a = 0; a < 3; ++a) {
-    b->lo[a] = std::min(b->lo[a], o.lo[a]);
-    b->hi[a] = std::max(b->hi[a], o.hi[a]);
-  }
-}
-
 float area(const Box& b) {
   const float x = b.hi[0] - b.lo[0], y = b.hi[1] - b.lo[1], z = b.hi[2] - b.lo[2];
   if (!(x >= 0) || !(y >= 0) || !(z >= 0)) return 0;
   return x * y + y * z + z * x;
 }
 
-struct Builder {
-  const std::vector<Box>& boxes;
-  std::vector<uint32_t>& prims;
-  std::vector<float>& centre;         // 3 per primitive
-  std::vector<BinaryNode>& nodes;
-  std::vector<uint32_t>& scratch;     // the right side of a partition
-  std::vector<uint8_t>& binIds;       // each primitive's bin, by position in the node's range
+// Four floats, of which the builder uses three (the fourth is zero or ignored): a box corner or a
+// centre, taken in one SSE2 operation where there is SSE2. min and max are exact, so both forms
+// build the same hierarchy.
+#if VFF_SCENE_SSE2
+struct V4 {
+  __m128 v;
+};
+inline V4 load4(const float* p) { return {_mm_load_ps(p)}; }
+inline void store4(float* p, V4 a) { _mm_store_ps(p, a.v); }
+inline V4 splat4(float f) { return {_mm_set1_ps(f)}; }
+inline V4 min4(V4 a, V4 b) { return {_mm_min_ps(a.v, b.v)}; }
+inline V4 max4(V4 a, V4 b) { return {_mm_max_ps(a.v, b.v)}; }
+inline V4 mid4(V4 a, V4 b) { return {_mm_mul_ps(_mm_add_ps(a.v, b.v), _mm_set1_ps(0.5f))}; }
+#else
+struct V4 {
+  float v[4];
+};
+inline V4 load4(const float* p) { return {{p[0], p[1], p[2], p[3]}}; }
+inline void store4(float* p, V4 a) { std::copy(a.v, a.v + 4, p); }
+inline V4 splat4(float f) { return {{f, f, f, f}}; }
+inline V4 min4(V4 a, V4 b) { return {{std::min(a.v[0], b.v[0]), std::min(a.v[1], b.v[1]), std::min(a.v[2], b.v[2]), std::min(a.v[3], b.v[3])}}; }
+inline V4 max4(V4 a, V4 b) { return {{std::max(a.v[0], b.v[0]), std::max(a.v[1], b.v[1]), std::max(a.v[2], b.v[2]), std::max(a.v[3], b.v[3])}}; }
+inline V4 mid4(V4 a, V4 b) {
+  V4 m;
+  for (int i = 0; i < 4; ++i) m.v[i] = (a.v[i] + b.v[i]) * 0.5f;
+  return m;
+}
+#endif
 
-  Box centreBox(uint32_t prim) const {
-    const float* c = &centre[3 * size_t(prim)];
-    return Box{{c[0], c[1], c[2]}, {c[0], c[1], c[2]}};
+// A box of the builder: of primitives, or of their centres.
+struct Box4 {
+  V4 lo = splat4(kInf), hi = splat4(-kInf);
+  void grow(V4 l, V4 h) { lo = min4(lo, l), hi = max4(hi, h); }
+  void grow(const Box4& b) { grow(b.lo, b.hi); }
+  Box box() const {
+    alignas(16) float l[4], h[4];
+    store4(l, lo), store4(h, hi);
+    return Box{{l[0], l[1], l[2]}, {h[0], h[1], h[2]}};
   }
-  // The box around primitives [start, start + count) and the box around their centres.
-  void bounds(uint32_t start, uint32_t count, Box* box, Box* cbox) const {
-    *box = emptyBox(), *cbox = emptyBox();
+};
+
+float area(const Box4& b) { return area(b.box()); }
+
+struct Builder {
+  std::vector<PrimRef>& refs;        // the primitives' boxes, in the order of ids
+  std::vector<uint32_t>& ids;        // the primitives, reordered as the nodes split them
+  std::vector<PrimRef>& refScratch;  // the right side of a partition
+  std::vector<uint32_t>& idScratch;
+  std::vector<BinaryNode>& nodes;
+  std::vector<uint8_t>& binIds;      // each primitive's bin, by position in the node's range
+
+  static V4 lo(const PrimRef& r) { return load4(r.lo); }
+  static V4 hi(const PrimRef& r) { return load4(r.hi); }
+  // The boxes around primitives [start, start + count) and around their centres.
+  void bounds(uint32_t start, uint32_t count, Box4* box, Box4* cbox) const {
+    *box = Box4{}, *cbox = Box4{};
     for (uint32_t i = start; i < start + count; ++i) {
-      grow(box, boxes[prims[i]]);
-      grow(cbox, centreBox(prims[i]));
+      const V4 l = lo(refs[i]), h = hi(refs[i]), c = mid4(l, h);
+      box->grow(l, h);
+      cbox->grow(c, c);
     }
   }
 
   // The node over primitives [start, start + count), whose bounds are `box` and `cbox` (a split
   // hands its children theirs, from the bins: each primitive is visited twice a level, to bin it
   // and to move it).
-  uint32_t build(uint32_t start, uint32_t count, int depth, const Box& box, const Box& cbox) {
+  uint32_t build(uint32_t start, uint32_t count, int depth, const Box4& box, const Box4& cbox) {
     const uint32_t id = uint32_t(nodes.size());
     nodes.emplace_back();
-    nodes[id].box = box;
+    nodes[id].box = box.box();
     if (count <= kLeafSize) {
       nodes[id].start = start;
       nodes[id].count = count;
       return id;
     }
     uint32_t mid = 0;
+    const Box cb = cbox.box();
     int axis = 0;
     for (int a = 1; a < 3; ++a)
-      if (cbox.hi[a] - cbox.lo[a] > cbox.hi[axis] - cbox.lo[axis]) axis = a;
-    const float extent = cbox.hi[axis] - cbox.lo[axis];
-    uint32_t* p = prims.data() + start;
-    Box side[2][2];  // [left, right][box, centre box] of the chosen split
+      if (cb.hi[a] - cb.lo[a] > cb.hi[axis] - cb.lo[axis]) axis = a;
+    const float extent = cb.hi[axis] - cb.lo[axis];
+    PrimRef* p = refs.data() + start;
+    uint32_t* pid = ids.data() + start;
+    Box4 side[2][2];  // [left, right][box, centre box] of the chosen split
     // (Two primitives: the split binning would find, when it finds one, is the middle split's.)
     if (extent > 0 && depth < 48 && count > 2) {
       // Binned SAH on the widest centroid axis, with fewer bins for fewer primitives (a node's
       // sweeps cost as much per bin as its binning costs per primitive).
       const int bins = count < uint32_t(kBins) ? std::max(4, int(count)) : kBins;
-      Box binBox[kBins], binCentres[kBins];
+      Box4 binBox[kBins], binCentres[kBins];
       uint32_t binCount[kBins] = {};
-      std::fill_n(binBox, bins, emptyBox());
-      std::fill_n(binCentres, bins, emptyBox());
       const float scale = float(bins) / extent;
       binIds.resize(count);
       for (uint32_t i = 0; i < count; ++i) {
         // Written so that a huge or NaN product (a tiny extent) never reaches the conversion.
-        const float f = (centre[3 * size_t(p[i]) + axis] - cbox.lo[axis]) * scale;
+        const float f = (p[i].centre(axis) - cb.lo[axis]) * scale;
         const int bin = f >= float(bins - 1) ? bins - 1 : (f > 0 ? int(f) : 0);
         binIds[i] = uint8_t(bin);
         ++binCount[bin];
-        grow(&binBox[bin], boxes[p[i]]);
-        grow(&binCentres[bin], centreBox(p[i]));
+        const V4 l = lo(p[i]), h = hi(p[i]), c = mid4(l, h);
+        binBox[bin].grow(l, h);
+        binCentres[bin].grow(c, c);
       }
       uint32_t rightCount[kBins];
-      Box rightBox[kBins], rightCentres[kBins];
-      Box acc = emptyBox(), accCentres = emptyBox();
+      Box4 rightBox[kBins], rightCentres[kBins];
+      Box4 acc, accCentres;
       uint32_t n = 0;
       for (int b = bins - 1; b > 0; --b) {
-        grow(&acc, binBox[b]);
-        grow(&accCentres, binCentres[b]);
+        acc.grow(binBox[b]);
+        accCentres.grow(binCentres[b]);
         n += binCount[b];
         rightCount[b] = n;
         rightBox[b] = acc, rightCentres[b] = accCentres;
       }
-      acc = emptyBox(), accCentres = emptyBox();
+      acc = Box4{}, accCentres = Box4{};
       n = 0;
       float best = kInf;
       int bestSplit = -1;
       for (int b = 1; b < bins; ++b) {
-        grow(&acc, binBox[b - 1]);
-        grow(&accCentres, binCentres[b - 1]);
+        acc.grow(binBox[b - 1]);
+        accCentres.grow(binCentres[b - 1]);
         n += binCount[b - 1];
         if (n == 0 || rightCount[b] == 0) continue;
         const float cost = area(acc) * float(n) + area(rightBox[b]) * float(rightCount[b]);
@@ -123,26 +159,36 @@ struct Builder {
         // A stable partition through the builder's scratch, without a branch: each primitive is
         // written to both sides and only its own side's end moves (the sides are random bits,
         // which a branch mispredicts half the time).
-        scratch.resize(count);
+        refScratch.resize(count);
+        idScratch.resize(count);
         uint32_t nLeft = 0, nRight = 0;
         for (uint32_t i = 0; i < count; ++i) {
-          const uint32_t prim = p[i], right = binIds[i] >= bestSplit ? 1u : 0u;
-          p[nLeft] = prim;
-          scratch[nRight] = prim;
+          const PrimRef r = p[i];
+          const uint32_t prim = pid[i], right = binIds[i] >= bestSplit ? 1u : 0u;
+          p[nLeft] = r, pid[nLeft] = prim;
+          refScratch[nRight] = r, idScratch[nRight] = prim;
           nLeft += 1u - right;
           nRight += right;
         }
-        std::copy(scratch.begin(), scratch.begin() + nRight, p + nLeft);
+        std::copy(refScratch.begin(), refScratch.begin() + nRight, p + nLeft);
+        std::copy(idScratch.begin(), idScratch.begin() + nRight, pid + nLeft);
         mid = nLeft;
       }
     }
     if (mid == 0 || mid == count) {
-      // Coincident centroids or a deep branch: split in the middle, in a fixed order.
+      // Coincident centroids or a deep branch: split in the middle, in a fixed order (centre,
+      // then id), through the scratch: a partial sort of (centre, position) pairs.
       mid = count / 2;
-      std::nth_element(p, p + mid, p + count, [&](uint32_t a, uint32_t b) {
-        const float ca = centre[3 * size_t(a) + axis], cb = centre[3 * size_t(b) + axis];
-        return ca < cb || (ca == cb && a < b);
+      std::vector<std::pair<float, uint32_t>> order(count);
+      for (uint32_t i = 0; i < count; ++i) order[i] = {p[i].centre(axis), i};
+      std::nth_element(order.begin(), order.begin() + mid, order.end(), [&](const auto& a, const auto& b) {
+        return a.first < b.first || (a.first == b.first && pid[a.second] < pid[b.second]);
       });
+      refScratch.resize(count);
+      idScratch.resize(count);
+      for (uint32_t i = 0; i < count; ++i) refScratch[i] = p[order[i].second], idScratch[i] = pid[order[i].second];
+      std::copy(refScratch.begin(), refScratch.begin() + count, p);
+      std::copy(idScratch.begin(), idScratch.begin() + count, pid);
       bounds(start, mid, &side[0][0], &side[0][1]);
       bounds(start + mid, count - mid, &side[1][0], &side[1][1]);
     }
@@ -176,13 +222,16 @@ void Bvh4::build(const std::vector<Box>& boxes) {
   for (uint32_t i = 0; i < prims_.size(); ++i) prims_[i] = i;
   if (boxes.empty()) return;
   BuildMemory& mem = memory_;
-  mem.centre.resize(3 * boxes.size());
+  mem.refs.resize(boxes.size());
+  for (size_t i = 0; i < boxes.size(); ++i) {
+    PrimRef& r = mem.refs[i];
+    for (int a = 0; a < 3; ++a) r.lo[a] = boxes[i].lo[a], r.hi[a] = boxes[i].hi[a];
+    r.lo[3] = r.hi[3] = 0;
+  }
   mem.nodes.clear();
   mem.nodes.reserve(2 * boxes.size());
-  Builder b{boxes, prims_, mem.centre, mem.nodes, mem.scratch, mem.binIds};
-  for (size_t i = 0; i < boxes.size(); ++i)
-    for (int a = 0; a < 3; ++a) b.centre[3 * i + a] = 0.5f * (boxes[i].lo[a] + boxes[i].hi[a]);
-  Box all, allCentres;
+  Builder b{mem.refs, prims_, mem.refScratch, mem.idScratch, mem.nodes, mem.binIds};
+  Box4 all, allCentres;
   b.bounds(0, uint32_t(boxes.size()), &all, &allCentres);
   b.build(0, uint32_t(boxes.size()), 0, all, allCentres);
   // Collapse to four children a node: open the child of largest area until there are four.

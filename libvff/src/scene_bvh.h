@@ -81,6 +81,13 @@ struct BinaryNode {
   uint32_t start = 0, count = 0;  // count > 0: a leaf
 };
 
+// A primitive's box as Bvh4::build moves it while splitting: two rows of four floats (the fourth
+// zero), so that the builder grows its boxes a row at a time.
+struct alignas(16) PrimRef {
+  float lo[4], hi[4];
+  float centre(int axis) const noexcept { return (lo[axis] + hi[axis]) * 0.5f; }
+};
+
 class Bvh4 {
  public:
   static constexpr int kMaxDepth = 96;
@@ -110,9 +117,9 @@ class Bvh4 {
   // The builder's working memory, kept between builds: a scene rebuilt every frame then finds it
   // already faulted in.
   struct BuildMemory {
-    std::vector<float> centre;
+    std::vector<PrimRef> refs, refScratch;
+    std::vector<uint32_t> idScratch;
     std::vector<BinaryNode> nodes;
-    std::vector<uint32_t> scratch;
     std::vector<uint8_t> binIds;
     struct Pending {
       uint32_t binary, slot;
