@@ -18,8 +18,9 @@ Makes `--rays` ambient-occlusion rays about the field (origins on a disc around 
   I/O floor    reading the rays file and writing the answers' bytes, through the page cache, in
                Python: what vff-query's reading and writing cannot beat
   one ray      vff-query answering one --ray: its fixed cost (process start, the field opened and
-               its checksums verified); with the I/O floor and the C++ batch, the bound on any
-               vff-query's end-to-end rate here
+               its checksums verified); with the I/O floor and the C++ batch, one after another, the
+               rate of a vff-query that did nothing else (a bound for this tool as it runs its parts
+               in turn, not for one that overlaps its I/O with the query)
   Python       FieldQuery.intersect(origins, directions) on numpy arrays (threads as vff-query's),
                warm (after an untimed call), with new answer arrays and with out= (arrays reused),
                and FieldQuery.occluded for reference
@@ -167,11 +168,12 @@ def main():
         best["hitt"], best["hitt"] / best["cpp"]))
     print("| I/O floor: read the rays .npy, write the answers' bytes (no query) | %.1f | %.2f |" % (
         best["floor"], best["floor"] / best["cpp"]))
-    # What no vff-query can beat here: its fixed cost, the I/O floor and the C++ batch, one after
+    # A vff-query that did nothing but its fixed cost, the I/O floor and the C++ batch, one after
     # another (each part's best time from this run).
     bound = a.rays / 1e6 / (best["one"] + a.rays / 1e6 / best["floor"] + a.rays / 1e6 / best["cpp"])
     print("| bound for vff-query: its one-ray run (%.1f ms: process start, field opened and verified), "
-          "the I/O floor and the C++ batch, one after another | %.1f | %.2f |" % (1e3 * best["one"], bound, bound / best["cpp"]))
+          "the I/O floor and the C++ batch, one after another | %.1f | %.2f |" % (
+              1e3 * best["one"], bound, bound / best["cpp"]))
     print("| Python FieldQuery.intersect, numpy in and out | %.1f | %.2f |" % (best["py"], best["py"] / best["cpp"]))
     print("| Python FieldQuery.intersect, out= (arrays reused) | %.1f | %.2f |" % (best["reuse"], best["reuse"] / best["cpp"]))
     print("| Python FieldQuery.occluded (a byte per ray out; no C++ baseline here) | %.1f | - |" % best["occ"])

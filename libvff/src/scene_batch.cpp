@@ -24,14 +24,6 @@ constexpr size_t kChunk = 4096;
 // How far ahead pairing asks for the rays and the instances' steps it will read.
 constexpr size_t kRaysAhead = 8, kLeavesAhead = 2;
 
-inline void prefetch(const void* p) {
-#if defined(__GNUC__) || defined(__clang__)
-  __builtin_prefetch(p);
-#else
-  (void)p;
-#endif
-}
-
 using Pairs = detail::ScenePairs;
 using Scratch = detail::SceneScratch;
 
@@ -86,11 +78,11 @@ void pairUp(const Scene::Impl& m, std::span<const Ray> chunk, Scratch* s) {
   for (size_t c = 0; c < l.prim.size(); ++c) {
     const uint32_t id = l.prim[c], to = p->first[id];
     const detail::ToObject& x = m.toObject[id];
-    if (c + kLeavesAhead < l.prim.size()) prefetch(&m.toObject[l.prim[c + kLeavesAhead]]);
+    if (c + kLeavesAhead < l.prim.size()) __builtin_prefetch(&m.toObject[l.prim[c + kLeavesAhead]]);
     for (uint32_t k = 0; k < l.count[c]; ++k) {
       const size_t item = l.first[c] + k;
       const uint32_t r = l.rays[item];
-      if (item + kRaysAhead < listed) prefetch(&chunk[l.rays[item + kRaysAhead]]);
+      if (item + kRaysAhead < listed) __builtin_prefetch(&chunk[l.rays[item + kRaysAhead]]);
       p->ray[to + k] = r;
       p->rays[to + k] = x.ray(chunk[r]);
     }

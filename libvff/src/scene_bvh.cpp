@@ -45,8 +45,14 @@ struct V4 {
 inline V4 load4(const float* p) { return {{p[0], p[1], p[2], p[3]}}; }
 inline void store4(float* p, V4 a) { std::copy(a.v, a.v + 4, p); }
 inline V4 splat4(float f) { return {{f, f, f, f}}; }
-inline V4 min4(V4 a, V4 b) { return {{std::min(a.v[0], b.v[0]), std::min(a.v[1], b.v[1]), std::min(a.v[2], b.v[2]), std::min(a.v[3], b.v[3])}}; }
-inline V4 max4(V4 a, V4 b) { return {{std::max(a.v[0], b.v[0]), std::max(a.v[1], b.v[1]), std::max(a.v[2], b.v[2]), std::max(a.v[3], b.v[3])}}; }
+inline V4 min4(V4 a, V4 b) {
+  for (int i = 0; i < 4; ++i) a.v[i] = std::min(a.v[i], b.v[i]);
+  return a;
+}
+inline V4 max4(V4 a, V4 b) {
+  for (int i = 0; i < 4; ++i) a.v[i] = std::max(a.v[i], b.v[i]);
+  return a;
+}
 inline V4 mid4(V4 a, V4 b) {
   V4 m;
   for (int i = 0; i < 4; ++i) m.v[i] = (a.v[i] + b.v[i]) * 0.5f;
@@ -69,10 +75,11 @@ struct Box4 {
 float area(const Box4& b) { return area(b.box()); }
 
 struct Builder {
-  std::vector<PrimRef>& refs;        // the primitives' boxes, in the order of ids
+  std::vector<PrimRef>& refs;        // the primitives' boxes, each beside its id in `ids`
   std::vector<uint32_t>& ids;        // the primitives, reordered as the nodes split them
   std::vector<PrimRef>& refScratch;  // the right side of a partition
   std::vector<uint32_t>& idScratch;
+  std::vector<std::pair<float, uint32_t>>& order;  // a middle split's (centre, position) pairs
   std::vector<BinaryNode>& nodes;
   std::vector<uint8_t>& binIds;      // each primitive's bin, by position in the node's range
 
@@ -179,7 +186,7 @@ struct Builder {
       // Coincident centroids or a deep branch: split in the middle, in a fixed order (centre,
       // then id), through the scratch: a partial sort of (centre, position) pairs.
       mid = count / 2;
-      std::vector<std::pair<float, uint32_t>> order(count);
+      order.resize(count);
       for (uint32_t i = 0; i < count; ++i) order[i] = {p[i].centre(axis), i};
       std::nth_element(order.begin(), order.begin() + mid, order.end(), [&](const auto& a, const auto& b) {
         return a.first < b.first || (a.first == b.first && pid[a.second] < pid[b.second]);
@@ -230,7 +237,7 @@ void Bvh4::build(const std::vector<Box>& boxes) {
   }
   mem.nodes.clear();
   mem.nodes.reserve(2 * boxes.size());
-  Builder b{mem.refs, prims_, mem.refScratch, mem.idScratch, mem.nodes, mem.binIds};
+  Builder b{mem.refs, prims_, mem.refScratch, mem.idScratch, mem.order, mem.nodes, mem.binIds};
   Box4 all, allCentres;
   b.bounds(0, uint32_t(boxes.size()), &all, &allCentres);
   b.build(0, uint32_t(boxes.size()), 0, all, allCentres);

@@ -119,6 +119,7 @@ class Bvh4 {
   struct BuildMemory {
     std::vector<PrimRef> refs, refScratch;
     std::vector<uint32_t> idScratch;
+    std::vector<std::pair<float, uint32_t>> order;
     std::vector<BinaryNode> nodes;
     std::vector<uint8_t> binIds;
     struct Pending {

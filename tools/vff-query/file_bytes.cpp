@@ -59,8 +59,12 @@ void FileBytes::release() noexcept {
 Result<FileBytes> FileBytes::read(const std::string& path) {
   const Fd fd(::open(path.c_str(), O_RDONLY | O_CLOEXEC));
   if (fd.get() < 0) return makeError(Code::kIoOpen, path + ": " + std::strerror(errno));
+  return read(fd.get(), path);
+}
+
+Result<FileBytes> FileBytes::read(int fd, const std::string& path) {
   struct stat st {};
-  if (::fstat(fd.get(), &st) != 0) return makeError(Code::kIoRead, path + ": " + std::strerror(errno));
+  if (::fstat(fd, &st) != 0) return makeError(Code::kIoRead, path + ": " + std::strerror(errno));
   if (!S_ISREG(st.st_mode)) return makeError(Code::kIoOpen, path + ": not a regular file");
   FileBytes b;
   b.size_ = size_t(st.st_size);
@@ -79,7 +83,7 @@ Result<FileBytes> FileBytes::read(const std::string& path) {
   (void)::madvise(b.data_, size_t(static_cast<uint8_t*>(m) + b.mapSize_ - b.data_), MADV_HUGEPAGE);  // (a hint)
 #endif
   for (size_t done = 0; done < b.size_;) {
-    const ssize_t n = ::read(fd.get(), b.data_ + done, b.size_ - done);
+    const ssize_t n = ::read(fd, b.data_ + done, b.size_ - done);
     if (n < 0 && errno == EINTR) continue;
     if (n < 0) return makeError(Code::kIoRead, path + ": " + std::strerror(errno));
     if (n == 0) return makeError(Code::kIoRead, path + ": the file ended at byte " + std::to_string(done) +

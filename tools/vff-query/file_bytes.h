@@ -25,6 +25,9 @@ class FileBytes {
   // kIoOpen when the path cannot be opened or is not a regular file; kIoRead when reading fails;
   // kOutOfMemory when no memory of the file's size can be had. The messages name the path.
   static Result<FileBytes> read(const std::string& path);
+  // The same from a descriptor the caller opened and keeps (read from its current offset, which
+  // must be the start); `path` only names the file in messages.
+  static Result<FileBytes> read(int fd, const std::string& path);
 
   FileBytes() = default;
   FileBytes(FileBytes&& o) noexcept;

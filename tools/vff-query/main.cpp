@@ -7,8 +7,8 @@
 //
 // Every answer is the C++ batch query's (FieldQuery or Instance), split over threads in chunks;
 // the answers do not depend on the thread count. A .npy input is read whole (file_bytes.h) and
-// turned into rays chunk by chunk on the threads that answer them; a .npy output file is written by those
-// threads too, each chunk's rows at their offset, so that no whole copy of the rays or answers is
+// turned into rays chunk by chunk on the threads that answer them; a .npy output file is written by
+// those threads too, each chunk's rows at their offset, so that no whole copy of the answers is
 // ever made.
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -129,8 +129,8 @@ class Input {
     if (fd < 0) return makeError(Code::kIoOpen, "cannot open " + path + ": " + std::strerror(errno));
     struct stat st {};
     if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode)) {
+      auto file = FileBytes::read(fd, path);
       ::close(fd);
-      auto file = FileBytes::read(path);
       if (!file) return std::move(file).error();
       in.file_ = std::move(*file);
       return in;
@@ -143,7 +143,9 @@ class Input {
     if (n < 0) return makeError(Code::kIoRead, "cannot read " + path + ": " + std::strerror(err));
     return in;
   }
-  std::span<const uint8_t> bytes() const { return file_.bytes().empty() ? std::span<const uint8_t>(owned_) : file_.bytes(); }
+  std::span<const uint8_t> bytes() const {
+    return file_.bytes().empty() ? std::span<const uint8_t>(owned_) : file_.bytes();
+  }
 
  private:
   std::vector<uint8_t> owned_;
