@@ -18,7 +18,10 @@ template <bool kHitOnly, class Emit>
 void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOptions& o, const detail::ToObject* to,
                                     Emit&& emit) const noexcept {
   auto objectRay = [&](size_t r) { return to ? to->ray(rays[r]) : rays[r]; };
-  const detail::GroupKernel* kernel = detail::groupKernel();  // (one for the whole batch)
+  // A batch of one ray (an Embree callback for rtcIntersect1 or rtcOccluded1) takes the reference
+  // path: a group's fixed cost is larger than the ray's own, and there are no other texel reads
+  // for its read to overlap.
+  const detail::GroupKernel* kernel = rays.size() > 1 ? detail::groupKernel() : nullptr;
   if (!kernel) {
     for (size_t base = 0; base < rays.size(); base += detail::kGroupRays) {
       const size_t n = std::min(detail::kGroupRays, rays.size() - base);
