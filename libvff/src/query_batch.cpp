@@ -31,21 +31,32 @@ void writeHitBytes(uint64_t hits, size_t n, uint8_t* out) {
 }
 
 
+// Calls batch(objectRays, first) for the rays of `rays` taken to object space by `to`, kChunk at a
+// time.
+template <size_t kChunk, class Batch>
+void inChunks(const detail::ToObject& to, std::span<const Ray> rays, Batch&& batch) {
+  Ray local[kChunk];
+  for (size_t first = 0; first < rays.size(); first += kChunk) {
+    const size_t n = std::min(kChunk, rays.size() - first);
+    for (size_t r = 0; r < n; ++r) local[r] = to.ray(rays[first + r]);
+    batch(std::span<const Ray>(local, n), first);
+  }
+}
+
 // Calls batch(objectRays, first) for rays in chunks, taken to object space by x (none: the rays
-// are in object space, one call).
+// are in object space, one call). A small batch (an Embree callback's) gets a small chunk, which
+// costs less to set up.
 template <class Batch>
 void inObjectSpace(const RigidTransform* x, std::span<const Ray> rays, Batch&& batch) {
   if (!x) {
     batch(rays, size_t(0));
     return;
   }
-  constexpr size_t kChunk = 256;
   const detail::ToObject to(*x);
-  Ray local[kChunk];
-  for (size_t first = 0; first < rays.size(); first += kChunk) {
-    const size_t n = std::min(kChunk, rays.size() - first);
-    for (size_t r = 0; r < n; ++r) local[r] = to.ray(rays[first + r]);
-    batch(std::span<const Ray>(local, n), first);
+  if (rays.size() <= 16) {
+    inChunks<16>(to, rays, batch);
+  } else {
+    inChunks<256>(to, rays, batch);
   }
 }
 

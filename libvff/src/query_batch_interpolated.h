@@ -17,6 +17,12 @@ namespace vff {
 // had longer to arrive, gained nothing measurable.)
 template <class Emit>
 void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept {
+  if (rays.size() == 1) {  // (as batchNearest: a block's fixed cost is larger than one ray's own)
+    float vis = 1.0f;
+    const QueryHit h = query(rays[0], o, &vis);
+    emit(size_t(0), h, vis);
+    return;
+  }
   constexpr size_t kPlanned = detail::kPlanLanes;
   const detail::GroupKernel* kernel = detail::groupKernel();  // (one for the whole batch)
   needNeighbours();

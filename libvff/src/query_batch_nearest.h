@@ -20,7 +20,7 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
   auto objectRay = [&](size_t r) { return to ? to->ray(rays[r]) : rays[r]; };
   // A batch of one ray (an Embree callback for rtcIntersect1 or rtcOccluded1) takes the reference
   // path: a group's fixed cost is larger than the ray's own, and there are no other texel reads
-  // for its read to overlap.
+  // for its read to overlap. (batchInterpolated does the same.)
   const detail::GroupKernel* kernel = rays.size() > 1 ? detail::groupKernel() : nullptr;
   if (!kernel) {
     for (size_t base = 0; base < rays.size(); base += detail::kGroupRays) {
