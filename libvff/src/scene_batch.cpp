@@ -17,9 +17,12 @@ namespace vff {
 
 namespace {
 
-// Rays a chunk: few enough that a chunk's rays, box rays, traversal lists and pairs stay in the
-// core's own caches; the field's batch path still gets the pairs of all its instances at once.
-constexpr size_t kChunk = 4096;
+// Rays a chunk. Few enough that a chunk's rays, box rays, traversal lists and pairs stay near the
+// core's own caches (larger chunks run slower, the more so on two threads); many enough that the
+// traversal's cost per node, and its partly filled vector steps near the leaves, are shared by
+// many rays (smaller chunks run slower, the more so the more instances). The field's batch path
+// gets the pairs of all its instances at once either way.
+constexpr size_t kChunk = 8192;
 
 // How far ahead pairing asks for the rays and the instances' steps it will read.
 constexpr size_t kRaysAhead = 8, kLeavesAhead = 2;
