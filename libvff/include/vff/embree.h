@@ -22,10 +22,18 @@
 // kInterpolated the blend sees the tfar Embree holds when it calls. Filter functions are not
 // invoked.
 //
-// Why vff::Scene does not use this. vff::Scene's batches hand each instance all the rays of the
-// batch that reach it, in one call: full SIMD groups. Embree calls the callback per packet and
-// per primitive, with few active rays; vff-experiments scene-bench measures both tops. A
-// renderer that has Embree uses this; one that has only fields uses vff::Scene.
+// Speed, and why vff::Scene does not use this. vff::Scene's batches hand each instance all the
+// rays of the batch that reach it, in one call: full SIMD groups, whose texel reads overlap.
+// Embree calls the callback per packet and per primitive, with few active rays (one, for
+// rtcIntersect1 and rtcOccluded1), and such a ray waits for its own texel read, as a single-ray
+// traversal of triangles waits for its nodes. vff-experiments scene-bench measures Embree's
+// instancing of the triangles, vff::Scene and this hybrid side by side: for the bunny there, the
+// hybrid answers single AO rays more slowly than Embree's own triangles, and vff::Scene's batches
+// many times faster than either. A field's cost does not grow with its object's triangles while
+// Embree's does (vff-experiments triangle-bench), so the hybrid gains with heavier objects. Use
+// this where one traversal must meet fields and triangles together (rays that can also hit the
+// static environment); cast the rays that only the field objects can stop (their own ambient
+// occlusion, say) in batches through vff::Scene.
 //
 // Threads. The callbacks are const and run on Embree's threads. setTransform() must not run
 // while the scene is traced.
