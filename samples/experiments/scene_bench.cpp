@@ -14,13 +14,16 @@
 //   (c) hybrid: Embree's top level over N vff::embree::FieldGeometry; rtcOccluded1
 // Rays run on --threads workers (timedParallelFor); commits on the calling thread (Embree's own
 // threads for (a) and (c)); a first frame, untimed, warms every side up. Each frame's rays are
-// cast --repeat times by each side in turn and the best pass counts. The table gives the mean per
-// frame, the frame speed-up of (b) and (c) over (a), and the share of rays on which (b) agrees
-// with (a) and (c) with (b).
+// cast --repeat times by each side in turn and the best pass counts. The counts take turns too:
+// every count's scenes are built first, and each frame then moves and measures every count in
+// turn, so that the ratios between counts compare measurements from the same stretch of the run.
+// The table gives the mean per frame, the frame speed-up of (b) and (c) over (a), and the share
+// of rays on which (b) agrees with (a) and (c) with (b).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <random>
 #include <string>
 
@@ -109,90 +112,113 @@ int runSceneBench(const Options& o) {
   std::printf("| instances | (a) Embree rebuild ms | (a) rays ms | (b) vff::Scene rebuild ms | (b) rays ms | (c) hybrid "
               "rebuild ms | (c) rays ms | frame (a)/(b) | frame (a)/(c) | (b) = (a) | (c) = (b) |\n");
   std::printf("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-  std::vector<std::pair<uint32_t, double>> speedups;  // (instances, frame (a)/(b))
-  for (uint32_t n : o.instanceCounts) {
-    std::mt19937_64 g(n);
-    const float side = 4.0f * R * std::cbrt(float(n));
-    RTCScene exact = rtcNewScene(device);
-    RTCScene hybrid = rtcNewScene(device);
-    std::vector<RTCGeometry> inst(n);
-    std::vector<vff::embree::FieldGeometry> fields(n);
+  // Every count's scenes at once: the counts take turns frame by frame (below).
+  struct Count {
+    uint32_t n = 0;
+    std::mt19937_64 g;
+    float side = 0;
+    RTCScene exact = nullptr, hybrid = nullptr;
+    std::vector<RTCGeometry> inst;
+    std::vector<vff::embree::FieldGeometry> fields;
     vff::Scene scene;
-    for (uint32_t i = 0; i < n; ++i) {
-      inst[i] = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
-      rtcSetGeometryInstancedScene(inst[i], mesh);
-      rtcAttachGeometryByID(exact, inst[i], i);
-      const vff::RigidTransform x = fieldPlacement(randomPlacement(g, side));
-      fields[i] = std::move(vff::embree::FieldGeometry::attach(device, hybrid, &q, x, qo, i).value());
-      (void)scene.add(&q, x);
-    }
     Side a, b, c;
     uint64_t agreeAB = 0, agreeBC = 0, total = 0;
-    std::vector<vff::Ray> rays(o.sceneRays);
-    std::vector<uint8_t> ra(rays.size()), rb(rays.size()), rc(rays.size());
-    for (int frame = -1; frame < o.frames; ++frame) {  // frame -1 warms up (page faults, caches)
-      const double w = frame < 0 ? 0.0 : 1.0;
+  };
+  std::vector<std::unique_ptr<Count>> counts;
+  for (uint32_t n : o.instanceCounts) {
+    Count& k = *counts.emplace_back(std::make_unique<Count>());
+    k.n = n;
+    k.g.seed(n);
+    k.side = 4.0f * R * std::cbrt(float(n));
+    k.exact = rtcNewScene(device);
+    k.hybrid = rtcNewScene(device);
+    k.inst.resize(n);
+    k.fields.resize(n);
+    for (uint32_t i = 0; i < n; ++i) {
+      k.inst[i] = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+      rtcSetGeometryInstancedScene(k.inst[i], mesh);
+      rtcAttachGeometryByID(k.exact, k.inst[i], i);
+      const vff::RigidTransform x = fieldPlacement(randomPlacement(k.g, k.side));
+      k.fields[i] = std::move(vff::embree::FieldGeometry::attach(device, k.hybrid, &q, x, qo, i).value());
+      (void)k.scene.add(&q, x);
+    }
+  }
+  std::vector<vff::Ray> rays(o.sceneRays);
+  std::vector<uint8_t> ra(rays.size()), rb(rays.size()), rc(rays.size());
+  // Frame by frame, every count in turn: the ratios between counts (what the scene keeps of the
+  // single object's speed-up) then compare measurements taken in the same moments of the machine,
+  // whose speed drifts (and not alike for every side) over a run.
+  for (int frame = -1; frame < o.frames; ++frame) {  // frame -1 warms up (page faults, caches)
+    const double w = frame < 0 ? 0.0 : 1.0;
+    for (auto& count : counts) {
+      Count& k = *count;
+      const uint32_t n = k.n;
       std::vector<vff::RigidTransform> placement(n);
-      for (auto& x : placement) x = randomPlacement(g, side);
+      for (auto& x : placement) x = randomPlacement(k.g, k.side);
       std::uniform_real_distribution<float> u(0, 1);
       for (auto& r : rays) {
-        const vff::RigidTransform& x = placement[std::min(n - 1, uint32_t(u(g) * float(n)))];
-        const float u0 = u(g), u1 = u(g), u2 = u(g);
+        const vff::RigidTransform& x = placement[std::min(n - 1, uint32_t(u(k.g) * float(n)))];
+        const float u0 = u(k.g), u1 = u(k.g), u2 = u(k.g);
         const auto [point, normal] = surface.sample(u0, u1, u2);
         const Vec3 wn = x.toWorldVector(normal);
         r.origin = x.toWorldPoint(point) + wn * (1e-3f * R);
-        const float u3 = u(g), u4 = u(g);
+        const float u3 = u(k.g), u4 = u(k.g);
         r.direction = cosineDirection(wn, u3, u4);
         r.tmin = 0;
         r.tmax = o.aoDistance * R;
       }
       double t0 = now();
-      for (uint32_t i = 0; i < n; ++i) setEmbreeTransform(inst[i], placement[i]);
-      rtcCommitScene(exact);
-      a.commit += w * (now() - t0);
+      for (uint32_t i = 0; i < n; ++i) setEmbreeTransform(k.inst[i], placement[i]);
+      rtcCommitScene(k.exact);
+      k.a.commit += w * (now() - t0);
       t0 = now();
-      for (uint32_t i = 0; i < n; ++i) (void)scene.setTransform(i, fieldPlacement(placement[i]));
-      if (vff::Status st = scene.commit(); !st) return vff::cli::reportError(kProg, o.mesh, st.error());
-      b.commit += w * (now() - t0);
+      for (uint32_t i = 0; i < n; ++i) (void)k.scene.setTransform(i, fieldPlacement(placement[i]));
+      if (vff::Status st = k.scene.commit(); !st) return vff::cli::reportError(kProg, o.mesh, st.error());
+      k.b.commit += w * (now() - t0);
       t0 = now();
-      for (uint32_t i = 0; i < n; ++i) (void)fields[i].setTransform(fieldPlacement(placement[i]));
-      rtcCommitScene(hybrid);
-      c.commit += w * (now() - t0);
+      for (uint32_t i = 0; i < n; ++i) (void)k.fields[i].setTransform(fieldPlacement(placement[i]));
+      rtcCommitScene(k.hybrid);
+      k.c.commit += w * (now() - t0);
       // Each side's rays, best of --repeat passes taken in turn (a, b, c, a, b, c, ...), so that a
       // busy moment of the machine falls on no side alone.
       double ta = 1e30, tb = 1e30, tc = 1e30;
-      for (int k = 0; k < o.repeat; ++k) {
+      for (int rep = 0; rep < o.repeat; ++rep) {
         ta = std::min(ta, timedParallelFor(rays.size(), kChunk, threads, [&](uint64_t lo, uint64_t hi) {
-          for (uint64_t i = lo; i < hi; ++i) ra[i] = occluded1(exact, rays[i]);
+          for (uint64_t i = lo; i < hi; ++i) ra[i] = occluded1(k.exact, rays[i]);
         }));
         tb = std::min(tb, timedParallelFor(rays.size(), kSceneChunk, threads, [&](uint64_t lo, uint64_t hi) {
-          (void)scene.occluded(std::span<const vff::Ray>(rays).subspan(lo, hi - lo),
-                               std::span<uint8_t>(rb).subspan(lo, hi - lo), qo);
+          (void)k.scene.occluded(std::span<const vff::Ray>(rays).subspan(lo, hi - lo),
+                                 std::span<uint8_t>(rb).subspan(lo, hi - lo), qo);
         }));
         tc = std::min(tc, timedParallelFor(rays.size(), kChunk, threads, [&](uint64_t lo, uint64_t hi) {
-          for (uint64_t i = lo; i < hi; ++i) rc[i] = occluded1(hybrid, rays[i]);
+          for (uint64_t i = lo; i < hi; ++i) rc[i] = occluded1(k.hybrid, rays[i]);
         }));
       }
-      a.rays += w * ta, b.rays += w * tb, c.rays += w * tc;
+      k.a.rays += w * ta, k.b.rays += w * tb, k.c.rays += w * tc;
+      if (frame < 0) continue;
       for (size_t i = 0; i < rays.size(); ++i) {
-        agreeAB += ra[i] == rb[i];
-        agreeBC += rb[i] == rc[i];
+        k.agreeAB += ra[i] == rb[i];
+        k.agreeBC += rb[i] == rc[i];
       }
-      total += rays.size();
-      if (frame < 0) agreeAB = agreeBC = total = 0;
+      k.total += rays.size();
     }
-    const double f = 1000.0 / o.frames;
-    std::printf("| %u | %.3f | %.2f | %.3f | %.2f | %.3f | %.2f | %.2f | %.2f | %.4f | %.4f |\n", n, a.commit * f,
+  }
+  std::vector<std::pair<uint32_t, double>> speedups;  // (instances, frame (a)/(b))
+  const double f = 1000.0 / o.frames;
+  for (auto& count : counts) {
+    Count& k = *count;
+    const Side &a = k.a, &b = k.b, &c = k.c;
+    std::printf("| %u | %.3f | %.2f | %.3f | %.2f | %.3f | %.2f | %.2f | %.2f | %.4f | %.4f |\n", k.n, a.commit * f,
                 a.rays * f, b.commit * f, b.rays * f, c.commit * f, c.rays * f,
                 (a.commit + a.rays) / (b.commit + b.rays), (a.commit + a.rays) / (c.commit + c.rays),
-                double(agreeAB) / double(total), double(agreeBC) / double(total));
-    std::fflush(stdout);
-    speedups.emplace_back(n, (a.commit + a.rays) / (b.commit + b.rays));
-    fields.clear();
-    for (RTCGeometry gi : inst) rtcReleaseGeometry(gi);
-    rtcReleaseScene(hybrid);
-    rtcReleaseScene(exact);
+                double(k.agreeAB) / double(k.total), double(k.agreeBC) / double(k.total));
+    speedups.emplace_back(k.n, (a.commit + a.rays) / (b.commit + b.rays));
+    k.fields.clear();
+    for (RTCGeometry gi : k.inst) rtcReleaseGeometry(gi);
+    rtcReleaseScene(k.hybrid);
+    rtcReleaseScene(k.exact);
   }
+  std::fflush(stdout);
   rtcReleaseScene(mesh);
   rtcReleaseDevice(device);
   // The summary: where the field scene overtakes Embree, and what the scene keeps of the single
