@@ -41,15 +41,12 @@ inline Vec3 normalize(Vec3 v) {
 
 inline Vec3 toVec(const float c[3]) { return {c[0], c[1], c[2]}; }
 
-// (An unnamed namespace, as when the query was one file: the functions whose signatures name these
-// types, blendResult and the batch templates, are then local to the file that uses them, and the
-// compiler inlines them there as it did then. blendResult is defined below for that reason.)
 namespace detail {
-namespace {
 
 // A RigidTransform's inverse, taken apart once for many rays: what toObjectVector and
 // toObjectPoint compute, inlined. The group kernel repeats these operations lane by lane
-// (GroupTables::toObject).
+// (GroupTables::toObject). (Not in the unnamed namespace below: vff::Scene's state, which two
+// files share, holds these.)
 struct ToObject {
   float r[3][3];  // the inverse rotation is the transpose
   Vec3 translation;
@@ -68,6 +65,11 @@ struct ToObject {
   Vec3 point(Vec3 p) const noexcept { return vector(p - translation); }
   Ray ray(const Ray& w) const noexcept { return Ray{point(w.origin), vector(w.direction), w.tmin, w.tmax}; }
 };
+
+// (An unnamed namespace, as when the query was one file: the functions whose signatures name these
+// types, blendResult and the batch templates, are then local to the file that uses them, and the
+// compiler inlines them there as it did then. blendResult is defined below for that reason.)
+namespace {
 
 // Tables whose kernel takes world-space rays to object space by `to`, lane by lane (none: the
 // rays are in object space).
