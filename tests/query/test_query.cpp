@@ -394,6 +394,29 @@ int expectBatchesEqualSingleRays(const Q& q, const std::vector<Ray>& rays) {
       if (::testing::Test::HasFailure()) return hitCount;
       hitCount += h.hit;
     }
+    // Small batches too (an Embree callback's: one ray, or a packet of up to 16), whose paths
+    // differ from a large batch's.
+    for (const size_t size : {size_t(1), size_t(2), size_t(16), size_t(17)}) {
+      for (size_t first = 0; first + size <= std::min(rays.size(), size_t(340)); first += size) {
+        const std::span<const Ray> part = std::span<const Ray>(rays).subspan(first, size);
+        std::vector<QueryHit> h(size);
+        std::vector<uint8_t> oc(size);
+        std::vector<float> v(size);
+        q.intersect(part, h, o);
+        q.occluded(part, oc, o);
+        q.visibility(part, v, o);
+        for (size_t k = 0; k < size; ++k) {
+          const QueryHit one = q.intersect(part[k], o);
+          EXPECT_EQ(h[k].hit, one.hit) << "batch of " << size << ", ray " << first + k;
+          EXPECT_EQ(h[k].t, one.t) << "batch of " << size << ", ray " << first + k;
+          EXPECT_EQ(h[k].point.y, one.point.y) << "batch of " << size << ", ray " << first + k;
+          EXPECT_EQ(h[k].normal.z, one.normal.z) << "batch of " << size << ", ray " << first + k;
+          EXPECT_EQ(oc[k] != 0, q.occluded(part[k], o)) << "batch of " << size << ", ray " << first + k;
+          EXPECT_EQ(v[k], q.visibility(part[k], o)) << "batch of " << size << ", ray " << first + k;
+        }
+        if (::testing::Test::HasFailure()) return hitCount;
+      }
+    }
   }
   return hitCount;
 }
