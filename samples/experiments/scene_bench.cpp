@@ -112,7 +112,8 @@ int runSceneBench(const Options& o) {
   std::printf("| instances | (a) Embree rebuild ms | (a) rays ms | (b) vff::Scene rebuild ms | (b) rays ms | (c) hybrid "
               "rebuild ms | (c) rays ms | frame (a)/(b) | frame (a)/(c) | (b) = (a) | (c) = (b) |\n");
   std::printf("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-  // Every count's scenes at once: the counts take turns frame by frame (below).
+  // Every count's scenes at once: the counts take turns frame by frame (below). A count owns its
+  // Embree objects, and releases them on every way out.
   struct Count {
     uint32_t n = 0;
     std::mt19937_64 g;
@@ -123,6 +124,12 @@ int runSceneBench(const Options& o) {
     vff::Scene scene;
     Side a, b, c;
     uint64_t agreeAB = 0, agreeBC = 0, total = 0;
+    ~Count() {
+      fields.clear();  // (each detaches from `hybrid`, which must still exist)
+      for (RTCGeometry gi : inst) rtcReleaseGeometry(gi);
+      if (hybrid) rtcReleaseScene(hybrid);
+      if (exact) rtcReleaseScene(exact);
+    }
   };
   std::vector<std::unique_ptr<Count>> counts;
   for (uint32_t n : o.instanceCounts) {
@@ -213,12 +220,9 @@ int runSceneBench(const Options& o) {
                 (a.commit + a.rays) / (b.commit + b.rays), (a.commit + a.rays) / (c.commit + c.rays),
                 double(k.agreeAB) / double(k.total), double(k.agreeBC) / double(k.total));
     speedups.emplace_back(k.n, (a.commit + a.rays) / (b.commit + b.rays));
-    k.fields.clear();
-    for (RTCGeometry gi : k.inst) rtcReleaseGeometry(gi);
-    rtcReleaseScene(k.hybrid);
-    rtcReleaseScene(k.exact);
   }
   std::fflush(stdout);
+  counts.clear();
   rtcReleaseScene(mesh);
   rtcReleaseDevice(device);
   // The summary: where the field scene overtakes Embree, and what the scene keeps of the single

@@ -30,10 +30,10 @@
 // instancing of the triangles, vff::Scene and this hybrid side by side: for the bunny there, the
 // hybrid answers single AO rays more slowly than Embree's own triangles, and vff::Scene's batches
 // many times faster than either. A field's cost does not grow with its object's triangles while
-// Embree's does (vff-experiments triangle-bench), so the hybrid gains with heavier objects. Use
-// this where one traversal must meet fields and triangles together (rays that can also hit the
-// static environment); cast the rays that only the field objects can stop (their own ambient
-// occlusion, say) in batches through vff::Scene.
+// Embree's does (vff-experiments triangle-bench), so the hybrid should compare better for heavier
+// objects (scene-bench measures one mesh only). Use this where one traversal must meet fields and
+// triangles together (rays that can also hit the static environment); cast the rays that only the
+// field objects can stop (their own ambient occlusion, say) in batches through vff::Scene.
 //
 // Threads. The callbacks are const and run on Embree's threads. setTransform() must not run
 // while the scene is traced.
