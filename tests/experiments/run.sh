@@ -61,9 +61,15 @@ case "$case" in
     grep -q "^Scene benchmark: .* threads, " stdout.txt || { cat stdout.txt; fail "scene-bench header names no CPU"; }
     [ "$(grep -cE '^\| [0-9]+ \|' stdout.txt)" -eq 3 ] || { cat stdout.txt; fail "scene-bench: not one row per count"; }
     for n in 1 7 40; do grep -qE "^\| $n \|" stdout.txt || { cat stdout.txt; fail "scene-bench: no row for $n"; }; done
-    # The hybrid (c) answers every ray as vff::Scene (b) does: its last column is 1.
+    # The hybrid (c) answers every ray as vff::Scene (b) does: its column "(c) = (b)" is 1.
     [ "$(awk -F'|' '/^\| [0-9]+ \|/ {print $12}' stdout.txt | tr -d ' ' | sort -u)" = "1.0000" ] \
       || { cat stdout.txt; fail "scene-bench: the hybrid answers otherwise than vff::Scene"; }
+    # (b)'s floor (the field's batch on (b)'s pairs, found beforehand) answers as (b) does, and
+    # the summary says what finding the pairs costs.
+    [ "$(awk -F'|' '/^\| [0-9]+ \|/ {print $15}' stdout.txt | tr -d ' ' | sort -u)" = "1.0000" ] \
+      || { cat stdout.txt; fail "scene-bench: the pairs found beforehand answer otherwise than vff::Scene"; }
+    grep -q "^1 instance: finding and preparing the pairs takes " stdout.txt \
+      || { cat stdout.txt; fail "scene-bench: no line on what finding the pairs costs"; }
     ;;
   scene_writes_frames_and_table)
     "$exp" scene --mesh knot.obj --config 290x16x16 --size 48 --rays 8 --frames 2 -j 2 -o out >stdout.txt 2>stderr.txt \
