@@ -159,6 +159,8 @@ int runSceneBench(const Options& o) {
   std::vector<uint8_t> ra(rays.size()), rb(rays.size()), rc(rays.size()), rd;
   std::vector<vff::Ray> pairs;  // (b)'s pairs in object space, and each pair's ray
   std::vector<uint32_t> pairRay;
+  std::vector<vff::RigidTransform> placed;
+  std::vector<uint8_t> any;  // the floor's answers, combined per ray
   // Frame by frame, every count in turn: the ratios between counts (what the scene keeps of the
   // single object's speed-up) then compare measurements taken in the same moments of the machine,
   // whose speed drifts (and not alike for every side) over a run.
@@ -195,11 +197,13 @@ int runSceneBench(const Options& o) {
       k.c.commit += w * (now() - t0);
       pairs.clear();
       pairRay.clear();
+      placed.resize(n);  // each instance as the scene holds it
+      for (uint32_t i = 0; i < n; ++i) placed[i] = fieldPlacement(placement[i]);
       for (uint32_t i = 0; i < rays.size(); ++i) {
         auto ids = k.scene.candidates(rays[i]);
         if (!ids) return vff::cli::reportError(kProg, o.mesh, ids.error());
         for (uint32_t id : *ids) {
-          const vff::RigidTransform x = fieldPlacement(placement[id]);
+          const vff::RigidTransform& x = placed[id];
           pairs.push_back(vff::Ray{x.toObjectPoint(rays[i].origin), x.toObjectVector(rays[i].direction),
                                    rays[i].tmin, rays[i].tmax});
           pairRay.push_back(i);
@@ -227,7 +231,7 @@ int runSceneBench(const Options& o) {
       }
       k.a.rays += w * ta, k.b.rays += w * tb, k.c.rays += w * tc, k.answers += w * td;
       if (frame < 0) continue;
-      std::vector<uint8_t> any(rays.size(), 0);  // the floor's answers, combined per ray
+      any.assign(rays.size(), 0);
       for (size_t p = 0; p < pairs.size(); ++p) any[pairRay[p]] |= rd[p];
       for (size_t i = 0; i < rays.size(); ++i) {
         k.agreeAB += ra[i] == rb[i];
@@ -238,12 +242,12 @@ int runSceneBench(const Options& o) {
       k.pairs += pairs.size();
     }
   }
-  std::vector<std::pair<uint32_t, double>> speedups;  // (instances, frame (a)/(b))
-  struct Floor {
+  struct Summary {
     uint32_t n;
+    double speedup;        // frame (a)/(b)
     double rays, answers;  // (b)'s rays and its floor, ms a frame
   };
-  std::vector<Floor> floors;
+  std::vector<Summary> summary;
   const double f = 1000.0 / o.frames;
   for (auto& count : counts) {
     Count& k = *count;
@@ -253,8 +257,7 @@ int runSceneBench(const Options& o) {
                 (a.commit + a.rays) / (b.commit + b.rays), (a.commit + a.rays) / (c.commit + c.rays),
                 double(k.agreeAB) / double(k.total), double(k.agreeBC) / double(k.total),
                 double(k.pairs) / double(k.total), k.answers * f, double(k.agreeBD) / double(k.total));
-    floors.push_back({k.n, b.rays * f, k.answers * f});
-    speedups.emplace_back(k.n, (a.commit + a.rays) / (b.commit + b.rays));
+    summary.push_back({k.n, (a.commit + a.rays) / (b.commit + b.rays), b.rays * f, k.answers * f});
   }
   std::fflush(stdout);
   counts.clear();
@@ -263,23 +266,23 @@ int runSceneBench(const Options& o) {
   // The summary: where the field scene overtakes Embree, and what the scene keeps of the single
   // object's speed-up.
   std::string faster;
-  for (const auto& [n, x] : speedups)
-    if (x > 1) faster += (faster.empty() ? "" : ", ") + std::to_string(n);
+  for (const Summary& r : summary)
+    if (r.speedup > 1) faster += (faster.empty() ? "" : ", ") + std::to_string(r.n);
   std::printf("\nvff::Scene is faster than Embree instancing at %s instances", faster.empty() ? "no count of" : faster.c_str());
   double single = 0;
-  for (const auto& [n, x] : speedups)
-    if (n == 1) single = x;
-  for (const auto& [n, x] : speedups)
-    if (n == 1000 && single > 0)
-      std::printf("; at 1000 instances its speed-up is %.2fx, %.2f of the single object's %.2fx (target 0.8)", x,
-                  x / single, single);
+  for (const Summary& r : summary)
+    if (r.n == 1) single = r.speedup;
+  for (const Summary& r : summary)
+    if (r.n == 1000 && single > 0)
+      std::printf("; at 1000 instances its speed-up is %.2fx, %.2f of the single object's %.2fx (target 0.8)",
+                  r.speedup, r.speedup / single, single);
   std::printf("\n");
   // Where (b)'s time goes beyond the field's own answers.
-  for (const Floor& fl : floors)
-    if (fl.n == 1 || fl.n == 1000)
+  for (const Summary& r : summary)
+    if (r.n == 1 || r.n == 1000)
       std::printf("%u instance%s: finding and preparing the pairs takes %.2f of (b)'s %.2f ms of rays a frame; the "
                   "field's answers alone, %.2f\n",
-                  fl.n, fl.n == 1 ? "" : "s", fl.rays - fl.answers, fl.rays, fl.answers);
+                  r.n, r.n == 1 ? "" : "s", r.rays - r.answers, r.rays, r.answers);
   return 0;
 }
 
