@@ -1,19 +1,23 @@
 #!/usr/bin/env python3
-"""benchmarks/report.py - the results files of benchmarks/run.sh, and the README's tables.
+"""benchmarks/report.py - the results files of benchmarks/run.sh, and the READMEs' tables.
 
   python3 benchmarks/report.py compose RAWDIR OUT.md   the results file from run.sh's raw outputs
-  python3 benchmarks/report.py readme [--check] [README.md]
-                                                       README's figures from benchmarks/results/
+  python3 benchmarks/report.py readme [--check] [README.md [benchmarks/README.md]]
+                                                       both READMEs' figures from benchmarks/results/
   python3 benchmarks/report.py check RESULTS.md        parses a results file back: every step there
   python3 benchmarks/report.py cpu                     this machine's CPU, as the results name it
   python3 benchmarks/report.py slug MACHINE.txt        a results file's name: <cpu>-<date>
 
 A results file holds the machine, a summary in rounded tables, and the full output of every
 benchmark command in fenced blocks; `readme` reads those blocks back with the same parsers, so every
-figure in README.md comes from a committed results file. `readme --check` exits 1 when README.md's
-block differs from what the results files give (the hygiene test runs it).
+figure in README.md and benchmarks/README.md comes from a committed results file. `readme` writes
+README.md's headline table (a few rows from the newest results file) and benchmarks/README.md's full
+tables, each between its file's markers; `readme --check` exits 1 when either block differs from
+what the results files give (the benchmarks test runs it). Links in a block are relative to the
+file's place in the source tree (README.md at the top, the full tables in benchmarks/), whatever
+path is given, so a copy elsewhere checks the same.
 
-Exit codes: 0 ok, 1 usage or README out of date, 2 a file cannot be read or written, 3 a results
+Exit codes: 0 ok, 1 usage or a README out of date, 2 a file cannot be read or written, 3 a results
 file or an output that does not parse.
 """
 import glob
@@ -563,7 +567,9 @@ def read_results(path):
     return machine, steps
 
 
-def readme_block(results_dir):
+def load_runs(results_dir):
+    """The results files that are not --quick, oldest first, as (path, machine, steps); and the
+    newest whole run (not --only) among them."""
     runs = [(p, *read_results(p)) for p in sorted(glob.glob(os.path.join(results_dir, "*.md")))]
     runs = sorted((r for r in runs if r[1].get("quick") != "1"), key=lambda r: (r[1]["date"], r[0]))
     if not runs:
@@ -571,53 +577,139 @@ def readme_block(results_dir):
     full = [r for r in runs if not r[1].get("only")]
     if not full:
         raise ParseError(f"{results_dir}: no results file of a whole run")
-    path, machine, steps = full[-1]
+    return runs, full[-1]
+
+
+def link(path, base):
+    """A Markdown link to path, relative to the folder base (the file's folder in the source tree)."""
+    return f"[{os.path.relpath(path, ROOT)}]({os.path.relpath(path, base)})"
+
+
+def full_block(runs, newest, base):
+    """benchmarks/README.md's block: every summary table of the newest whole run, the query table
+    with a row for each CPU on record, and the distance-field comparison of the newest file that
+    has it."""
+    path, machine, steps = newest
     latest = {m["cpu"]: (m, s["query"]) for _, m, s in runs if "query" in s}
-    rel = os.path.relpath(path, ROOT)
     lines = [BEGIN, "",
-             f"From [{rel}]({rel}): {machine['cpu']}, {machine['cores']} cores, commit {machine['commit']}, "
+             f"From {link(path, base)}: {machine['cpu']}, {machine['cores']} cores, commit {machine['commit']}, "
              f"{machine['mesh']}, field {machine['field']}; the query table has a row for each CPU on record. "
              "Figures differ between CPUs: `bash benchmarks/run.sh` measures yours.", ""]
-    main = sections(machine, {k: v for k, v in steps.items() if k != "sdf"}, "####", list(latest.values()),
+    main = sections(machine, {k: v for k, v in steps.items() if k != "sdf"}, "###", list(latest.values()),
                     machine["field"])
     # The distance-field comparison: from the newest file that has it (a whole run, or --only sdf).
     with_sdf = [r for r in runs if "sdf" in r[2]]
     if with_sdf:
         spath, smachine, ssteps = with_sdf[-1]
-        srel = os.path.relpath(spath, ROOT)
         reduced = f" (`run.sh --only {smachine['only']}`: a reduced run)" if smachine.get("only") else ""
         d = ssteps["sdf"]
-        main += [f"#### Field against a signed distance field at equal memory per object", "",
-                 f"From [{srel}]({srel}){reduced}: {smachine['cpu']}, {smachine['cores']} cores, commit "
+        main += [f"### Field against a signed distance field at equal memory per object", "",
+                 f"From {link(spath, base)}{reduced}: {smachine['cpu']}, {smachine['cores']} cores, commit "
                  f"{smachine['commit']}, {d['values']} values, {d['rays']} rays per set; command "
                  f"`{ssteps['sdf_cmd']}`. Speed above 1x: the field is faster; wrong answers: rays answered otherwise "
                  "than Embree.", "", *sdf_summary(d), ""]
     return "\n".join(lines + main + [END])
 
 
-def readme(args):
-    check = "--check" in args
-    args = [a for a in args if a != "--check"]
-    path = args[0] if args else os.path.join(ROOT, "README.md")
+def sdf_headline_row(machine, d):
+    """The distance-field row the headline quotes: the ao rays on the run's own mesh (else the first)
+    at the run's field configuration (else the largest memory)."""
+    rows = [r for r in d["rows"] if r["set"] == "ao"] or d["rows"]
+    mine = [r for r in rows if r["mesh"] == machine.get("mesh")] or [r for r in rows if r["mesh"] == rows[0]["mesh"]]
+    same = [r for r in mine if r["field"] == machine.get("field")]
+    return same[0] if same else max(mine, key=lambda r: r["mib"])
+
+
+def headline_table(machine, steps, sdf):
+    """README.md's one table: vff against its baseline on each topic the run has, a row each."""
+    rows = []
+    if "bake" in steps:
+        b = steps["bake"]
+        rows.append(("bake: the whole bake against Embree alone on the bake's rays, Mrays/s", rate(b["bake"]),
+                     rate(b["raw"]), f"{b['ratio']:.2f}x"))
+    if "query" in steps:
+        sets = steps["query"]["sets"]
+        name = "ao" if "ao" in sets else next(iter(sets))
+        s = sets[name]
+        rows.append((f"query, {name} rays: the field's batch against Embree, Mrays/s", rate(s["b"]["mrays"]),
+                     rate(s["a"]["mrays"]), f"{s['b']['x']:.1f}x"))
+        rows.append((f"query, {name} rays: the field's batch against the memory floor, Mrays/s",
+                     rate(s["b"]["mrays"]), rate(s["m"]["mrays"]), s["b"]["floor"]))
+    if "scene" in steps and steps["scene"]["rows"]:
+        sc = steps["scene"]["rows"]
+        r = next((r for r in sc if r["instances"] == 1000), sc[-1])
+        rows.append((f"{r['instances']} moving instances: vff::Scene against Embree instancing, ms/frame",
+                     fmt(r["scene"], 1), fmt(r["exact"], 1), f"{r['ab']:.2f}x"))
+    if "triangles" in steps and steps["triangles"]["rows"]:
+        r = max(steps["triangles"]["rows"], key=lambda r: r["triangles"])
+        s = r["surface"]
+        rows.append((f"an object of {r['triangles']} triangles, surface AO rays: the field against Embree, ns/ray",
+                     fmt(s[1], 1), fmt(s[0], 1), f"{s[2]:.1f}x"))
+    if sdf:
+        r = sdf_headline_row(machine, sdf)
+        rows.append((f"{r['mesh']} at {r['mib']:.1f} MiB, {r['set']} rays: the field against a signed distance "
+                     "field of the same memory, Mrays/s", rate(r["fieldrate"]), rate(r["sdfrate"]),
+                     f"{r['speed']:.0f}x"))
+        rows.append(("the same: rays answered otherwise than Embree", f"{r['fieldwrong']:.2f}%",
+                     f"{r['sdfwrong']:.2f}%", "-"))
+    return ["| vff against | vff | baseline | vff's speed / baseline's |", "|---|---:|---:|---:|",
+            *[f"| {a} | {v} | {b} | {x} |" for a, v, b, x in rows]]
+
+
+def headline_block(runs, newest, base):
+    """README.md's block: the headline table from the newest whole run (the distance-field rows
+    from the newest file that has them), the CPU named, and a link to the full tables."""
+    path, machine, steps = newest
+    with_sdf = [r for r in runs if "sdf" in r[2]]
+    sdf = with_sdf[-1] if with_sdf else None
+    threads = f", {steps['query']['threads']} threads" if "query" in steps else ""
+    lines = [BEGIN, "",
+             f"From {link(path, base)}: {machine['cpu']}, {machine['cores']} cores{threads}, commit "
+             f"{machine['commit']}, {machine['mesh']}, field {machine['field']}. Every table, each CPU on record: "
+             f"{link(os.path.join(ROOT, 'benchmarks', 'README.md'), base)}.", "",
+             *headline_table(machine, steps, sdf[2]["sdf"] if sdf else None)]
+    if sdf and sdf[0] != path:
+        lines += ["", f"Distance-field rows from {link(sdf[0], base)} ({sdf[1]['cpu']}, commit {sdf[1]['commit']})."]
+    return "\n".join(lines + ["", END])
+
+
+def replace_block(path, block):
+    """(old text, new text) of the file at path with its block between the markers replaced."""
     with open(path, encoding="utf-8") as f:
         text = f.read()
     if text.count(BEGIN) != 1 or text.count(END) != 1:
-        print(f"report.py: error: {path}: needs one '{BEGIN}' line and one '{END}' line", file=sys.stderr)
-        return 3
-    block = readme_block(os.path.join(ROOT, "benchmarks", "results"))
+        raise ParseError(f"{path}: needs one '{BEGIN}' line and one '{END}' line")
     start, end = text.index(BEGIN), text.index(END) + len(END)
-    new = text[:start] + block + text[end:]
+    return text, text[:start] + block + text[end:]
+
+
+def readme(args):
+    check = "--check" in args
+    args = [a for a in args if a != "--check"]
+    if len(args) > 2 or any(a.startswith("-") for a in args):
+        print("usage: report.py readme [--check] [README.md [benchmarks/README.md]]", file=sys.stderr)
+        return 1
+    paths = args + [os.path.join(ROOT, "README.md"), os.path.join(ROOT, "benchmarks", "README.md")][len(args):]
+    runs, newest = load_runs(os.path.join(ROOT, "benchmarks", "results"))
+    # Each block's links are relative to its file's place in the source tree, not to the path given.
+    blocks = [headline_block(runs, newest, ROOT), full_block(runs, newest, os.path.join(ROOT, "benchmarks"))]
+    what = [("headline table", "differs from", "matches"), ("benchmark tables", "differ from", "match")]
+    texts = [replace_block(p, b) for p, b in zip(paths, blocks)]
     if check:
-        if new != text:
-            print(f"report.py: {path}: its benchmark tables differ from benchmarks/results/ "
+        stale = [(p, w) for p, w, (old, new) in zip(paths, what, texts) if old != new]
+        for p, (w, differ, _) in stale:
+            print(f"report.py: {p}: its {w} {differ} benchmarks/results/ "
                   "(run python3 benchmarks/report.py readme)", file=sys.stderr)
+        if stale:
             return 1
-        print(f"report.py: {path}: benchmark tables match benchmarks/results/")
+        for p, (w, _, match) in zip(paths, what):
+            print(f"report.py: {p}: its {w} {match} benchmarks/results/")
         return 0
-    if new != text:
-        with open(path + ".tmp", "w", encoding="utf-8") as f:
-            f.write(new)
-        os.replace(path + ".tmp", path)
+    for p, (old, new) in zip(paths, texts):
+        if new != old:
+            with open(p + ".tmp", "w", encoding="utf-8") as f:
+                f.write(new)
+            os.replace(p + ".tmp", p)
     return 0
 
 

@@ -25,7 +25,7 @@
 #   library      benchmarks/library.sh: vff-library's pool (and Slurm, where SLURM_CONF is set)
 #                against the same bakes one after another, and the up-to-date re-run
 # and writes benchmarks/results/<cpu>-<date>.md (or --out): the machine, the commit, a summary in
-# rounded tables (README.md copies it: python3 benchmarks/report.py readme) and the full output of
+# rounded tables (README.md and benchmarks/README.md copy it: python3 benchmarks/report.py readme) and the full output of
 # every command. --quick runs each at a tiny size: a check that the whole chain works, whose
 # figures mean nothing. --only STEP runs one step (bake, query, accuracy, scene, triangles,
 # compression, gpu, sdf, python, library): a reduced run, and its results file says so. Run it on

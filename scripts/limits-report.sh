@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Prints the limits table of the README's "Robustness" section: every hostile input of
+# Prints a limits table (docs/robustness.md describes the limits): every hostile input of
 # tests/limits (inputs that claim huge sizes: gen.cpp) with each tool that reads it, the tool's exit
 # code, its peak resident memory (ru_maxrss, measured by vff_peak_rss) and its time, and a summary of
 # the conformance suite's invalid vectors. It runs the test functions of tests/limits/limits_tests.sh

@@ -9,7 +9,8 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"
 bash scripts/setup.sh
 cmake --preset release >/dev/null
-cmake --build --preset release -j "$(nproc)"
+# Only what the demo runs (scripts/test.sh builds everything).
+cmake --build --preset release -j "$(nproc)" --target vff-bake vff-inspect vff-experiments
 
 bin="$root/build/tools"
 mesh="${1:-/usr/share/glmark2/models/bunny.obj}"

@@ -11,7 +11,7 @@ packages=(
   libstb-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev glslang-tools
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
   clang libclang-rt-14-dev
-  glmark2-data zstd xz-utils python3
+  glmark2-data zstd xz-utils python3 universal-ctags
   python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-matplotlib
   chromium nodejs
   slurm-wlm munge

@@ -2,7 +2,7 @@
 // spec/positions.md, spec/format.md "Packed slice layout" and "Value encodings").
 //
 // Include it after `#version 430` (or later). It answers the same rays as the CPU query
-// vff::FieldQuery::intersect with Reconstruction::kNearest (libvff/src/query.cpp): the same
+// vff::FieldQuery::intersect with Reconstruction::kNearest (libvff/src/query/query_ray.cpp): the same
 // sphere test, the same nearest positional sample, the same texel and the same decoded distance,
 // up to rounding of atan/sqrt/division near a texel or sample boundary (spec/geometry.md section 8).
 //
@@ -43,7 +43,8 @@
 // queried from its field table, so the scene and the single field share every function below.
 // Building blocks (names as in spec/geometry.md 5.4 and spec/positions.md 6): vffFrame, vffToLocal,
 // vffHemisphereToSquare, vffSquareToHemisphere, vffSquareToTexel, vffTexelCenter, vffNearestSample,
-// vffFetchCode, vffDecode.
+// vffFetchCode, vffDecode. vffQuery's steps, named as vff::FieldQuery::Impl's: vffPrepare (sphere and
+// nearest sample), vffNearestHit, vffInterpolated (the kernel's samples blended), vffBlendResult.
 //
 // Exactness. Variables on the path whose bits matter are `precise` (no fused multiply-add, no
 // reassociation), and divisions and square roots go through vffDivide and vffSqrt, which refine the
@@ -469,146 +470,116 @@ float vffKernel(vec3 eu, uint k) {
   return x > 0.0 ? w : 0.0;
 }
 
-// The core of every query, as vff::FieldQuery::Impl::query. `visibility` receives the unoccluded
-// share: 0 or 1 for kNearest (interpolated == false), the misses' and far hits' share of the blend
-// weight for kInterpolated. Rays from inside the sphere are answered as kNearest in both modes.
-VffHit vffQuery(vec3 origin, vec3 direction, float tmin, float tmax, float intraBias, bool interpolated,
-                out float visibility) {
-  VffHit o;
-  o.hit = false;
-  o.inside = false;
-  o.t = uintBitsToFloat(0x7f800000u);
-  o.normal = vec3(0.0);
-  o.hasNormal = false;
-  o.looked = false;
-  o.sampleIndex = 0u;
-  o.texel = uvec2(0u);
-  o.code = 0u;
-  o.distance = 0.0;
-  visibility = 1.0;
+// A ray where it enters the field's sphere, as vff::FieldQuery::Impl::Lookup: its unit direction w
+// and length len; the direction looked up, v (w, or -w from inside: the reversed ray); the entry
+// point t0 (from inside: the exit point) and the range [lo, hi], along w; the entry point on the
+// unit sphere, eu, and its nearest sample k0.
+struct VffLookup {
+  vec3 w, v, eu;
+  float len, t0, lo, hi;
+  bool inside;
+  int k0;
+};
+
+// 1. The sphere and 2. the nearest sample, as vff::FieldQuery::Impl::prepare: false (l unset) when
+// the ray misses the sphere or cannot be answered (a zero direction; a bit1 field from inside).
+bool vffPrepare(vec3 origin, vec3 direction, float tmin, float tmax, float intraBias, out VffLookup l) {
   precise float len = vffSqrt(vffDot(direction, direction));
-  if (!(len > 0.0) || isinf(len) || isnan(len)) return o;
+  if (!(len > 0.0) || isinf(len) || isnan(len)) return false;
   precise float invLen = vffDivide(1.0, len);
   precise vec3 w = direction * invLen;
   precise float lo = tmin * len;
   precise float hi = tmax * len;
-  // 1. The sphere.
   vec3 c = VFF_FIELD.sphereCenter;
   float R = VFF_FIELD.sphereRadius;
   precise vec3 delta = origin - c;
   precise float beta = vffDot(delta, w);
   precise float gamma = vffDot(delta, delta) - R * R;
   precise float disc = beta * beta - gamma;
-  if (!(disc >= 0.0)) return o;
+  if (!(disc >= 0.0)) return false;
   precise float sq = vffSqrt(disc);
   precise float t1 = -beta + sq;
-  if (t1 < 0.0) return o;
+  if (t1 < 0.0) return false;
   bool inside = gamma <= 0.0;
   // From inside, the reversed ray enters at the exit point and looks back at the origin.
   precise float t0 = inside ? t1 : max(-beta - sq, 0.0);
   precise vec3 e = origin + w * t0;
   vec3 v = inside ? -w : w;
   if (inside) {
-    if (VFF_FIELD.distanceEncoding == VFF_ENCODING_BIT1) return o;  // no distances: cannot tell
+    if (VFF_FIELD.distanceEncoding == VFF_ENCODING_BIT1) return false;  // no distances: cannot tell
     precise float bias = (intraBias >= 0.0 ? intraBias : VFF_FIELD.intraBias) * R;
     lo = max(lo, bias);
   }
-#ifdef VFF_NO_NORMALS
-  bool normals = false;
-#else
-  bool normals = VFF_FIELD.normalEncoding != VFF_NORMAL_NONE;
-#endif
-  // 2. The nearest sample, 3. the texel, 4. the decode.
   precise vec3 eu = (e - c) * VFF_FIELD.invRadius;
-  int k = vffNearestSample(eu);
+  l = VffLookup(w, v, eu, len, t0, lo, hi, inside, vffNearestSample(eu));
+  return true;
+}
+
+// kNearest (and every ray from inside), as vff::FieldQuery::Impl::nearestHit: 3. the texel of the
+// nearest sample's map in direction v, 4. its decode, 5. the result. `o` is the answer so far (the
+// sample looked up); `visibility` becomes 0 on a hit.
+VffHit vffNearestHit(VffHit o, VffLookup l, bool normals, inout float visibility) {
+  int k = l.k0;
   int M = int(VFF_FIELD.mapResolution);
-  o.looked = true;
-  o.sampleIndex = uint(k);
-  if (!interpolated || inside) {
-    vec3 ek = vffPosition(k);
-    mat3 F = vffFrame(-ek);
-    vec3 l = vffToLocal(F, v);
-    vec2 uv = vffHemisphereToSquare(VFF_FIELD.directionScheme, l);
-    uvec2 ij = uvec2(vffSquareToTexel(uv, M));
-    uint code = vffFetchCode(uint(k), ij);
-    VffTexel s = vffDecode(code, ij);
-    o.texel = ij;
-    o.code = code;
-    o.distance = s.distance;
-    if (!s.hit) return o;
-    // 5. The result.
-    precise float t = inside ? t0 - s.distance : t0 + s.distance;
-    if (t < lo || t > hi) return o;
-    visibility = 0.0;
-    o.hit = true;
-    o.inside = inside;
-    o.t = vffDivide(t, len);
-    if (normals) {
-      o.normal = vffFetchNormal(uint(k), ij);
-      o.hasNormal = true;
-    }
-    return o;
+  vec3 ek = vffPosition(k);
+  mat3 F = vffFrame(-ek);
+  vec3 lv = vffToLocal(F, l.v);
+  vec2 uv = vffHemisphereToSquare(VFF_FIELD.directionScheme, lv);
+  uvec2 ij = uvec2(vffSquareToTexel(uv, M));
+  uint code = vffFetchCode(uint(k), ij);
+  VffTexel s = vffDecode(code, ij);
+  o.texel = ij;
+  o.code = code;
+  o.distance = s.distance;
+  if (!s.hit) return o;
+  // 5. The result.
+  precise float t = l.inside ? l.t0 - s.distance : l.t0 + s.distance;
+  if (t < l.lo || t > l.hi) return o;
+  visibility = 0.0;
+  o.hit = true;
+  o.inside = l.inside;
+  o.t = vffDivide(t, l.len);
+  if (normals) {
+    o.normal = vffFetchNormal(uint(k), ij);
+    o.hasNormal = true;
   }
-  // kInterpolated (from outside). The sphere begins beyond the range: nothing can occlude (the CPU
-  // query returns before any lookup; for kNearest the texel's hit would lie beyond tmax anyway).
-  if (t0 > hi) return o;
-  // kInterpolated: the kernel's samples (the nearest and its neighbours within the kernel), each
-  // looked up along v from its own sample point with miss-aware bilinear weights; every hit point
-  // is projected onto the ray. Hits and misses are summed separately (FieldQuery::Impl::query).
-  uint ks[VFF_NEIGHBOURS + 1u];
-  float kw[VFF_NEIGHBOURS + 1u];
-  uint kc = 1u;
-  ks[0] = uint(k);
-  kw[0] = max(vffKernel(eu, uint(k)), 1e-6);  // the nearest sample always contributes
-  uint nbase = VFF_FIELD.neighbourOffset + (VFF_NEIGHBOURS / 4u) * uint(k);
+  return o;
+}
+
+// The kernel of kInterpolated around the nearest sample k: k itself (which always contributes) and
+// its neighbours of positive weight, in the CPU's order.
+struct VffKernelSamples {
+  uint count;
+  uint index[VFF_NEIGHBOURS + 1u];
+  float weight[VFF_NEIGHBOURS + 1u];
+};
+
+VffKernelSamples vffKernelSamples(vec3 eu, uint k) {
+  VffKernelSamples ks;
+  ks.count = 1u;
+  ks.index[0] = k;
+  ks.weight[0] = max(vffKernel(eu, k), 1e-6);  // the nearest sample always contributes
+  uint nbase = VFF_FIELD.neighbourOffset + (VFF_NEIGHBOURS / 4u) * k;
   for (uint q = 0u; q < VFF_NEIGHBOURS; ++q) {
     float f = vffPositions[VFF_POSITIONS_BASE + nbase + q / 4u][q % 4u];
     if (f < 0.0) break;
     uint nk = uint(f);
     float wk = vffKernel(eu, nk);
     if (wk > 0.0) {
-      ks[kc] = nk;
-      kw[kc] = wk;
-      ++kc;
+      ks.index[ks.count] = nk;
+      ks.weight[ks.count] = wk;
+      ++ks.count;
     }
   }
-  precise float hitW = 0.0, missW = 0.0, farW = 0.0, tSum = 0.0;
-  precise vec3 nSum = vec3(0.0);
-  for (uint q = 0u; q < kc; ++q) {
-    uint kk = ks[q];
-    vec3 uk = vffPosition(int(kk));
-    precise vec3 p = c + uk * R;
-    vec3 l = vffToLocal(vffFrame(-uk), v);
-    if (l.z <= 0.0) continue;  // the sample does not see this direction
-    vec2 uv = vffHemisphereToSquare(VFF_FIELD.directionScheme, l);
-    precise float x = (uv.x + 1.0) * 0.5 * float(M) - 0.5;
-    precise float y = (uv.y + 1.0) * 0.5 * float(M) - 0.5;
-    precise float fx0 = floor(x), fy0 = floor(y);
-    precise float fx = x - fx0, fy = y - fy0;
-    int ix = int(fx0), iy = int(fy0);
-    precise float base = vffDot(p - origin, w);  // t of the sample point, projected on the ray
-    for (int dj = 0; dj < 2; ++dj) {
-      for (int di = 0; di < 2; ++di) {
-        precise float bw = kw[q] * (di != 0 ? fx : 1.0 - fx) * (dj != 0 ? fy : 1.0 - fy);
-        if (bw <= 0.0) continue;
-        uvec2 tij = uvec2(clamp(ivec2(ix + di, iy + dj), ivec2(0), ivec2(M - 1)));
-        VffTexel s = vffDecode(vffFetchCode(kk, tij), tij);
-        if (!s.hit) {
-          missW += bw;
-          continue;
-        }
-        precise float t = base + s.distance;  // along v = w from outside (t per unit distance: 1)
-        if (t > hi) {
-          farW += bw;
-        } else if (t >= lo) {
-          hitW += bw;
-          tSum += bw * t;
-          if (normals) nSum = nSum + vffFetchNormal(kk, tij) * bw;
-        }
-        // t < lo: a hit before the range, neither an occluder nor a miss
-      }
-    }
-  }
+  return ks;
+}
+
+// The answer of a kInterpolated blend from its weight sums (vff::detail::Blend: the hits within
+// the range, with their weighted t and normals; the misses; the hits beyond tmax), as
+// vff::FieldQuery::Impl::blendResult: `visibility` becomes the unoccluded share; a hit where the
+// hits outweigh the rest, at their mean t.
+VffHit vffBlendResult(VffHit o, float hitW, float missW, float farW, float tSum, vec3 nSum, float len,
+                      bool normals, inout float visibility) {
   precise float open = missW + farW;
   precise float total = hitW + open;
   if (!(total > 0.0)) return o;
@@ -626,6 +597,78 @@ VffHit vffQuery(vec3 origin, vec3 direction, float tmin, float tmax, float intra
     }
   }
   return o;
+}
+
+// kInterpolated from outside, as vff::FieldQuery::Impl::interpolated: the kernel's samples, each
+// looked up along v from its own sample point with miss-aware bilinear weights; every hit point is
+// projected onto the ray. Hits and misses are summed separately. `o` is the answer so far.
+VffHit vffInterpolated(VffHit o, vec3 origin, VffLookup l, bool normals, inout float visibility) {
+  // The sphere begins beyond the range: nothing can occlude (the CPU query returns before any
+  // lookup; for kNearest the texel's hit would lie beyond tmax anyway).
+  if (l.t0 > l.hi) return o;
+  VffKernelSamples ks = vffKernelSamples(l.eu, uint(l.k0));
+  vec3 c = VFF_FIELD.sphereCenter;
+  float R = VFF_FIELD.sphereRadius;
+  int M = int(VFF_FIELD.mapResolution);
+  precise float hitW = 0.0, missW = 0.0, farW = 0.0, tSum = 0.0;
+  precise vec3 nSum = vec3(0.0);
+  for (uint q = 0u; q < ks.count; ++q) {
+    uint kk = ks.index[q];
+    vec3 uk = vffPosition(int(kk));
+    precise vec3 p = c + uk * R;
+    vec3 lv = vffToLocal(vffFrame(-uk), l.v);
+    if (lv.z <= 0.0) continue;  // the sample does not see this direction
+    vec2 uv = vffHemisphereToSquare(VFF_FIELD.directionScheme, lv);
+    precise float x = (uv.x + 1.0) * 0.5 * float(M) - 0.5;
+    precise float y = (uv.y + 1.0) * 0.5 * float(M) - 0.5;
+    precise float fx0 = floor(x), fy0 = floor(y);
+    precise float fx = x - fx0, fy = y - fy0;
+    int ix = int(fx0), iy = int(fy0);
+    precise float base = vffDot(p - origin, l.w);  // t of the sample point, projected on the ray
+    for (int dj = 0; dj < 2; ++dj) {
+      for (int di = 0; di < 2; ++di) {
+        precise float bw = ks.weight[q] * (di != 0 ? fx : 1.0 - fx) * (dj != 0 ? fy : 1.0 - fy);
+        if (bw <= 0.0) continue;
+        uvec2 tij = uvec2(clamp(ivec2(ix + di, iy + dj), ivec2(0), ivec2(M - 1)));
+        VffTexel s = vffDecode(vffFetchCode(kk, tij), tij);
+        if (!s.hit) {
+          missW += bw;
+          continue;
+        }
+        precise float t = base + s.distance;  // along v = w from outside (t per unit distance: 1)
+        if (t > l.hi) {
+          farW += bw;
+        } else if (t >= l.lo) {
+          hitW += bw;
+          tSum += bw * t;
+          if (normals) nSum = nSum + vffFetchNormal(kk, tij) * bw;
+        }
+        // t < lo: a hit before the range, neither an occluder nor a miss
+      }
+    }
+  }
+  return vffBlendResult(o, hitW, missW, farW, tSum, nSum, l.len, normals, visibility);
+}
+
+// The core of every query, as vff::FieldQuery::Impl::query. `visibility` receives the unoccluded
+// share: 0 or 1 for kNearest (interpolated == false), the misses' and far hits' share of the blend
+// weight for kInterpolated. Rays from inside the sphere are answered as kNearest in both modes.
+VffHit vffQuery(vec3 origin, vec3 direction, float tmin, float tmax, float intraBias, bool interpolated,
+                out float visibility) {
+  // No hit (t = +inf), nothing looked up.
+  VffHit o = VffHit(false, false, uintBitsToFloat(0x7f800000u), vec3(0.0), false, false, 0u, uvec2(0u), 0u, 0.0);
+  visibility = 1.0;
+  VffLookup l;
+  if (!vffPrepare(origin, direction, tmin, tmax, intraBias, l)) return o;
+  o.looked = true;
+  o.sampleIndex = uint(l.k0);
+#ifdef VFF_NO_NORMALS
+  bool normals = false;
+#else
+  bool normals = VFF_FIELD.normalEncoding != VFF_NORMAL_NONE;
+#endif
+  if (!interpolated || l.inside) return vffNearestHit(o, l, normals, visibility);
+  return vffInterpolated(o, origin, l, normals, visibility);
 }
 
 // vff::FieldQuery::intersect with Reconstruction::kNearest (the paper's lookup).

@@ -8,10 +8,10 @@
 //   // shader: "#version 430\n" + sdfShaderDefines(sdf) + sdfShaderSource(text of vff_sdf.glsl)
 //   //         + main calling vffSdfIntersect(o, d, tmin, tmax) / vffSdfOccluded (object space)
 //
-// Why here and not in vff_gl (vff/gl/loader.h): the grid is vff-experiments' peer (vffx, built
-// with OpenVDB and NanoVDB), not part of the .vff format that libvff and vff_gl serve; the public GL
-// library stays free of those dependencies, and this library (vffx_sdf_gl) is built only with the
-// samples, for vff-gpu-bench and tests/gpu.
+// Why here and not in vff_gl (vff/gl/loader.h): the grid is the distance-field peer's (sdf/, vffx,
+// built with OpenVDB and NanoVDB), not part of the .vff format that libvff and vff_gl serve; the
+// public GL library stays free of those dependencies, and this library (vff_sdf_gl) serves
+// vff-gpu-bench and tests/gpu.
 //
 // What uploadSdf creates (owned by the GpuSdf, deleted by its destructor): a shader storage buffer
 // holding the grid's bytes as SdfField::gridBuffer() gives them (the NanoVDB buffer, read in place
@@ -27,7 +27,7 @@
 #include <string>
 #include <utility>
 
-#include "sdf_field.h"
+#include "vff/sdf/sdf_field.h"
 #include "vff/error.h"
 #include "vff/gl/gl_name.h"
 

@@ -1,4 +1,4 @@
-// bake.cpp - vff.bake and vff.bake_file: the Embree baker (tools/bake) with vff-bake's options as
+// bake.cpp - vff.bake and vff.bake_file: the Embree baker (bake/) with vff-bake's options as
 // keyword arguments. The bake runs on its own threads without the GIL; the calling thread reports
 // progress to the callback and checks for Ctrl-C, which cancels the bake (KeyboardInterrupt).
 #include <pybind11/stl.h>
@@ -11,7 +11,7 @@
 
 #include "bindings.h"
 #include "errors.h"
-#include "spelling.h"
+#include "vff/spelling.h"
 #include "vff/bake/baker.h"
 #include "vff/bake/mesh.h"
 
@@ -22,7 +22,7 @@ namespace vff::python {
 namespace {
 
 template <class E>
-E spelled(const cli::Spellings<E>& s, const std::string& text, const char* name) {
+E spelled(const vff::Spellings<E>& s, const std::string& text, const char* name) {
   if (auto v = s.parse(text)) return *v;
   std::string all;
   for (const auto& w : s.all()) all += (all.empty() ? "" : ", ") + w;
@@ -74,14 +74,14 @@ Options optionsOf(const py::kwargs& kw) {
     else if (key == "progress") o.progress = py::reinterpret_borrow<py::object>(v);
     else throw py::type_error("bake: unexpected keyword argument '" + key + "'");
   }
-  o.bake.positionScheme = spelled(cli::kPositionSchemes, positions, "positions");
+  o.bake.positionScheme = spelled(vff::kPositionSchemes, positions, "positions");
   o.bake.positionParam = count ? count : defaultCount(o.bake.positionScheme);
-  o.bake.directionScheme = spelled(cli::kDirectionSchemes, directions, "directions");
-  o.bake.encoding = spelled(cli::kDistanceEncodings, encoding, "encoding");
-  o.write.codec = spelled(cli::kCodecs, codec, "codec");
+  o.bake.directionScheme = spelled(vff::kDirectionSchemes, directions, "directions");
+  o.bake.encoding = spelled(vff::kDistanceEncodings, encoding, "encoding");
+  o.write.codec = spelled(vff::kCodecs, codec, "codec");
   if (filter == "hits-med") o.write.filter = Filter::kHitsMed;
   else if (filter != "none") throw py::value_error("filter: expected \"none\" or \"hits-med\", got \"" + filter + "\"");
-  o.write.layout.target = spelled(cli::kLayoutTargets, target, "target");
+  o.write.layout.target = spelled(vff::kLayoutTargets, target, "target");
   if (center.has_value() != (radius > 0)) throw py::value_error("center and radius go together (radius > 0)");
   if (center) {
     if (center->size() != 3) throw py::value_error("center: expected 3 numbers");

@@ -6,19 +6,18 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
-#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstring>
 #include <optional>
 #include <string>
-#include <thread>
 #include <type_traits>
 #include <vector>
 
 #include "arrays.h"
 #include "bindings.h"
 #include "errors.h"
+#include "platform/parallel.h"
 
 namespace vff::python {
 
@@ -139,29 +138,22 @@ inline RayBatch batchOf(const py::object& origins, const py::object& directions,
   if (b.tmax.array) b.tmaxData = static_cast<const uint8_t*>(b.tmax.array->data()), b.tmaxStride = b.tmax.array->strides(0);
   b.options.reconstruction = interpolated ? Reconstruction::kInterpolated : Reconstruction::kNearest;
   b.options.intraBias = intraBias;
-  b.threads = threads ? threads : std::max(1u, std::thread::hardware_concurrency());
+  b.threads = vff::parallel::resolveThreads(threads);
   return b;
 }
 
-// Runs work(first, count, rays) over the batch's chunks on its threads, without the GIL.
+// Runs work(first, rays) over the batch's chunks on its threads, without the GIL; each worker
+// turns its chunks into rays in a buffer of its own.
 template <class Work>
 void parallel(const RayBatch& b, Work work) {
   py::gil_scoped_release unlocked;
-  const size_t chunks = (b.n + kChunk - 1) / kChunk;
-  std::atomic<size_t> next{0};
-  auto run = [&] {
-    std::vector<Ray> rays(std::min(kChunk, b.n));
-    for (size_t c; (c = next.fetch_add(1)) < chunks;) {
-      const size_t first = c * kChunk, count = std::min(kChunk, b.n - first);
-      b.fill(first, count, rays.data());
-      work(first, std::span<const Ray>(rays.data(), count));
-    }
-  };
-  const unsigned n = unsigned(std::min<size_t>(b.threads, chunks));
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < n; ++t) pool.emplace_back(run);
-  run();
-  for (auto& t : pool) t.join();
+  std::vector<std::vector<Ray>> buffers(vff::parallel::workerCount(b.n, kChunk, b.threads));
+  vff::parallel::parallelForWorkers(b.n, kChunk, b.threads, [&](unsigned w, size_t first, size_t end) {
+    std::vector<Ray>& rays = buffers[w];
+    rays.resize(std::min(kChunk, b.n));
+    b.fill(first, end - first, rays.data());
+    work(first, std::span<const Ray>(rays.data(), end - first));
+  });
 }
 
 // Hits as numpy arrays.

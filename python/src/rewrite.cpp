@@ -6,7 +6,7 @@
 
 #include "bindings.h"
 #include "errors.h"
-#include "spelling.h"
+#include "vff/spelling.h"
 
 namespace py = pybind11;
 
@@ -75,13 +75,13 @@ the CLI's only.)doc");
         auto probe = openFile(src, "lazy");
         const LayoutDesc& l = probe->file.layout();
         WriteOptions wo;
-        wo.codec = cli::kCodecs.parse(codec).value_or(Codec::kStored);
-        if (!cli::kCodecs.parse(codec)) throw py::value_error("codec: expected \"stored\" or \"zstd\", got \"" + codec + "\"");
+        wo.codec = vff::kCodecs.parse(codec).value_or(Codec::kStored);
+        if (!vff::kCodecs.parse(codec)) throw py::value_error("codec: expected \"stored\" or \"zstd\", got \"" + codec + "\"");
         wo.zstdLevel = zstdLevel;
         wo.mapsPerBlock = mapsPerBlock;
         wo.layout = LayoutLimits{l.target, l.maxTextureSize, l.maxLayers, l.gutter};
         if (!target.is_none()) {
-          auto t = cli::kLayoutTargets.parse(target.cast<std::string>());
+          auto t = vff::kLayoutTargets.parse(target.cast<std::string>());
           if (!t) throw py::value_error("target: expected \"2d-array\" or \"3d\"");
           wo.layout.target = *t;
         }

@@ -79,7 +79,9 @@ class Hits:
 
 HitTuple = Tuple[bool, float, Tuple[float, float, float], Tuple[float, float, float], bool]
 
-class _Queries:
+class _BatchQueries:
+    # The batch queries of FieldQuery, Instance and Scene (a stub's base class only: at run time each
+    # class defines its own).
     def intersect(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
                   tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0,
                   threads: int = 0, out: Optional[Hits] = None) -> Hits: ...
@@ -89,6 +91,8 @@ class _Queries:
     def visibility(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
                    tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0,
                    threads: int = 0) -> npt.NDArray[np.float32]: ...
+
+class _Queries(_BatchQueries):
     def sites(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
               tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0,
               threads: int = 0) -> Tuple[npt.NDArray[np.int32], npt.NDArray[np.int32]]: ...
@@ -119,7 +123,7 @@ class Instance(_Queries):
 
 SceneHitTuple = Tuple[bool, float, Tuple[float, float, float], Tuple[float, float, float], bool, int]
 
-class Scene:
+class Scene(_BatchQueries):
     """Many instances answered together (vff/scene.h); answers equal the loop over the instances in
     id order. Queries need a commit() after add() or set_transform(); before, vff.OperationError."""
     def __init__(self) -> None: ...
@@ -132,15 +136,6 @@ class Scene:
     names: list[str]
     def instance(self, id: int) -> Instance: ...
     def __len__(self) -> int: ...
-    def intersect(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
-                  tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0,
-                  threads: int = 0, out: Optional[Hits] = None) -> Hits: ...
-    def occluded(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
-                 tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0,
-                 threads: int = 0) -> npt.NDArray[np.bool_]: ...
-    def visibility(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
-                   tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0,
-                   threads: int = 0) -> npt.NDArray[np.float32]: ...
     def intersect_ray(self, origin: Vec3, direction: Vec3, tmin: float = 0.0, tmax: float = ..., *,
                       interpolated: bool = False, intra_bias: float = -1.0) -> SceneHitTuple: ...
     def occluded_ray(self, origin: Vec3, direction: Vec3, tmin: float = 0.0, tmax: float = ..., *,

@@ -21,7 +21,7 @@
 #include "vff/bake/baker.h"
 #include "vff/bake/mesh.h"
 #include "vff/query.h"
-#include "sdf_field.h"
+#include "vff/sdf/sdf_field.h"
 
 namespace vffx {
 
@@ -172,22 +172,6 @@ inline std::span<const float> openShares(const SdfField& sdf, const SdfTraceOpti
   out.resize(rays.size());
   sdf.visibility(rays, out, so);
   return out;
-}
-
-// The distance field's options for one image: the cone estimate when `cone` (the SDF's counterpart
-// of the field's interpolated row); a skip of two voxels at the start of rays leaving the object's
-// own surface (the engine's self-shadow bias: the sampled distance is a voxel off there).
-inline SdfTraceOptions sdfOptions(bool cone, bool fromObject, float coneTan = 0, float coneRadiusAtEnd = 0) {
-  SdfTraceOptions so;
-  so.startVoxels = fromObject ? 2.0f : 0.0f;
-  if (cone) so.coneTan = coneTan, so.coneRadiusAtEnd = coneRadiusAtEnd;
-  return so;
-}
-// tan of the half-angle of one of `rays` equal cones covering the hemisphere (solid angle 2 pi / rays
-// each): the AO experiments' cone estimate.
-inline float hemisphereConeTan(int rays) {
-  const float c = 1.0f - 1.0f / float(std::max(rays, 1));
-  return std::sqrt(std::max(0.0f, 1.0f - c * c)) / std::max(c, 1e-3f);
 }
 
 // Bakes one configuration (unorm8-diameter) of the object and places it like the world's object.

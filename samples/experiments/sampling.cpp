@@ -1,10 +1,10 @@
-// sampling.cpp - per-pixel random numbers, hemisphere and sphere sampling, the thread pool loop.
+// sampling.cpp - per-pixel random numbers, hemisphere and sphere sampling, and the experiments'
+// parallel loops: the project's one chunked loop (platform/parallel.h) under common.h's names.
 #include <algorithm>
-#include <atomic>
 #include <chrono>
-#include <thread>
 
 #include "common.h"
+#include "platform/parallel.h"
 
 namespace vffx {
 
@@ -57,45 +57,25 @@ Vec3 uniformSphere(float u1, float u2) {
   return {r * std::cos(phi), r * std::sin(phi), z};
 }
 
-unsigned resolveThreads(unsigned threads) {
-  return threads ? threads : std::max(1u, std::thread::hardware_concurrency());
-}
+unsigned resolveThreads(unsigned threads) { return vff::parallel::resolveThreads(threads); }
 
 void parallelFor(uint64_t count, uint64_t chunk, unsigned threads,
                  const std::function<void(uint64_t, uint64_t)>& fn) {
-  timedParallelFor(count, chunk, threads, fn);
+  vff::parallel::parallelFor(count, chunk, threads, fn);
 }
 
+// The workers are started (and wait) before the clock starts, and joined after it stops; the time
+// ends when the last of them finishes its last chunk.
 double timedParallelFor(uint64_t count, uint64_t chunk, unsigned threads,
                         const std::function<void(uint64_t, uint64_t)>& fn) {
   using Clock = std::chrono::steady_clock;
-  threads = resolveThreads(threads);
-  chunk = std::max<uint64_t>(1, chunk);
-  std::atomic<uint64_t> next{0};
-  std::atomic<unsigned> started{0};
-  std::atomic<bool> go{false};
-  Clock::time_point start;
-  std::vector<Clock::time_point> end(threads);
-  auto worker = [&](unsigned w) {
-    started.fetch_add(1);
-    if (w == 0) {  // the clock starts once every worker is running
-      while (started.load() < threads) std::this_thread::yield();
-      start = Clock::now();
-      go.store(true);
-    } else {
-      while (!go.load()) std::this_thread::yield();
-    }
-    for (;;) {
-      const uint64_t begin = next.fetch_add(chunk);
-      if (begin >= count) break;
-      fn(begin, std::min(count, begin + chunk));
-    }
+  vff::parallel::WorkerPool pool(vff::parallel::workerCount(count, chunk, threads));
+  const Clock::time_point start = Clock::now();
+  std::vector<Clock::time_point> end(pool.size(), start);
+  pool.parallelForWorkers(count, chunk, [&](unsigned w, size_t begin, size_t stop) {
+    fn(begin, stop);
     end[w] = Clock::now();
-  };
-  std::vector<std::thread> pool;
-  for (unsigned i = 1; i < threads; ++i) pool.emplace_back(worker, i);
-  worker(0);
-  for (auto& t : pool) t.join();
+  });
   return std::chrono::duration<double>(*std::max_element(end.begin(), end.end()) - start).count();
 }
 

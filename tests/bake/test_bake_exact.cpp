@@ -8,13 +8,13 @@
 
 #include "vff/bake/baker.h"
 #include "vff/bake/procedural.h"
-#include "embree_reference.h"
+#include "vff/bake/embree_reference.h"
 #include "vff/vff.h"
 
 namespace vff::bake {
 namespace {
 
-using test::Reference;
+using Reference = bake::EmbreeReference;
 
 struct Stats {
   uint64_t hits = 0, misses = 0;

@@ -29,20 +29,6 @@ class MeshImport : public ::testing::Test {
   fs::path dir_;
 };
 
-std::string base64(const std::vector<uint8_t>& in) {
-  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (size_t i = 0; i < in.size(); i += 3) {
-    uint32_t v = uint32_t(in[i]) << 16 | (i + 1 < in.size() ? uint32_t(in[i + 1]) << 8 : 0) |
-                 (i + 2 < in.size() ? in[i + 2] : 0);
-    out += t[(v >> 18) & 63];
-    out += t[(v >> 12) & 63];
-    out += i + 1 < in.size() ? t[(v >> 6) & 63] : '=';
-    out += i + 2 < in.size() ? t[v & 63] : '=';
-  }
-  return out;
-}
-
 // A glTF with one triangle (positions + uint16 indices) under a translated, scaled node.
 std::string triangleGltf(const std::string& primitiveExtra = "", const std::string& topExtra = "",
                          int accessorCount = 3) {

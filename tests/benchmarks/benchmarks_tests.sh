@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # benchmarks_tests.sh - benchmarks/run.sh writes a results file that benchmarks/report.py reads back,
-# and README.md's tables are the ones the committed results files give.
+# and the tables of README.md and benchmarks/README.md are the ones the committed results files give.
 #
 # Every function named test_* is one ctest case (tests/benchmarks/CMakeLists.txt); environment:
 #   VFF_SOURCE_DIR, VFF_BUILD_DIR  the source and build folders; PYTHON  python3;
@@ -86,17 +86,35 @@ test_run_refuses_a_missing_mesh() {
   [[ ! -e $WORK/r.md ]] || fail "a results file was written"
 }
 
-# Every figure in README.md comes from a committed results file: its tables are exactly what
-# report.py makes of benchmarks/results/.
+# Every figure in README.md and benchmarks/README.md comes from a committed results file: README's
+# headline table and the full tables are exactly what report.py makes of benchmarks/results/, and a
+# changed figure in either file fails the check, naming that file.
 test_readme_tables_match_the_results_files() {
-  run "$PYTHON" "$report" readme --check "$VFF_SOURCE_DIR/README.md"
+  local f other
+  run "$PYTHON" "$report" readme --check "$VFF_SOURCE_DIR/README.md" "$VFF_SOURCE_DIR/benchmarks/README.md"
   expect_rc 0
-  cp "$VFF_SOURCE_DIR/README.md" "$WORK/README.md"
-  sed -i '/^<!-- benchmarks:begin/,/^<!-- benchmarks:end/ s/| \([0-9]\+\)\.\([0-9]\+\)x |/| 9\1.\2x |/' "$WORK/README.md"
-  cmp -s "$VFF_SOURCE_DIR/README.md" "$WORK/README.md" && fail "the edit of a ratio changed nothing"
-  run "$PYTHON" "$report" readme --check "$WORK/README.md"
-  expect_rc 1
-  expect_err "its benchmark tables differ from benchmarks/results/"
+  for f in README.md benchmarks/README.md; do
+    mkdir -p "$WORK/copy/benchmarks"
+    cp "$VFF_SOURCE_DIR/README.md" "$WORK/copy/README.md"
+    cp "$VFF_SOURCE_DIR/benchmarks/README.md" "$WORK/copy/benchmarks/README.md"
+    sed -i '/^<!-- benchmarks:begin/,/^<!-- benchmarks:end/ s/| \([0-9]\+\)\.\([0-9]\+\)x |/| 9\1.\2x |/' "$WORK/copy/$f"
+    cmp -s "$VFF_SOURCE_DIR/$f" "$WORK/copy/$f" && fail "the edit of a ratio in $f changed nothing"
+    run "$PYTHON" "$report" readme --check "$WORK/copy/README.md" "$WORK/copy/benchmarks/README.md"
+    expect_rc 1
+    expect_err "$WORK/copy/$f: its "
+    expect_err " benchmarks/results/"
+    other=README.md; [[ $f == README.md ]] && other=benchmarks/README.md
+    ! grep -q -F "$WORK/copy/$other: its " "$WORK/err" || { show; fail "the check names $other, whose tables are unchanged"; }
+  done
+}
+
+# README.md is a user's manual of at most 12 KiB: the full tables live in benchmarks/README.md,
+# details in docs/.
+test_readme_is_at_most_12288_bytes() {
+  local size
+  size=$(wc -c <"$VFF_SOURCE_DIR/README.md")
+  echo "README.md: $size bytes"
+  ((size <= 12288)) || fail "README.md is $size bytes, over 12288: move details to docs/ or benchmarks/README.md"
 }
 
 run_test "$1"

@@ -6,7 +6,7 @@
 //                17 t for t < 15 and a miss at t = 15 -> 150 hits of 160 (0.9375); with 2 histogram
 //                bins, codes 0..119 (80 hits) fall in [0, R) and 136..238 (70 hits) in [R, 2R].
 //                4 maps per block (3 blocks: 4, 4, 2). Metadata {"name":"known","note":"cli fixture"}.
-//   small.vff    10 maps of 8x8 unorm8-diameter, synthetic codes (tests/unit/test_util.h)
+//   small.vff    10 maps of 8x8 unorm8-diameter, synthetic codes (tests/common/synthetic_field.h)
 //   zstd.vff     26 maps of 8x8 unorm16-diameter + oct-snorm16 normals, zstd blocks
 //   chord.vff    10 maps of 8x8 unorm8-chord, hemi-octahedral directions
 //   bit1.vff     10 maps of 8x8 bit1
@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "../unit/test_util.h"
+#include "common/synthetic_field.h"
 #include "vff/vff.h"
 
 namespace {

@@ -52,20 +52,13 @@
 #include <string>
 #include <vector>
 
+#include "common/synthetic_field.h"
 #include "vff/vff.h"
 
 namespace {
 
 using namespace vff;
-
-uint32_t mix(uint32_t x) {
-  x ^= x >> 16;
-  x *= 0x7feb352dU;
-  x ^= x >> 15;
-  x *= 0x846ca68bU;
-  x ^= x >> 16;
-  return x;
-}
+using test::hashMix;
 
 // A plain 4x4 EXR with a FLOAT Y channel and no vff.field attribute.
 int plainExr(int argc, char** argv) {
@@ -187,7 +180,7 @@ int write(int argc, char** argv) {
     std::span<uint8_t> map(dist.data() + k * dBytes, dBytes);
     for (uint32_t j = 0; j < m; ++j) {
       for (uint32_t i = 0; i < m; ++i, ++t) {
-        const uint32_t h = mix(uint32_t(t) * 2654435761u + 12345u);
+        const uint32_t h = hashMix(uint32_t(t) * 2654435761u + 12345u);
         uint32_t code;
         if (f.distanceEncoding == DistanceEncoding::kBit1)
           code = (h & 7) ? 1 : 0;
@@ -201,13 +194,13 @@ int write(int argc, char** argv) {
         const bool hit = code != miss;  // bit1: miss code 0
         if (normals && hit && (h & 0x100)) {
           // Half of the normals are raw codes: every code a file may hold, seam duplicates included.
-          const auto cx = static_cast<uint16_t>(int32_t(mix(h + 1) % 65535) - 32767);
-          const auto cy = static_cast<uint16_t>(int32_t(mix(h + 2) % 65535) - 32767);
+          const auto cx = static_cast<uint16_t>(int32_t(hashMix(h + 1) % 65535) - 32767);
+          const auto cy = static_cast<uint16_t>(int32_t(hashMix(h + 2) % 65535) - 32767);
           uint8_t* o = norm.data() + k * nBytes + 4 * (uint64_t{j} * m + i);
           o[0] = uint8_t(cx & 0xff), o[1] = uint8_t(cx >> 8), o[2] = uint8_t(cy & 0xff), o[3] = uint8_t(cy >> 8);
         } else if (normals && hit) {
-          const float z = float(mix(h) % 20001) / 10000.0f - 1.0f;
-          const float phi = float(mix(h + 7) % 62832) / 10000.0f;
+          const float z = float(hashMix(h) % 20001) / 10000.0f - 1.0f;
+          const float phi = float(hashMix(h + 7) % 62832) / 10000.0f;
           const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
           encodeNormal({r * std::cos(phi), r * std::sin(phi), z}, norm.data() + k * nBytes + 4 * (uint64_t{j} * m + i));
         }

@@ -15,15 +15,19 @@ set -euo pipefail
 
 # ---- Helpers ---------------------------------------------------------------------------------------
 source "$(dirname "${BASH_SOURCE[0]}")/convert_harness.sh"
-# exr_round_trip ENCODING [FIELD ARGS...]: vff -> FLOAT exr -> vff gives the same bytes.
-exr_round_trip() {
-  field "$WORK/a.vff" "$@"
+# exr_and_back: $WORK/a.vff -> $WORK/a.exr (FLOAT) -> $WORK/b.vff, both steps clean.
+exr_and_back() {
   convert "$WORK/a.vff" --to exr "$WORK/a.exr"
   expect_rc 0
   expect_no_err
   convert "$WORK/a.exr" --to vff "$WORK/b.vff"
   expect_rc 0
   expect_no_err
+}
+# exr_round_trip ENCODING [FIELD ARGS...]: vff -> FLOAT exr -> vff gives the same bytes.
+exr_round_trip() {
+  field "$WORK/a.vff" "$@"
+  exr_and_back
   same "$WORK/a.vff" "$WORK/b.vff"
   cmp "$WORK/a.vff" "$WORK/b.vff" || fail "the round trip is not byte-identical"
   valid "$WORK/b.vff"
@@ -143,12 +147,7 @@ test_half_lossy_for_unorm16() {
 # ---- Normals ---------------------------------------------------------------------------------------
 test_normals_round_trip() {
   field "$WORK/a.vff" unorm8-diameter --n 4 --m 16 --normals
-  convert "$WORK/a.vff" --to exr "$WORK/a.exr"
-  expect_rc 0
-  expect_no_err
-  convert "$WORK/a.exr" --to vff "$WORK/b.vff"
-  expect_rc 0
-  expect_no_err
+  exr_and_back
   # Within the oct-snorm16 quantisation: at most one code per component; in practice all exact.
   same "$WORK/a.vff" "$WORK/b.vff" --normal-tolerance 1
   expect_out "largest difference 0 codes"

@@ -1,5 +1,5 @@
 // The GLSL normals, kInterpolated reconstruction and ground AO (gpu/glsl/vff_query.glsl,
-// gpu/bench/ao_scene.h) against the CPU query, on a headless EGL context.
+// gpu/harness/ao_scene.h) against the CPU query, on a headless EGL context.
 //
 // * Normals: for every ray where the GPU and FieldQuery::intersect (kNearest) both hit at the same
 //   t (within 1e-5 R), the GPU normal must be within 1e-5 of the CPU's (each component).
@@ -15,14 +15,15 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <random>
 #include <string>
 #include <vector>
 
-#include "../../gpu/bench/ao_gl.h"
-#include "../../gpu/bench/ao_scene.h"
+#include "ao_gl.h"
+#include "ao_scene.h"
 #include "baked_fields.h"
+#include "common/rng.h"
 #include "egl_context.h"
+#include "gl_test.h"
 #include "vff/bake/baker.h"
 #include "vff/bake/procedural.h"
 #include "vff/gl/loader.h"
@@ -36,30 +37,16 @@ constexpr double kVoteEps = 1e-4;
 constexpr double kInterpT = 1e-4;    // fraction of R
 constexpr double kInterpVis = 1e-4;
 
-#define VFF_REQUIRE_GL()                                                        \
-  do {                                                                          \
-    const test::HeadlessGl& gl_ = test::headlessGl();                           \
-    if (!gl_.ok) GTEST_SKIP() << "no headless OpenGL 4.3 context: " << gl_.error; \
-  } while (0)
-
 GLuint buildProgram(const char* defines, const std::string& body) {
   std::string log;
-  const GLuint prog = test::buildQueryProgram(defines, body, &log);
+  const GLuint prog = harness::buildQueryProgram(defines, body, &log);
   EXPECT_NE(prog, 0u) << log;
   return prog;
 }
 
 // One ray per invocation: both reconstructions.
-const char* kMain = R"(
-layout(local_size_x = 64) in;
-struct TestRay { vec4 origin; vec4 direction; vec4 range; };
-struct TestOut { vec4 nearest; vec4 nearestNormal; vec4 interp; vec4 interpNormal; };
-layout(std430, binding = 3) readonly buffer TestRays { TestRay rays[]; };
-layout(std430, binding = 4) writeonly buffer TestOuts { TestOut outs[]; };
-void main() {
-  uint id = gl_GlobalInvocationID.x;
-  if (id >= uint(rays.length())) return;
-  TestRay r = rays[id];
+const std::string kMain = "struct TestOut { vec4 nearest; vec4 nearestNormal; vec4 interp; vec4 interpNormal; };\n" +
+                          test::rayShaderHead(3, 4) + R"(
   VffHit a = vffIntersect(r.origin.xyz, r.direction.xyz, r.range.x, r.range.y, r.range.z);
   float vis;
   VffHit b = vffQuery(r.origin.xyz, r.direction.xyz, r.range.x, r.range.y, r.range.z, true, vis);
@@ -80,13 +67,7 @@ struct GpuOut {
 };
 
 std::vector<GpuRay> makeRays(const FieldDesc& f, uint32_t count, uint64_t seed) {
-  std::mt19937_64 g(seed);
-  auto uni = [&] { return float(std::uniform_real_distribution<double>(0, 1)(g)); };
-  auto dir = [&] {
-    const float z = 2 * uni() - 1, phi = 6.2831853f * uni();
-    const float r = std::sqrt(std::max(0.0f, 1 - z * z));
-    return Vec3{r * std::cos(phi), r * std::sin(phi), z};
-  };
+  test::Rng rng(seed);
   const Vec3 c{f.sphere.center[0], f.sphere.center[1], f.sphere.center[2]};
   const float R = f.sphere.radius;
   std::vector<GpuRay> rays(count);
@@ -94,17 +75,17 @@ std::vector<GpuRay> makeRays(const FieldDesc& f, uint32_t count, uint64_t seed) 
     Vec3 o, d;
     float tmin = 0, tmax = INFINITY;
     if (r % 4 != 3) {  // mostly from outside: the interpolated path
-      const Vec3 a = dir(), b = dir();
-      const float s = R * (1.05f + 2.0f * uni()), s2 = R * 1.1f * std::cbrt(uni());
+      const Vec3 a = rng.direction(), b = rng.direction();
+      const float s = R * (1.05f + 2.0f * rng.uniform()), s2 = R * 1.1f * std::cbrt(rng.uniform());
       o = Vec3{c.x + a.x * s, c.y + a.y * s, c.z + a.z * s};
       d = Vec3{c.x + b.x * s2 - o.x, c.y + b.y * s2 - o.y, c.z + b.z * s2 - o.z};
       if (r % 8 == 2) d = Vec3{d.x * 2.5f, d.y * 2.5f, d.z * 2.5f};
-      if (r % 16 == 4) tmax = 1.5f * uni();
+      if (r % 16 == 4) tmax = 1.5f * rng.uniform();
     } else {
-      const Vec3 a = dir();
-      const float s = R * 0.95f * std::cbrt(uni());
+      const Vec3 a = rng.direction();
+      const float s = R * 0.95f * std::cbrt(rng.uniform());
       o = Vec3{c.x + a.x * s, c.y + a.y * s, c.z + a.z * s};
-      d = dir();
+      d = rng.direction();
     }
     rays[r] = GpuRay{{o.x, o.y, o.z, 0}, {d.x, d.y, d.z, 0}, {tmin, tmax, r % 3 == 0 ? 0.0f : -1.0f, 0}};
   }
@@ -333,22 +314,22 @@ TEST(GpuAo, GroundAoMatchesCpu) {
   float minY = INFINITY;
   for (size_t v = 1; v < mesh.positions.size(); v += 3) minY = std::min(minY, mesh.positions[v]);
   constexpr int kSize = 64, kRays = 64;
-  const gpubench::AoScene s = gpubench::makeAoScene(file->field(), minY, kSize);
+  const harness::AoScene s = harness::makeAoScene(file->field(), minY, kSize);
   auto gpu = gl::loadField(*file);
   ASSERT_TRUE(gpu.ok()) << gpu.error().toString();
   auto cpu = FieldQuery::fromFile(*file);
   ASSERT_TRUE(cpu.ok());
-  const GLuint prog = buildProgram("", gpubench::kAoShader);
+  const GLuint prog = buildProgram("", harness::kAoShader);
   ASSERT_NE(prog, 0u);
-  const gpubench::AoBuffers aoBuffers(s);
+  const harness::AoBuffers aoBuffers(s);
   gpu->bind();
   glUseProgram(prog);
   for (Reconstruction r : {Reconstruction::kNearest, Reconstruction::kInterpolated}) {
     const bool interp = r == Reconstruction::kInterpolated;
     std::vector<float> g;
-    (void)gpubench::renderAo(s, aoBuffers, kRays, interp ? 1 : 0, &g);
-    const std::vector<float> c = gpubench::cpuAo(*cpu, s, kRays, r, 2);
-    const gpubench::AoDiff d = gpubench::compareAo(c, g);
+    (void)harness::renderAo(s, aoBuffers, kRays, interp ? 1 : 0, &g);
+    const std::vector<float> c = harness::cpuAo(*cpu, s, kRays, r, 2);
+    const harness::AoDiff d = harness::compareAo(c, g);
     std::printf("[ gpu ] ground AO %dx%d, %d rays/px, %s: mean AO %.4f; GPU vs CPU on the 8-bit scale: max %.0f, "
                 "RMS %.4f, %llu of %d pixels differ\n",
                 kSize, kSize, kRays, interp ? "kInterpolated visibility" : "kNearest occluded", d.meanA, d.max, d.rms,

@@ -19,13 +19,14 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <random>
 #include <string>
 #include <vector>
 
 #include "baked_fields.h"
+#include "common/rng.h"
 #include "dispatch.h"
 #include "egl_context.h"
+#include "gl_test.h"
 #include "vff/bake/baker.h"
 #include "vff/bake/procedural.h"
 #include "vff/gl/loader.h"
@@ -38,12 +39,6 @@ constexpr double kSampleEps = 1e-5;  // dot-product difference of two equally ne
 constexpr double kTexelEps = 1e-3;   // texels from the texel boundary
 constexpr double kRangeEps = 1e-5;   // fraction of R from tmin / tmax / bias
 
-#define VFF_REQUIRE_GL()                                                        \
-  do {                                                                          \
-    const test::HeadlessGl& gl_ = test::headlessGl();                           \
-    if (!gl_.ok) GTEST_SKIP() << "no headless OpenGL 4.3 context: " << gl_.error; \
-  } while (0)
-
 Vec3 add(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 Vec3 sub(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 Vec3 mul(Vec3 a, float s) { return {a.x * s, a.y * s, a.z * s}; }
@@ -53,16 +48,9 @@ float dot3(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
 
 // The test's compute shader: one ray per invocation.
-const char* kMain = R"(
-layout(local_size_x = 64) in;
-struct TestRay { vec4 origin; vec4 direction; vec4 range; };  // range: tmin, tmax, intraBias
-struct TestOut { uint flags; float t; uint k; uint i; uint j; uint code; float distance; uint pad; };
-layout(std430, binding = 3) readonly buffer TestRays { TestRay rays[]; };
-layout(std430, binding = 4) writeonly buffer TestOuts { TestOut outs[]; };
-void main() {
-  uint id = gl_GlobalInvocationID.x;
-  if (id >= uint(rays.length())) return;
-  TestRay r = rays[id];
+const std::string kMain =
+    "struct TestOut { uint flags; float t; uint k; uint i; uint j; uint code; float distance; uint pad; };\n" +
+    test::rayShaderHead(3, 4) + R"(
   VffHit h = vffIntersect(r.origin.xyz, r.direction.xyz, r.range.x, r.range.y, r.range.z);
   TestOut o;
   o.flags = (h.hit ? 1u : 0u) | (h.inside ? 2u : 0u) | (h.looked ? 4u : 0u);
@@ -94,7 +82,7 @@ static_assert(sizeof(GpuRay) == 48 && sizeof(GpuOut) == 32);
 // Compiles the program for a field (gl::shaderDefines); empty string on success, else the log.
 std::string buildProgram(const File& file, GLuint* program) {
   std::string log;
-  *program = test::buildQueryProgram(gl::shaderDefines(file.field(), file.layout()), kMain, &log);
+  *program = harness::buildQueryProgram(gl::shaderDefines(file.field(), file.layout()), kMain, &log);
   return log;
 }
 
@@ -159,7 +147,7 @@ CpuLookup cpuLookup(const File& file, const PositionSet& ps, const Vec3 o, const
   EXPECT_TRUE(map.ok());
   c.code = loadCode(f.distanceEncoding, *map, m, c.i, c.j);
   c.looked = true;
-  // The decode of libvff/src/query.cpp (FieldQuery::Impl::texel).
+  // The decode of libvff/src/query/query_impl.h (FieldQuery::Impl::texel).
   bool hit = false;
   switch (f.distanceEncoding) {
     case DistanceEncoding::kUnorm8Diameter:
@@ -199,13 +187,7 @@ struct Agreement {
 
 // Random rays: half from outside the sphere towards points inside it, half from inside.
 std::vector<GpuRay> makeRays(const FieldDesc& f, uint32_t count, uint64_t seed) {
-  std::mt19937_64 g(seed);
-  auto uni = [&] { return float(std::uniform_real_distribution<double>(0, 1)(g)); };
-  auto dir = [&] {
-    const float z = 2 * uni() - 1, phi = 6.2831853f * uni();
-    const float r = std::sqrt(std::max(0.0f, 1 - z * z));
-    return Vec3{r * std::cos(phi), r * std::sin(phi), z};
-  };
+  test::Rng rng(seed);
   const Vec3 c{f.sphere.center[0], f.sphere.center[1], f.sphere.center[2]};
   const float R = f.sphere.radius;
   std::vector<GpuRay> rays(count);
@@ -214,16 +196,16 @@ std::vector<GpuRay> makeRays(const FieldDesc& f, uint32_t count, uint64_t seed) 
     Vec3 o, d;
     float tmin = 0, tmax = INFINITY;
     if (r % 2 == 0) {
-      o = add(c, mul(dir(), R * (1.05f + 2.0f * uni())));
-      const Vec3 target = add(c, mul(dir(), R * 1.1f * std::cbrt(uni())));  // a few miss the sphere
+      o = add(c, mul(rng.direction(), R * (1.05f + 2.0f * rng.uniform())));
+      const Vec3 target = add(c, mul(rng.direction(), R * 1.1f * std::cbrt(rng.uniform())));  // a few miss the sphere
       d = sub(target, o);
-      if (r % 8 == 2) d = mul(d, 0.5f + 3 * uni());  // non-unit directions
-      if (r % 16 == 4) tmax = 1.5f * uni();          // finite ranges
-      if (r % 16 == 6) tmin = 0.5f * uni();
+      if (r % 8 == 2) d = mul(d, 0.5f + 3 * rng.uniform());  // non-unit directions
+      if (r % 16 == 4) tmax = 1.5f * rng.uniform();          // finite ranges
+      if (r % 16 == 6) tmin = 0.5f * rng.uniform();
     } else {
-      o = add(c, mul(dir(), R * 0.95f * std::cbrt(uni())));
-      d = dir();
-      if (r % 16 == 5) tmax = R * uni();
+      o = add(c, mul(rng.direction(), R * 0.95f * std::cbrt(rng.uniform())));
+      d = rng.direction();
+      if (r % 16 == 5) tmax = R * rng.uniform();
     }
     rays[r] = GpuRay{{o.x, o.y, o.z, 0}, {d.x, d.y, d.z, 0}, {tmin, tmax, biases[r % 3], 0}};
   }
@@ -376,7 +358,7 @@ class GpuQuery : public ::testing::TestWithParam<FieldCase> {};
 
 TEST_P(GpuQuery, MatchesCpuNearest) {
   VFF_REQUIRE_GL();
-  std::printf("[ gpu ] %s\n", test::headlessGl().renderer.c_str());
+  std::printf("[ gpu ] %s\n", harness::headlessGl().renderer.c_str());
   auto file = bakeFile(GetParam());
   ASSERT_TRUE(file.ok()) << file.error().toString();
   EXPECT_GT(file->layout().sliceCount, 1u);
@@ -442,7 +424,7 @@ INSTANTIATE_TEST_SUITE_P(Valid, GpuConformance, ::testing::ValuesIn(validVectors
 // returns 8 vec4 per invocation.
 std::vector<float> runProbe(const std::string& body, uint32_t count) {
   std::string log;
-  const GLuint prog = test::buildQueryProgram(
+  const GLuint prog = harness::buildQueryProgram(
       "",
       "layout(local_size_x = 64) in;\n"
       "layout(std430, binding = 4) writeonly buffer ProbeOut { vec4 outs[]; };\n"

@@ -13,7 +13,7 @@
 //   spec/geometry.md section 8): at most 0.5% of the rays, counted and printed;
 // * the first rays also against the loop over Instance::intersect (lowest id on equal t);
 // * after every instance moved, Scene::commit and GpuScene::update: the same again;
-// * a ground-AO frame of the scene (gpu/bench/ao_scene.h) equal to the CPU Scene's within the
+// * a ground-AO frame of the scene (gpu/harness/ao_scene.h) equal to the CPU Scene's within the
 //   single-field AO test's bounds.
 #include <gtest/gtest.h>
 #include <GL/glcorearb.h>
@@ -26,22 +26,17 @@
 #include <string>
 #include <vector>
 
-#include "../../gpu/bench/ao_gl.h"
-#include "../../gpu/bench/ao_scene.h"
+#include "ao_gl.h"
+#include "ao_scene.h"
 #include "baked_fields.h"
 #include "dispatch.h"
 #include "egl_context.h"
+#include "gl_test.h"
 #include "vff/gl/scene_loader.h"
 #include "vff/vff.h"
 
 namespace vff {
 namespace {
-
-#define VFF_REQUIRE_GL()                                                        \
-  do {                                                                          \
-    const test::HeadlessGl& gl_ = test::headlessGl();                           \
-    if (!gl_.ok) GTEST_SKIP() << "no headless OpenGL 4.3 context: " << gl_.error; \
-  } while (0)
 
 constexpr double kNearestT = 1e-5;  // fraction of the instance's world radius
 constexpr double kInterpT = 1e-4;
@@ -52,19 +47,12 @@ constexpr double kMaxDifferingShare = 0.005;
 // One ray per invocation: the four scene queries (vffSceneIntersect kNearest and kInterpolated,
 // vffSceneOccluded, vffSceneVisibility), through their common walk, called from a loop whose
 // count is a uniform (4) so that the driver compiles the walk once, not four times.
-const char* kMain = R"(
-layout(local_size_x = 64) in;
-struct TestRay { vec4 origin; vec4 direction; vec4 range; };  // range: tmin, tmax, intraBias
+const std::string kMain = R"(
 struct TestOut { uint nearestHit; float nearestT; uint nearestInstance; uint occluded;
                  uint interpHit; float interpT; uint interpInstance; float visibility;
                  vec4 normal; };  // normal: the kNearest hit's world normal, w = hasNormal
-layout(std430, binding = 8) readonly buffer TestRays { TestRay rays[]; };
-layout(std430, binding = 9) writeonly buffer TestOuts { TestOut outs[]; };
 layout(location = 0) uniform int queries;
-void main() {
-  uint id = gl_GlobalInvocationID.x;
-  if (id >= uint(rays.length())) return;
-  TestRay r = rays[id];
+)" + test::rayShaderHead(8, 9) + R"(
   TestOut o;
   for (int q = 0; q < queries; ++q) {
     // q: 0 intersect kNearest (vffSceneIntersect), 1 intersect kInterpolated, 2 occluded
@@ -108,12 +96,12 @@ static_assert(sizeof(GpuRay) == 48 && sizeof(GpuOut) == 48);
 
 std::string sceneSource(const std::string& defines, const std::string& body) {
   return "#version 430\n" + defines +
-         gl::sceneShaderSource(test::readGlsl("vff_scene.glsl"), test::readGlsl("vff_query.glsl")) + body;
+         gl::sceneShaderSource(harness::readGlsl("vff_scene.glsl"), harness::readGlsl("vff_query.glsl")) + body;
 }
 
 GLuint buildSceneProgram(const std::string& defines, const std::string& body) {
   std::string log;
-  const GLuint prog = test::buildProgram(sceneSource(defines, body), &log);
+  const GLuint prog = harness::buildProgram(sceneSource(defines, body), &log);
   EXPECT_NE(prog, 0u) << log;
   return prog;
 }
@@ -446,27 +434,18 @@ TEST(GpuScene, GroundAoMatchesCpuScene) {
   }
   bounds.sphere = Sphere{{0, 0, 0}, 0.5f * extent};
   constexpr int kSize = 48, kRays = 32;
-  const gpubench::AoScene s = gpubench::makeAoScene(bounds, lowest, kSize);
-  const std::string defines =
-      "#define AO_VISIBILITY(o, d) vffSceneVisibility(o, d, 0.0, aoTmax, 0.0, true)\n"
-      "#define AO_OCCLUDED(o, d) vffSceneOccluded(o, d, 0.0, aoTmax, 0.0, false)\n";
-  const GLuint prog = buildSceneProgram("#define VFF_SCENE_INSTANCES_BINDING 10\n#define VFF_SCENE_NODES_BINDING 11\n",
-                                        defines + gpubench::kAoShader);
-  ASSERT_NE(prog, 0u);
-  const gpubench::AoBuffers aoBuffers(s);
-  // The AO shader's buffers are at 5, 6, 7; the scene's instances and nodes move to 10 and 11.
-  gl::SceneBindings b;
-  b.instances = 10;
-  b.nodes = 11;
-  gpu->bind(b);
-  aoBuffers.bind();
-  glUseProgram(prog);
+  const harness::AoScene s = harness::makeAoScene(bounds, lowest, kSize);
+  std::string log;
+  const GLuint prog = harness::buildProgram(harness::sceneAoShaderSource(), &log);
+  ASSERT_NE(prog, 0u) << log;
+  const harness::AoBuffers aoBuffers(s);
+  harness::useSceneAo(*gpu, aoBuffers, prog);
   for (Reconstruction r : {Reconstruction::kNearest, Reconstruction::kInterpolated}) {
     const bool interp = r == Reconstruction::kInterpolated;
     std::vector<float> g;
-    (void)gpubench::renderAo(s, aoBuffers, kRays, interp ? 1 : 0, &g);
-    const std::vector<float> c = gpubench::cpuAo(scene, s, kRays, r, 2);
-    const gpubench::AoDiff d = gpubench::compareAo(c, g);
+    (void)harness::renderAo(s, aoBuffers, kRays, interp ? 1 : 0, &g);
+    const std::vector<float> c = harness::cpuAo(scene, s, kRays, r, 2);
+    const harness::AoDiff d = harness::compareAo(c, g);
     std::printf("[ gpu ] scene ground AO %dx%d, %d rays/px, %s: mean AO %.4f; GPU vs CPU Scene on the 8-bit "
                 "scale: max %.0f, RMS %.4f, %llu of %d pixels differ\n",
                 kSize, kSize, kRays, interp ? "kInterpolated visibility" : "kNearest occluded", d.meanA, d.max, d.rms,

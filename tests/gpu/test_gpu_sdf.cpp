@@ -1,5 +1,5 @@
 // The distance-field peer's GLSL sphere tracer (gpu/glsl/vff_sdf.glsl through PNanoVDB, uploaded by
-// gpu/sdf/sdf_gl.h) against the CPU tracer (samples/experiments/sdf_field.cpp) on the same rays and
+// gpu/sdf/sdf_gl.h) against the CPU tracer (sdf/src/sdf_field.cpp) on the same rays and
 // the same grid, on a headless EGL context.
 //
 // Tolerances. Both tracers run in binary32 (the grid's float map, float samples and steps), the
@@ -23,11 +23,12 @@
 #include <string>
 #include <vector>
 
-#include "../../gpu/bench/ao_gl.h"
-#include "../../gpu/bench/sdf_ao.h"
-#include "common.h"  // samples/experiments: the AO experiments' cone options
+#include "ao_gl.h"
+#include "sdf_ao.h"
+#include "vff/sdf/sdf_field.h"
 #include "dispatch.h"
 #include "egl_context.h"
+#include "gl_test.h"
 #include "sdf_gl.h"
 #include "vff/bake/mesh.h"
 #include "vff/bake/procedural.h"
@@ -44,12 +45,6 @@ constexpr double kLooseVoxels = 0.5;
 constexpr double kAoMax = 8.0;  // one ray of 32 answered differently
 constexpr double kAoRms = 0.25;
 constexpr double kConeVis = 1e-4;  // the cone estimate, where the traces agree
-
-#define VFF_REQUIRE_GL()                                                          \
-  do {                                                                            \
-    const vff::test::HeadlessGl& gl_ = vff::test::headlessGl();                   \
-    if (!gl_.ok) GTEST_SKIP() << "no headless OpenGL 4.3 context: " << gl_.error; \
-  } while (0)
 
 const char* kRayMain = R"(
 layout(local_size_x = 64) in;
@@ -113,8 +108,8 @@ std::vector<vff::Ray> makeRays(const vff::Sphere& s, uint32_t n, uint64_t seed) 
 GLuint buildSdfProgram(const vffx::SdfField& sdf, const std::string& body) {
   std::string log;
   const std::string src = "#version 430\n" + vffx::gl::sdfShaderDefines(sdf) +
-                          vffx::gl::sdfShaderSource(vff::test::readGlsl("vff_sdf.glsl")) + body;
-  const GLuint prog = vff::test::buildProgram(src, &log);
+                          vffx::gl::sdfShaderSource(vff::harness::readGlsl("vff_sdf.glsl")) + body;
+  const GLuint prog = vff::harness::buildProgram(src, &log);
   EXPECT_NE(prog, 0u) << log;
   return prog;
 }
@@ -247,26 +242,26 @@ TEST(GpuSdf, GroundAoMatchesCpu) {
   vff::FieldDesc f;
   f.sphere = boundingSphere(m);
   constexpr int kSize = 32, kRays = 32;
-  const vff::gpubench::AoScene s = vff::gpubench::makeAoScene(f, minY, kSize);
+  const vff::harness::AoScene s = vff::harness::makeAoScene(f, minY, kSize);
   auto gpu = vffx::gl::uploadSdf(sdf);
   ASSERT_TRUE(gpu) << gpu.error().toString();
   std::string log;
-  const GLuint prog = vff::test::buildProgram(
-      vff::gpubench::sdfAoShaderSource(sdf, vff::test::readGlsl("vff_query.glsl"), vff::test::readGlsl("vff_sdf.glsl")),
+  const GLuint prog = vff::harness::buildProgram(
+      vff::harness::sdfAoShaderSource(sdf, vff::harness::readGlsl("vff_query.glsl"), vff::harness::readGlsl("vff_sdf.glsl")),
       &log);
   ASSERT_NE(prog, 0u) << log;
-  const vff::gpubench::AoBuffers aoBuffers(s);
+  const vff::harness::AoBuffers aoBuffers(s);
   for (const bool cone : {false, true}) {
     const vffx::SdfTraceOptions so = vffx::sdfOptions(cone, false, vffx::hemisphereConeTan(kRays));
     ASSERT_TRUE(gpu->setTraceOptions(so));
     gpu->bind();
     glUseProgram(prog);
     std::vector<float> g;
-    (void)vff::gpubench::renderAo(s, aoBuffers, kRays, cone ? 1 : 0, &g);
+    (void)vff::harness::renderAo(s, aoBuffers, kRays, cone ? 1 : 0, &g);
     ASSERT_EQ(glGetError(), GLenum(GL_NO_ERROR));
     const std::vector<float> c =
-        vff::gpubench::cpuAo(vff::gpubench::SdfAoQuery{&sdf, so}, s, kRays, vff::Reconstruction::kNearest, 2);
-    const vff::gpubench::AoDiff d = vff::gpubench::compareAo(c, g);
+        vff::harness::cpuAo(vff::harness::SdfAoQuery{&sdf, so}, s, kRays, vff::Reconstruction::kNearest, 2);
+    const vff::harness::AoDiff d = vff::harness::compareAo(c, g);
     std::printf(
         "[ gpu ] sdf ground AO %dx%d, %d rays/px, %s: CPU mean AO %.4f (min %.3f); GPU vs CPU on the 8-bit "
         "scale: max %.0f, RMS %.4f, %llu of %d pixels differ\n",

@@ -9,11 +9,11 @@ set -euo pipefail
 : "${NM:?}" "${VFF_OBJECTS:?}" "${WORK:?}"
 source "$(dirname "${BASH_SOURCE[0]}")/../common/cli_harness.sh"
 
-# The files compiled for an instruction set beyond the baseline (libvff/src/cpu_features.h: the
+# The files compiled for an instruction set beyond the baseline (libvff/src/platform/cpu_features.h: the
 # group kernel's query_group_avx2.cpp and query_group_avx512.cpp, the scene traversal's
 # scene_bvh_avx512.cpp, the filter's filter_simd_ssse3.cpp) define no weak symbol: an inline or template function emitted there is
 # code for that instruction set, and the linker may pick that copy for callers that run on any
-# x86-64 CPU (the rule at the top of libvff/src/query_group_kernel.h). A std::initializer_list in
+# x86-64 CPU (the rule at the top of libvff/src/query/batch/query_group_kernel.h). A std::initializer_list in
 # a range-for did so at -O0.
 test_kernel_objects_define_no_weak_symbols() {
   local objects o kernels=0 weak

@@ -7,22 +7,21 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <random>
 #include <vector>
 
-#include "../../libvff/src/huge_pages.h"  // private: detail::adviseHugePages
-#include "embree_reference.h"
-#include "vff/bake/baker.h"
-#include "vff/bake/procedural.h"
+#include "common/baked_shape.h"
+#include "common/rng.h"
+#include "platform/huge_pages.h"  // private: detail::adviseHugePages
+#include "vff/bake/embree_reference.h"
 #include "vff/vff.h"
 
 namespace vff {
 namespace {
 
-using bake::BakedField;
-using bake::BakeOptions;
-using bake::Mesh;
-using test::Reference;
+using Reference = bake::EmbreeReference;
+using test::bakeShape;
+using test::BakedShape;
+using test::Rng;
 
 Vec3 add(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 Vec3 sub(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
@@ -30,51 +29,6 @@ Vec3 mul(Vec3 a, float s) { return {a.x * s, a.y * s, a.z * s}; }
 float dot3(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 Vec3 unit(Vec3 a) { return mul(a, 1.0f / std::sqrt(dot3(a, a))); }
 Vec3 centerOf(const FieldDesc& f) { return {f.sphere.center[0], f.sphere.center[1], f.sphere.center[2]}; }
-
-struct Rng {
-  std::mt19937_64 g;
-  explicit Rng(uint64_t seed) : g(seed) {}
-  float uniform() { return float(std::uniform_real_distribution<double>(0, 1)(g)); }
-  Vec3 direction() {
-    const float z = 2 * uniform() - 1, phi = 6.2831853f * uniform();
-    const float r = std::sqrt(std::max(0.0f, 1 - z * z));
-    return {r * std::cos(phi), r * std::sin(phi), z};
-  }
-  // Cosine-weighted direction around n.
-  Vec3 cosine(Vec3 n) {
-    const float u = uniform(), phi = 6.2831853f * uniform();
-    const float r = std::sqrt(u);
-    const Frame f = frameFromNormal(n);
-    return toWorld(f, {r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1 - u))});
-  }
-};
-
-// A baked field kept alive together with its query.
-struct Baked {
-  Mesh mesh;
-  BakedField field;
-  FieldQuery query;
-};
-
-std::unique_ptr<Baked> bakeShape(const std::string& shape, uint32_t n, uint32_t m, bool normals = false,
-                                 DistanceEncoding e = DistanceEncoding::kUnorm8Diameter) {
-  auto b = std::make_unique<Baked>();
-  b->mesh = bake::makeShape(shape);
-  auto scene = bake::Scene::create(b->mesh);
-  EXPECT_TRUE(scene.ok());
-  BakeOptions o;
-  o.positionParam = n;
-  o.mapResolution = m;
-  o.encoding = e;
-  o.normals = normals;
-  auto baked = bake::bakeField(*scene, o);
-  EXPECT_TRUE(baked.ok()) << baked.error().toString();
-  b->field = std::move(*baked);
-  auto q = FieldQuery::fromMaps(b->field.field, b->field.distance, b->field.normals);
-  EXPECT_TRUE(q.ok()) << q.error().toString();
-  b->query = std::move(*q);
-  return b;
-}
 
 // ---- The lookup of spec/geometry.md 7.2, texel by texel -----------------------------------------
 
@@ -126,7 +80,7 @@ struct RayStats {
   }
 };
 
-RayStats interObject(const Baked& b, Reconstruction mode, uint32_t count, uint64_t seed) {
+RayStats interObject(const BakedShape& b, Reconstruction mode, uint32_t count, uint64_t seed) {
   const FieldDesc& f = b.field.field;
   const float R = f.sphere.radius;
   const Vec3 c = centerOf(f);
@@ -174,7 +128,7 @@ struct AoResult {
 
 // AO of a grid of points on the plane under the object (tangent to the mesh's lowest point), with
 // `raysPerPoint` cosine-weighted rays of length `reach` * R. Errors on the 8-bit scale.
-AoResult groundAo(const Baked& b, uint32_t grid, uint32_t raysPerPoint, float reach) {
+AoResult groundAo(const BakedShape& b, uint32_t grid, uint32_t raysPerPoint, float reach) {
   const FieldDesc& f = b.field.field;
   const float R = f.sphere.radius;
   const Vec3 c = centerOf(f);
@@ -237,7 +191,7 @@ struct IntraStats {
 
 // Rays from points on the surface (triangle centroids, offset along the outward-facing side the
 // ray leaves by) in cosine directions around the face normal.
-IntraStats intraObject(const Baked& b, Reconstruction mode, uint32_t faces, uint32_t raysPerFace) {
+IntraStats intraObject(const BakedShape& b, Reconstruction mode, uint32_t faces, uint32_t raysPerFace) {
   const float R = b.field.field.sphere.radius;
   Reference ref(b.mesh);
   QueryOptions o;

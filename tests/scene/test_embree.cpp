@@ -6,55 +6,20 @@
 #include <cmath>
 #include <cstring>
 #include <memory>
-#include <random>
 #include <vector>
 
-#include "vff/bake/baker.h"
-#include "vff/bake/procedural.h"
+#include "common/baked_shape.h"
+#include "common/rng.h"
 #include "vff/embree.h"
 #include "vff/vff.h"
 
 namespace vff {
 namespace {
 
-struct Baked {
-  bake::BakedField field;
-  FieldQuery query;
-};
+using test::Rng;
 
-const std::vector<std::unique_ptr<Baked>>& fields() {
-  static const auto* f = [] {
-    auto* v = new std::vector<std::unique_ptr<Baked>>;
-    for (const char* shape : {"torus-knot", "bowl"}) {
-      auto b = std::make_unique<Baked>();
-      auto scene = bake::Scene::create(bake::makeShape(shape));
-      bake::BakeOptions o;
-      o.positionParam = 8;
-      o.mapResolution = 16;
-      o.normals = true;
-      b->field = bake::bakeField(*scene, o).value();
-      b->query = FieldQuery::fromMaps(b->field.field, b->field.distance, b->field.normals).value();
-      v->push_back(std::move(b));
-    }
-    return v;
-  }();
-  return *f;
-}
-
-struct Rng {
-  std::mt19937_64 g;
-  explicit Rng(uint64_t seed) : g(seed) {}
-  float uniform(float a = 0, float b = 1) { return a + (b - a) * float(std::uniform_real_distribution<double>(0, 1)(g)); }
-  Vec3 direction() {
-    const float z = uniform(-1, 1), phi = uniform(0, 6.2831853f);
-    const float r = std::sqrt(std::max(0.0f, 1 - z * z));
-    return {r * std::cos(phi), r * std::sin(phi), z};
-  }
-  Vec3 point(float e) { return {uniform(-e, e), uniform(-e, e), uniform(-e, e)}; }
-  RigidTransform transform(float e) {
-    return RigidTransform::fromAxisAngle(direction(), uniform(0, 6.2831853f), point(e), uniform(0.4f, 1.4f));
-  }
-};
+// The two fields of every test, both with normals.
+const std::vector<std::unique_ptr<test::BakedShape>>& fields() { return test::knotAndBowl(true); }
 
 uint32_t bits(float f) {
   uint32_t u;
@@ -171,7 +136,7 @@ TEST(SceneEmbree, FieldGeometryGivesTheSceneHits) {
   EmbreeWorld w;
   Scene scene;
   for (uint32_t i = 0; i < 60; ++i) {
-    const RigidTransform x = rng.transform(4.0f);
+    const RigidTransform x = rng.transform(4.0f, 0.4f, 1.4f);
     ASSERT_TRUE(scene.add(&fields()[i % 2]->query, x).ok());
     auto g = embree::FieldGeometry::attach(w.device, w.scene, &fields()[i % 2]->query, x, {}, i);
     ASSERT_TRUE(g.ok()) << g.error().toString();
@@ -184,7 +149,7 @@ TEST(SceneEmbree, FieldGeometryGivesTheSceneHits) {
   EXPECT_GT(compare(w.scene, nullptr, scene, rays), 200u);
   // The next frame: every instance moves.
   for (uint32_t i = 0; i < 60; ++i) {
-    const RigidTransform x = rng.transform(4.0f);
+    const RigidTransform x = rng.transform(4.0f, 0.4f, 1.4f);
     ASSERT_TRUE(scene.setTransform(i, x).ok());
     ASSERT_TRUE(w.geometries[i].setTransform(x).ok());
   }
@@ -202,7 +167,7 @@ TEST(SceneEmbree, MixedWithTrianglesGivesTheNearerOfBoth) {
   addGround(w.device, w.scene);
   Scene scene;
   for (uint32_t i = 0; i < 20; ++i) {
-    const RigidTransform x = rng.transform(3.0f);
+    const RigidTransform x = rng.transform(3.0f, 0.4f, 1.4f);
     ASSERT_TRUE(scene.add(&fields()[i % 2]->query, x).ok());
     w.geometries.push_back(embree::FieldGeometry::attach(w.device, w.scene, &fields()[i % 2]->query, x, {}, i).value());
   }

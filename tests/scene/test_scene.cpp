@@ -6,70 +6,24 @@
 #include <cmath>
 #include <cstring>
 #include <memory>
-#include <random>
 #include <vector>
 
-#include "vff/bake/baker.h"
-#include "vff/bake/procedural.h"
+#include "common/baked_shape.h"
+#include "common/rng.h"
 #include "vff/vff.h"
 
 namespace vff {
 namespace {
 
-struct Baked {
-  bake::BakedField field;
-  FieldQuery query;
-};
+using test::Rng;
 
-std::unique_ptr<Baked> bakeShape(const std::string& shape, bool normals) {
-  auto b = std::make_unique<Baked>();
-  auto scene = bake::Scene::create(bake::makeShape(shape));
-  EXPECT_TRUE(scene.ok());
-  bake::BakeOptions o;
-  o.positionParam = 8;
-  o.mapResolution = 16;
-  o.normals = normals;
-  auto baked = bake::bakeField(*scene, o);
-  EXPECT_TRUE(baked.ok()) << baked.error().toString();
-  b->field = std::move(*baked);
-  auto q = FieldQuery::fromMaps(b->field.field, b->field.distance, b->field.normals);
-  EXPECT_TRUE(q.ok()) << q.error().toString();
-  b->query = std::move(*q);
-  return b;
-}
-
-// Two fields baked once for all tests.
-const std::vector<std::unique_ptr<Baked>>& fields() {
-  static const auto* f = [] {
-    auto* v = new std::vector<std::unique_ptr<Baked>>;
-    v->push_back(bakeShape("torus-knot", true));
-    v->push_back(bakeShape("bowl", false));
-    return v;
-  }();
-  return *f;
-}
-
-struct Rng {
-  std::mt19937_64 g;
-  explicit Rng(uint64_t seed) : g(seed) {}
-  float uniform(float a = 0, float b = 1) { return a + (b - a) * float(std::uniform_real_distribution<double>(0, 1)(g)); }
-  Vec3 direction() {
-    const float z = uniform(-1, 1), phi = uniform(0, 6.2831853f);
-    const float r = std::sqrt(std::max(0.0f, 1 - z * z));
-    return {r * std::cos(phi), r * std::sin(phi), z};
-  }
-  Vec3 point(float extent) { return {uniform(-extent, extent), uniform(-extent, extent), uniform(-extent, extent)}; }
-};
-
-RigidTransform randomTransform(Rng& rng, float extent) {
-  return RigidTransform::fromAxisAngle(rng.direction(), rng.uniform(0, 6.2831853f), rng.point(extent),
-                                       rng.uniform(0.3f, 1.5f));
-}
+// The two fields of every test: the torus knot with normals, the bowl without.
+const std::vector<std::unique_ptr<test::BakedShape>>& fields() { return test::knotAndBowl(false); }
 
 // n instances of the two fields, placed at random within extent (close enough to overlap).
 std::vector<Instance> randomInstances(Rng& rng, size_t n, float extent) {
   std::vector<Instance> v;
-  for (size_t i = 0; i < n; ++i) v.push_back(Instance{&fields()[i % 2]->query, randomTransform(rng, extent)});
+  for (size_t i = 0; i < n; ++i) v.push_back(Instance{&fields()[i % 2]->query, rng.transform(extent, 0.3f, 1.5f)});
   return v;
 }
 
@@ -242,7 +196,7 @@ TEST(Scene, TransformsUpdatedBetweenFrames) {
   for (int frame = 0; frame < 3; ++frame) {
     for (uint32_t i = 0; i < v.size(); ++i) {
       if ((i + frame) % 2) continue;  // half of them move each frame
-      v[i].transform = randomTransform(rng, 6.0f);
+      v[i].transform = rng.transform(6.0f, 0.3f, 1.5f);
       ASSERT_TRUE(s.setTransform(i, v[i].transform).ok());
     }
     EXPECT_FALSE(s.committed());

@@ -1,4 +1,4 @@
-// The scene hierarchy's batch traversal (libvff/src/scene_bvh.h): Bvh4::collect finds for each
+// The scene hierarchy's batch traversal (libvff/src/scene/scene_bvh.h): Bvh4::collect finds for each
 // ray of a batch exactly the leaves the one-ray walk visits; its AVX-512 node step gives the same
 // lists, entry for entry, as the scalar step it is written from; BoxRays hold each ray as boxRay
 // makes it. On random boxes and rays, with the awkward ones among them: zero, negative-zero and
@@ -12,7 +12,7 @@
 #include <random>
 #include <vector>
 
-#include "../../libvff/src/scene_bvh.h"  // private: the traversal under test
+#include "scene/scene_bvh.h"  // private: the traversal under test
 #include "vff/vff.h"
 
 namespace vff::detail {

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <random>
 
-#include "../unit/test_util.h"
+#include "common/synthetic_field.h"
 #include "vff/vff.h"
 
 namespace vff {

@@ -1,4 +1,4 @@
-// test_sdf.cpp - the signed-distance-field peer of the experiments (samples/experiments/sdf_field.h)
+// test_sdf.cpp - the signed-distance-field peer of the experiments (sdf/, vff/sdf/sdf_field.h)
 // against exact casts: sphere tracing hits where Embree does, within a tolerance in voxels; rays
 // that pass clear of the surface miss; the memory budget holds; the cone estimate and the
 // placement do what sdf_field.h says. The comparison in vff-experiments is only as fair as this
@@ -9,8 +9,8 @@
 #include <cmath>
 #include <random>
 
-#include "embree_reference.h"
-#include "sdf_field.h"
+#include "vff/bake/embree_reference.h"
+#include "vff/sdf/sdf_field.h"
 #include "vff/bake/procedural.h"
 
 namespace {
@@ -73,7 +73,7 @@ Vec3 randomUnit(std::mt19937& rng) {
 
 // True when a ray moved sideways by `tol` (four ways) misses the mesh: the ray passes within tol of
 // an edge or a silhouette, where the sampled distance rounds the shape off by up to a voxel.
-bool nearSilhouette(const vff::test::Reference& exact, Vec3 origin, Vec3 dir, float tol) {
+bool nearSilhouette(const vff::bake::EmbreeReference& exact, Vec3 origin, Vec3 dir, float tol) {
   const Vec3 a = unit(cross(dir, std::fabs(dir.x) < 0.9f * len(dir) ? Vec3{1, 0, 0} : Vec3{0, 1, 0}));
   const Vec3 b = unit(cross(dir, a));
   for (Vec3 side : {a, scale(a, -1), b, scale(b, -1)})
@@ -89,7 +89,7 @@ bool nearSilhouette(const vff::test::Reference& exact, Vec3 origin, Vec3 dir, fl
 // miss unless the tracer's hit point is within tolerance of the surface (a ray grazing an edge).
 // Returns the failures, printing the first few.
 int checkAgainstExact(const vff::bake::Mesh& m, const SdfField& sdf, float tolVoxels, int rays) {
-  vff::test::Reference exact(m);
+  vff::bake::EmbreeReference exact(m);
   Vec3 lo{INFINITY, INFINITY, INFINITY}, hi = scale(lo, -1);
   for (size_t i = 0; i < m.vertexCount(); ++i) {
     const Vec3 p{m.positions[3 * i], m.positions[3 * i + 1], m.positions[3 * i + 2]};

@@ -1,7 +1,7 @@
 // positions_reference.h - what the positional-sample tests (test_positions.cpp,
-// test_position_lookup.cpp) check the library against: binary64 vector helpers, a portable random
-// sequence, the exact nearest samples by an accelerated brute force, and the agreement of a lookup
-// with them on random and adversarial (near-tie) queries.
+// test_position_lookup.cpp) check the library against: binary64 vector helpers, the exact nearest
+// samples by an accelerated brute force, and the agreement of a lookup with them on random (the
+// SplitMix64 sequence of tests/common/rng.h) and adversarial (near-tie) queries.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "common/rng.h"
 #include "vff/vff.h"
 
 namespace vff::test {
@@ -37,9 +38,6 @@ inline uint32_t scaled(uint32_t queries) {
 
 // ---- Helpers -----------------------------------------------------------------------------------
 
-struct D3 {
-  double x = 0, y = 0, z = 0;
-};
 inline D3 toD(Vec3 v) {
   return {v.x, v.y, v.z};
 }
@@ -59,23 +57,6 @@ inline D3 normalized(D3 a) {
   const double l = std::sqrt(dot(a, a));
   return {a.x / l, a.y / l, a.z / l};
 }
-
-// SplitMix64: a fixed, portable random sequence.
-struct Rng {
-  uint64_t s;
-  uint64_t next() {
-    uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  }
-  double uniform() { return double(next() >> 11) * 0x1p-53; }  // [0, 1)
-  D3 direction() {                                             // uniform on the sphere
-    const double z = 2.0 * uniform() - 1.0, phi = 6.283185307179586 * uniform();
-    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-    return {r * std::cos(phi), r * std::sin(phi), z};
-  }
-};
 
 // The exact nearest samples (largest dot product with the binary32 positions, ties to the smallest
 // index): a uniform 3D grid over [-1, 1]^3, searched in growing shells of cells until no unsearched
@@ -194,7 +175,7 @@ struct Measured {
 template <class Lookup>
 inline Measured measure(const ExactNearest& ref, Lookup&& lookup, uint32_t queries, uint64_t seed) {
   Measured m;
-  Rng rng{seed};
+  SplitMix64 rng{seed};
   for (uint32_t k = 0; k < queries; ++k) {
     const D3 q = rng.direction();
     check(ref, lookup, q, &m.random);

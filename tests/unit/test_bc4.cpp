@@ -8,7 +8,7 @@
 #include <cmath>
 #include <vector>
 
-#include "test_util.h"
+#include "common/synthetic_field.h"
 #include "vff/vff.h"
 
 namespace vff {

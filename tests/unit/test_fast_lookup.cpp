@@ -1,6 +1,6 @@
 // The query's fast paths against their references: the binary32 octa-hemi2 nearest sample and the
-// atan2-free texel mapping (libvff/src/fast_lookup.h), and the group kernel behind the batch
-// functions (libvff/src/query_group_kernel.h), which must answer every ray exactly as a lookup
+// atan2-free texel mapping (libvff/src/query/fast_lookup.h), and the group kernel behind the batch
+// functions (libvff/src/query/batch/query_group_kernel.h), which must answer every ray exactly as a lookup
 // written here from the reference functions does.
 #include <gtest/gtest.h>
 
@@ -13,9 +13,9 @@
 #include <random>
 #include <vector>
 
-#include "../../libvff/src/fast_lookup.h"  // private: the fast paths against their references
-#include "../../libvff/src/query_group.h"  // private: choose the group kernel under test
-#include "test_util.h"
+#include "query/fast_lookup.h"  // private: the fast paths against their references
+#include "query/batch/query_group.h"  // private: choose the group kernel under test
+#include "common/synthetic_field.h"
 #include "vff/vff.h"
 
 namespace vff {

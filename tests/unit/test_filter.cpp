@@ -9,8 +9,8 @@
 #include <random>
 #include <vector>
 
-#include "../../libvff/src/filter.h"  // private: the decoder's fast path against its scalar reference
-#include "test_util.h"
+#include "codec/filter.h"  // private: the decoder's fast path against its scalar reference
+#include "common/synthetic_field.h"
 #include "vff/vff.h"
 
 namespace vff {

@@ -1,11 +1,11 @@
-// The META text check (libvff/src/json_text.h): spec/format.md section 9 and rule 8001 decide
+// The META text check (libvff/src/container/json_text.h): spec/format.md section 9 and rule 8001 decide
 // each case below.
 #include <gtest/gtest.h>
 
 #include <string>
 
-#include "../../libvff/src/json_text.h"  // private: the META check behind rule 8001
-#include "test_util.h"
+#include "container/json_text.h"  // private: the META check behind rule 8001
+#include "common/synthetic_field.h"
 #include "vff/vff.h"
 
 namespace vff::detail {

@@ -1,4 +1,4 @@
-// The group kernel's per-lane maths (libvff/src/kernel_math.h) against the one-ray steps they
+// The group kernel's per-lane maths (libvff/src/query/batch/kernel_math.h) against the one-ray steps they
 // mirror, bit for bit: each lane of the SSE2 lane type (every x86-64 CPU runs it) must give
 // exactly what hemisphereToSquareFast, frameFromNormal + toLocal and decodeNormal give, so that a
 // change to either side that lets them drift apart fails here, not only in the batch tests.
@@ -13,8 +13,8 @@
 #include "vff/vff.h"
 
 #if defined(__SSE2__) && (defined(__x86_64__) || defined(_M_X64))
-#include "../../libvff/src/simd/vfloat4_sse2.h"  // private: the lane type under test
-#include "../../libvff/src/kernel_math.h"        // private: the per-lane maths
+#include "query/batch/simd/vfloat4_sse2.h"  // private: the lane type under test
+#include "query/batch/kernel_math.h"        // private: the per-lane maths
 
 using namespace vff;
 

@@ -212,7 +212,7 @@ std::string caseName(const ::testing::TestParamInfo<Case>& info) {
 TEST_P(PositionLookup, RoundTripsEverySample) {
   const Case c = GetParam();
   const PositionSet s = make(c.scheme, c.n);
-  Rng rng{7};
+  SplitMix64 rng{7};
   const double spacing = std::sqrt(4.0 * 3.141592653589793 / s.count());
   for (uint32_t i = 0; i < s.count(); ++i) {
     const Vec3 p = s.position(i);
@@ -307,7 +307,7 @@ TEST(PositionLookupLarge, FibonacciLargestNSpotCheck) {
     const L rho = std::sqrt(L((2 * i + 1) * (2 * n - 2 * i - 1))) / n;
     return std::array<L, 3>{rho * std::cos(ph), rho * std::sin(ph), L(n - 2 * i - 1) / n};
   };
-  Rng rng{3};
+  SplitMix64 rng{3};
   for (int k = 0; k < int(scaled(200)); ++k) {
     const Vec3 q = toF(rng.direction());
     const uint32_t got = fib.nearest(q);

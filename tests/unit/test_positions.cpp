@@ -79,7 +79,7 @@ TEST(PositionSet, CandidatesHoldTheNearestSample) {
   for (auto [sc, n] : {std::pair{PositionScheme::kOctaHemi2, 32u}, std::pair{PositionScheme::kEqualAreaOctaGrid, 65u},
                        std::pair{PositionScheme::kSphericalFibonacci, 4226u}}) {
     const PositionSet s = make(sc, n);
-    Rng rng{42};
+    SplitMix64 rng{42};
     for (int k = 0; k < 20000; ++k) {
       const Vec3 d = toF(rng.direction());
       uint32_t c[PositionSet::kMaxCandidates];
@@ -257,7 +257,7 @@ TEST(PositionEaOctaGrid, NearestRegionsHaveNearlyEqualArea) {
   const uint32_t n = 16;
   const PositionSet s = make(PositionScheme::kEqualAreaOctaGrid, n);
   std::vector<uint32_t> hits(s.count(), 0);
-  Rng rng{42};
+  SplitMix64 rng{42};
   const uint32_t q = 256 * s.count();
   for (uint32_t k = 0; k < q; ++k) ++hits[s.nearest(toF(rng.direction()))];
   const auto [lo, hi] = std::minmax_element(hits.begin(), hits.end());

@@ -3,7 +3,7 @@
 #include <cstring>
 #include <tuple>
 
-#include "test_util.h"
+#include "common/synthetic_field.h"
 #include "vff/vff.h"
 
 namespace vff {

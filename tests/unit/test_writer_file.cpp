@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "test_util.h"
+#include "common/synthetic_field.h"
 #include "vff/vff.h"
 
 namespace vff {

@@ -1,7 +1,7 @@
 // cli.h - what every vff-* command-line tool shares: exit codes, diagnostics, --version, --format,
 // reading "-" from stdin and writing output files atomically.
 //
-// Conventions (KTX-Software style, see STYLE.md):
+// Conventions (in the manner of KTX-Software's tools):
 //   - data goes to stdout, diagnostics to stderr;
 //   - a diagnostic reads "vff-inspect: error: file.vff@0x40 [DIST]: header-checksum (3005): message";
 //   - every tool returns one of the documented exit codes below and prints exitCodeHelp() in --help;

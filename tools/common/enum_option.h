@@ -1,7 +1,7 @@
 // enum_option.h - one command-line option that takes a spelling of a libvff enum (spelling.h), and
 // the choice every option group makes about the values of its options left unset.
 //
-//   vff::cli::EnumOption<vff::Codec> codec{"--codec", vff::cli::kCodecs, vff::Codec::kStored};
+//   vff::cli::EnumOption<vff::Codec> codec{"--codec", vff::vff::kCodecs, vff::Codec::kStored};
 //   codec.add(app, "block codec")->capture_default_str();   // --help: TEXT:{stored,zstd} [stored]
 //   ... after vff::cli::parse():  w.codec = codec.value();
 #pragma once
@@ -11,7 +11,7 @@
 #include <string>
 #include <utility>
 
-#include "spelling.h"
+#include "vff/spelling.h"
 
 namespace vff::cli {
 

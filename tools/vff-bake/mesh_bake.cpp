@@ -6,10 +6,10 @@
 #include <cmath>
 #include <cstdio>
 #include <optional>
-#include <thread>
 
 #include "bake.h"
 #include "cli.h"
+#include "platform/parallel.h"
 #include "vff/bake/mesh.h"
 
 namespace vff::bake_tool {
@@ -65,7 +65,7 @@ void printBenchmark(const Options& o, const bake::Mesh& mesh, const FieldDesc& f
                     double payloadMiB, double meshMiB, double bvhMiB) {
   std::printf("mesh            %s: %zu triangles\n", o.mesh.c_str(), mesh.triangleCount());
   std::printf("rays            %u maps x %ux%u = %.0f rays, %u threads\n", field.mapCount, field.mapResolution,
-              field.mapResolution, rays, o.threads ? o.threads : std::thread::hardware_concurrency());
+              field.mapResolution, rays, parallel::resolveThreads(o.threads));
   std::printf("embree raw      %8.3f s  %7.2f Mrays/s   (rtcIntersect16, same rays, nothing stored)\n", m.raw,
               rays / m.raw / 1e6);
   std::printf("bake            %8.3f s  %7.2f Mrays/s   (trace + encode%s)\n", m.bake, rays / m.bake / 1e6,

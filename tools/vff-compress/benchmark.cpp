@@ -16,12 +16,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
-#include <thread>
 #include <unistd.h>
 
 #include "cli.h"
 #include "compress.h"
 #include "convert.h"
+#include "platform/parallel.h"
 
 namespace vff::compress {
 
@@ -86,7 +86,7 @@ Row ours(const File& src, const std::vector<uint8_t>& dist, uint32_t g, int repe
   r.codec = "vff zstd-19 + hits-med, G " + std::to_string(pi.mapsPerBlock) + " (" + std::to_string(pi.blocks.size()) +
             " blocks)";
   r.note = std::to_string(filtered) + " of " + std::to_string(pi.blocks.size()) + " blocks filtered; compress on " +
-           std::to_string(std::max(1u, std::thread::hardware_concurrency())) + " threads";
+           std::to_string(parallel::resolveThreads(w.threads)) + " threads";
   return r;
 }
 

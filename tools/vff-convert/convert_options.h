@@ -24,12 +24,12 @@ struct Options {
   cli::OptionsCodec codec;    // --to vff: the input's unless given
   unsigned threads = 0;
   // Conversions that change the maps (resample.h).
-  cli::EnumOption<DistanceEncoding> encoding{"--encoding", cli::kDistanceEncodings};
-  cli::EnumOption<PositionScheme> positions{"--positions", cli::kPositionSchemes};
+  cli::EnumOption<DistanceEncoding> encoding{"--encoding", vff::kDistanceEncodings};
+  cli::EnumOption<PositionScheme> positions{"--positions", vff::kPositionSchemes};
   cli::EnumOption<DownsampleRule> downsample{
-      "--downsample", cli::Spellings<DownsampleRule>{DownsampleRule::kMin, DownsampleRule::kTent, downsampleRuleName}};
+      "--downsample", vff::Spellings<DownsampleRule>{DownsampleRule::kMin, DownsampleRule::kTent, downsampleRuleName}};
   cli::EnumOption<PositionResample> resample{
-      "--resample", cli::Spellings<PositionResample>{PositionResample::kNearest, PositionResample::kInterpolated,
+      "--resample", vff::Spellings<PositionResample>{PositionResample::kNearest, PositionResample::kInterpolated,
                                                      positionResampleName}};
   std::optional<uint32_t> mapSize, count;
 

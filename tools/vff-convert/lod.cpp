@@ -2,15 +2,14 @@
 // (stage 2), computed from a larger field, and the driver of the three stages (resample.h).
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cmath>
 #include <limits>
 #include <new>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
+#include "platform/parallel.h"
 #include "resample.h"
 
 namespace vff::convert {
@@ -390,20 +389,24 @@ Result<FieldData> resampleField(const FieldData& src, const ResampleOptions& o, 
     accountBc4Errors(nf, {map, nBytes}, exact, &stats);
   };
 
-  unsigned threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
-  threads = std::min<unsigned>(threads, std::max<uint32_t>(1, nf.mapCount));
-  std::atomic<uint32_t> next{0};
-  std::vector<EncodeStats> stats(threads);
-  auto worker = [&](unsigned w) {
-    std::vector<Value> plane(size_t(m) * m);  // stage 1 of one map, at the source resolution
-    std::vector<uint8_t> codes(bc4 ? size_t(nm) * nm : 0);
-    std::vector<float> exact(codes.size());
-    for (uint32_t k; (k = next.fetch_add(1)) < nf.mapCount;) doMap(k, plane, codes, exact, stats[w]);
+  // One map per chunk, each map's statistics apart and merged in map order, so that the report does
+  // not depend on the thread count any more than the maps do; each worker its own scratch planes.
+  struct Scratch {
+    std::vector<Value> plane;  // stage 1 of one map, at the source resolution
+    std::vector<uint8_t> codes;
+    std::vector<float> exact;
   };
-  std::vector<std::thread> pool;
-  for (unsigned w = 1; w < threads; ++w) pool.emplace_back(worker, w);
-  worker(0);
-  for (std::thread& t : pool) t.join();
+  std::vector<EncodeStats> stats(nf.mapCount);
+  std::vector<Scratch> scratch(parallel::workerCount(nf.mapCount, 1, o.threads));
+  parallel::parallelForWorkers(nf.mapCount, 1, o.threads, [&](unsigned w, size_t begin, size_t end) {
+    Scratch& s = scratch[w];
+    if (s.plane.empty()) {
+      s.plane.resize(size_t(m) * m);
+      s.codes.resize(bc4 ? size_t(nm) * nm : 0);
+      s.exact.resize(s.codes.size());
+    }
+    for (size_t k = begin; k < end; ++k) doMap(uint32_t(k), s.plane, s.codes, s.exact, stats[k]);
+  });
   EncodeStats all;
   for (const EncodeStats& s : stats) all.merge(s);
 

@@ -14,11 +14,11 @@
 #include <algorithm>
 #include <cstdio>
 #include <optional>
-#include <thread>
 
 #include "cli.h"
 #include "convert.h"
 #include "convert_options.h"
+#include "platform/parallel.h"
 #include "resample.h"
 #include "vdb.h"
 #include "vff/vff.h"
@@ -227,8 +227,7 @@ int main(int argc, char** argv) {
   }
 
   // OpenEXR's worker threads (de)compress the scanline blocks; a tool may set this process-wide.
-  Imf::setGlobalThreadCount(
-      static_cast<int>(o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency())));
+  Imf::setGlobalThreadCount(static_cast<int>(vff::parallel::resolveThreads(o.threads)));
 
   FieldData d;
   const char* inputKind = "vff";

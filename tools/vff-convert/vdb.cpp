@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "cli.h"
+#include "vff/bake/exception_text.h"
 
 namespace vff::convert {
 namespace {
@@ -79,19 +80,8 @@ class MemoryArchive : public openvdb::io::Archive {
   }
 };
 
-// An OpenVDB exception's text for a message: on a damaged file it can hold bytes read from the
-// file (an unterminated name, say), so keep printable ASCII, collapse blanks, and cut it short.
-std::string exceptionText(const std::exception& e) {
-  std::string out;
-  for (const char* c = e.what(); *c && out.size() < 200; ++c) {
-    const unsigned char u = static_cast<unsigned char>(*c);
-    const char ch = u >= 0x20 && u < 0x7f ? *c : ' ';
-    if (ch == ' ' && (out.empty() || out.back() == ' ')) continue;
-    out += ch;
-  }
-  while (!out.empty() && out.back() == ' ') out.pop_back();
-  return out;
-}
+// What an OpenVDB exception says, fit for a message (shared with the baker's level-set input).
+using bake::exceptionText;
 
 bool isUuidText(const std::string& s, size_t at) {
   if (s.size() < at + kUuidLength) return false;

@@ -12,13 +12,13 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <thread>
 
 #include <nlohmann/json.hpp>
 
-#include "../vff-bake/bake.h"
+#include "bake_job.h"
 #include "cli.h"
 #include "library.h"
+#include "platform/parallel.h"
 #include "vff/bake/mesh.h"
 #include "vff/version.h"
 
@@ -253,15 +253,9 @@ std::string hostName() {
 }  // namespace
 
 void computeKeys(std::vector<Entry>& entries, const CacheOptions& o) {
-  std::atomic<size_t> next{0};
-  auto work = [&] {
-    for (size_t i; (i = next++) < entries.size();) computeKey(entries[i], o);
-  };
-  std::vector<std::thread> pool;
-  const unsigned n = std::max(1u, std::min<unsigned>(o.threads, unsigned(entries.size())));
-  for (unsigned t = 1; t < n; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
+  parallel::parallelFor(entries.size(), 1, std::max(1u, o.threads), [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) computeKey(entries[i], o);
+  });
 }
 
 std::string cachePath(const std::string& cacheDir, const std::string& key) {

@@ -16,10 +16,10 @@
 #include <filesystem>
 #include <map>
 #include <set>
-#include <thread>
 
 #include "cli.h"
 #include "library.h"
+#include "platform/parallel.h"
 
 namespace fs = std::filesystem;
 using namespace vff;
@@ -112,7 +112,7 @@ int bakeLibrary(const Options& o) {
       return cli::kExitUsage;
     }
 
-  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const unsigned cores = parallel::resolveThreads(0);
   WorkerOptions wo;
   wo.vffBake = findVffBake();
   wo.cacheDir = fs::absolute(o.cache.empty() ? o.out + "/.vff-cache" : o.cache).lexically_normal().string();

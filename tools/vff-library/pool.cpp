@@ -1,12 +1,13 @@
 // pool.cpp - the local pool: a few vff-bake processes at a time, each entry installed at its
-// output as soon as its field is in the cache.
+// output as soon as its field is in the cache. Each worker thread (platform/parallel.h, one unit
+// per chunk) runs one vff-bake at a time and waits for it.
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
-#include <mutex>
-#include <thread>
 
 #include "library.h"
+#include "platform/parallel.h"
 #include "progress.h"
 
 namespace vff::library {
@@ -19,14 +20,15 @@ uint64_t unitRays(const std::vector<Entry>& entries, const Unit& u) {
 std::vector<EntryOutcome> runPool(const std::vector<Entry>& entries, const std::vector<Unit>& todo,
                                   const WorkerOptions& wo, const PoolOptions& po) {
   std::vector<EntryOutcome> outcomes(todo.size());
-  std::atomic<size_t> next{0}, done{0};
+  std::atomic<size_t> done{0};
   cli::Progress progress(kProg, po.progress, 0, "entries");
   // The largest bakes first, so that the last one to start is a small one.
   std::vector<Unit> order(todo);
   std::stable_sort(order.begin(), order.end(),
                    [&](const Unit& a, const Unit& b) { return unitRays(entries, a) > unitRays(entries, b); });
-  auto work = [&] {
-    for (size_t i; (i = next++) < order.size();) {
+  // Each outcome at its unit's place in `order`, whichever worker baked it.
+  parallel::parallelFor(order.size(), 1, std::max(1u, po.workers), [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
       const Entry& e = entries[order[i].entry];
       EntryOutcome& out = outcomes[i];
       out.entry = order[i].entry;
@@ -41,11 +43,7 @@ std::vector<EntryOutcome> runPool(const std::vector<Entry>& entries, const std::
         }
       progress.update(++done, order.size());
     }
-  };
-  std::vector<std::thread> pool;
-  const unsigned n = std::max(1u, std::min<unsigned>(po.workers, unsigned(order.size())));
-  for (unsigned t = 0; t < n; ++t) pool.emplace_back(work);
-  for (auto& t : pool) t.join();
+  });
   return outcomes;
 }
 

@@ -21,12 +21,12 @@
 #include <cstdio>
 #include <cstring>
 #include <new>
-#include <thread>
 #include <utility>
 
 #include "cli.h"
 #include "file_bytes.h"
 #include "npy.h"
+#include "platform/parallel.h"
 #include "rays.h"
 #include "vff/vff.h"
 
@@ -205,31 +205,17 @@ struct Target {
   }
 };
 
-// fn(first, count) for the chunks of `size` rays, handed out to `threads` threads (this one too).
-template <class Fn>
-void inChunks(size_t size, unsigned threads, Fn&& fn) {
-  const size_t chunks = (size + kChunk - 1) / kChunk;
-  std::atomic<size_t> next{0};
-  auto work = [&] {
-    for (size_t c; (c = next.fetch_add(1)) < chunks;) fn(c * kChunk, std::min(kChunk, size - c * kChunk));
-  };
-  const unsigned n = std::max(1u, std::min<unsigned>(threads, unsigned(chunks)));
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < n; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
-}
-
-// Answers the rays in chunks over `threads` threads; each chunk's answers go to store(first,
-// answers) from the thread that made them (the sites and visibilities only where `columns` have
-// them). A chunk holding a bad .npy row is not answered; the index of the first bad row is
-// returned.
+// Answers the rays in chunks of kChunk over `threads` threads (platform/parallel.h); each chunk's
+// answers go to store(first, answers) from the thread that made them (the sites and visibilities
+// only where `columns` have them). A chunk holding a bad .npy row is not answered; the index of the
+// first bad row is returned.
 template <class Store>
 std::optional<size_t> answer(const Target& target, const RaySource& src, const QueryOptions& qo,
                              std::span<const Column> columns, unsigned threads, Store store) {
   const bool sites = needsSites(columns), visibility = hasColumn(columns, Column::kVisibility);
   std::atomic<size_t> firstBad{SIZE_MAX};
-  inChunks(src.size, threads, [&](size_t b, size_t n) {
+  parallel::parallelFor(src.size, kChunk, threads, [&](size_t b, size_t e) {
+    const size_t n = e - b;
     thread_local std::vector<Ray> rays;
     thread_local std::vector<QueryHit> hits;
     thread_local std::vector<LookupSite> where;
@@ -251,8 +237,8 @@ std::optional<size_t> answer(const Target& target, const RaySource& src, const Q
   return std::nullopt;
 }
 
-int run(int argc, char** argv) {
-  Options o;
+// The command line into `o`, and the checks between its options; an exit code where the run stops.
+std::optional<int> parseCommandLine(int argc, char** argv, Options& o) {
   CLI::App app{
       "Answers rays with a visibility field: hit, t, point, normal, whether the origin was inside the\n"
       "bounding sphere and which map and texel answered, one line (or .npy row) per ray, in the order given. Rays come from --ray, from\n"
@@ -276,193 +262,276 @@ int run(int argc, char** argv) {
     cli::usageError(kProg, "--tmin is greater than --tmax");
     return cli::kExitUsage;
   }
-  const bool toNpyName = o.output.size() > 4 && o.output.compare(o.output.size() - 4, 4, ".npy") == 0;
-  const OutputFormat format = o.format == "npy" ? OutputFormat::kNpy
-                              : o.format == "jsonl" ? OutputFormat::kJsonLines
-                              : o.format == "csv"   ? OutputFormat::kCsv
-                              : toNpyName           ? OutputFormat::kNpy
-                                                    : OutputFormat::kCsv;
+  return std::nullopt;
+}
 
-  // The field first: a field that cannot be read answers nothing.
-  const auto tOpen = std::chrono::steady_clock::now();
+// --format, or else what the output's name says.
+OutputFormat outputFormat(const Options& o) {
+  const bool toNpyName = o.output.size() > 4 && o.output.compare(o.output.size() - 4, 4, ".npy") == 0;
+  return o.format == "npy"     ? OutputFormat::kNpy
+         : o.format == "jsonl" ? OutputFormat::kJsonLines
+         : o.format == "csv"   ? OutputFormat::kCsv
+         : toNpyName           ? OutputFormat::kNpy
+                               : OutputFormat::kCsv;
+}
+
+ReadOptions readOptions(const Options& o) {
   ReadOptions ro;
   ro.checksums = o.checksums == "none" ? ChecksumPolicy::kNone
                  : o.checksums == "lazy" ? ChecksumPolicy::kLazy
                                          : ChecksumPolicy::kVerifyAll;
-  // Read whole into memory of its own (file_bytes.h), which the File and the query borrow.
+  return ro;
+}
+
+// The field placed by --rotate, --translate and --scale, into *inst (left empty without them); an
+// exit code for a rotation about no axis.
+std::optional<int> placeField(const Options& o, const FieldQuery* q, std::optional<Instance>* inst) {
+  if (o.rotate.empty() && o.translate.empty() && o.scale == 1.0f) return std::nullopt;
+  const Vec3 axis = o.rotate.empty() ? Vec3{0, 0, 1} : Vec3{o.rotate[0], o.rotate[1], o.rotate[2]};
+  if (axis.x == 0 && axis.y == 0 && axis.z == 0) {
+    cli::usageError(kProg, "--rotate needs a non-zero axis");
+    return cli::kExitUsage;
+  }
+  const Vec3 t = o.translate.empty() ? Vec3{} : Vec3{o.translate[0], o.translate[1], o.translate[2]};
+  *inst = Instance{q, RigidTransform::fromAxisAngle(axis, o.rotate.empty() ? 0.0f : o.rotate[3], t, o.scale)};
+  return std::nullopt;
+}
+
+// The rays of a run and what holds them: src reads them in place, from `rays` or from the .npy
+// rows of `input`, so a RayInput stays where it was filled.
+struct RayInput {
+  std::vector<Ray> rays;
+  std::optional<Input> input;
+  RaySource src;
+  std::optional<std::string> badInput;  // the diagnostic of a bad line, printed after the answers
+  std::string label;                    // the input's name in messages
+};
+
+// The --ray options into *rays; an exit code for a bad one.
+std::optional<int> rayArguments(const Options& o, std::vector<Ray>* rays) {
+  for (size_t i = 0; i < o.rays.size(); ++i) {
+    const auto& r = o.rays[i];
+    if (r.size() != 6) {
+      cli::usageError(kProg, "--ray number " + std::to_string(i + 1) + " has " + std::to_string(r.size()) +
+                                 " numbers: it takes 6 (ox oy oz dx dy dz)");
+      return cli::kExitUsage;
+    }
+    Ray ray{{r[0], r[1], r[2]}, {r[3], r[4], r[5]}, o.tmin, o.tmax};
+    if (auto bad = checkRay(ray)) {
+      cli::usageError(kProg, "--ray number " + std::to_string(i + 1) + ": " + bad->first);
+      return cli::kExitUsage;
+    }
+    rays->push_back(ray);
+  }
+  return std::nullopt;
+}
+
+// The rays of --input (or standard input): a .npy matrix, read in place, or text lines, parsed up
+// to the first bad one (whose diagnostic waits in in->badInput). An exit code where none can be read.
+std::optional<int> inputRays(const Options& o, RayInput* in) {
+  const std::string path = o.input.empty() ? "-" : o.input;
+  in->label = path == "-" ? "<stdin>" : path;
+  auto opened = Input::open(path);
+  if (!opened) return cli::reportError(kProg, in->label, opened.error());
+  in->input.emplace(std::move(*opened));
+  const std::span<const uint8_t> bytes = in->input->bytes();
+  if (bytes.size() >= 6 && std::memcmp(bytes.data(), "\x93NUMPY", 6) == 0) {
+    NpyMatrix m;
+    std::optional<std::string> e = readNpyMatrix(bytes, &m);
+    if (!e && m.cols != 6 && m.cols != 8)
+      e = "expected shape (N, 6) or (N, 8), found (" + std::to_string(m.rows) + ", " + std::to_string(m.cols) + ")";
+    if (e) {
+      cli::printError(kProg, in->label + ": " + *e);
+      return cli::kExitInvalidFile;
+    }
+    in->src.rows = m.data.data();
+    in->src.cols = size_t(m.cols);
+    in->src.size = size_t(m.rows);
+    return std::nullopt;
+  }
+  ParsedRays parsed = parseRayLines({reinterpret_cast<const char*>(bytes.data()), bytes.size()}, o.tmin, o.tmax);
+  in->rays = std::move(parsed.rays);
+  if (parsed.error)
+    in->badInput = in->label + ":" + std::to_string(parsed.error->line) + ":" + std::to_string(parsed.error->column) +
+                   ": " + parsed.error->message;
+  return std::nullopt;
+}
+
+// The rays of the run, from --ray or an input, into *in; an exit code where there are none to answer.
+std::optional<int> readRays(const Options& o, RayInput* in) {
+  in->src.tmin = o.tmin, in->src.tmax = o.tmax;
+  if (auto rc = o.rays.empty() ? inputRays(o, in) : rayArguments(o, &in->rays)) return rc;
+  if (!in->src.rows) in->src.rays = in->rays, in->src.size = in->rays.size();
+  return std::nullopt;
+}
+
+// The output's columns: --columns, or the default set; an exit code for a bad list.
+std::optional<int> chooseColumns(const Options& o, OutputFormat format, std::vector<Column>* columns) {
+  *columns = defaultColumns(!o.noSites, o.visibility);
+  if (o.columns.empty()) return std::nullopt;
+  if (auto bad = parseColumns(o.columns, columns)) {
+    cli::usageError(kProg, "--columns: " + *bad);
+    return cli::kExitUsage;
+  }
+  if (format == OutputFormat::kJsonLines) {
+    cli::usageError(kProg, "--columns applies to csv and npy answers (JSON lines name their keys)");
+    return cli::kExitUsage;
+  }
+  return std::nullopt;
+}
+
+// How a run answers: its target, rays, query options, columns and threads.
+struct Run {
+  const Target& target;
+  const RayInput& in;
+  const QueryOptions& qo;
+  std::span<const Column> columns;
+  unsigned threads;
+};
+
+// Answers straight into the .npy output file: each thread formats its chunks' rows and writes them
+// at their offset (no whole copy of the answers is made). An exit code on failure.
+std::optional<int> answerIntoNpyFile(const Run& r, const std::string& output) {
+  auto out = cli::AtomicFile::create(output);
+  if (!out) return cli::reportError(kProg, "", out.error());
+  const size_t cols = r.columns.size();
+  const std::vector<uint8_t> header = npyMatrixHeader(r.in.src.size, cols);
+  std::atomic<bool> failed{false};
+  std::optional<Error> writeError;
+  auto failWith = [&](Status st) {
+    if (!failed.exchange(true)) writeError = st.error();  // (the first failure only)
+  };
+  if (Status st = out->writeAt(0, header); !st) failWith(st);
+  const std::optional<size_t> badRow =
+      answer(r.target, r.in.src, r.qo, r.columns, r.threads, [&](size_t first, const Answers& a) {
+        if (failed) return;
+        thread_local std::vector<float> rowBuffer;
+        rowBuffer.resize(a.hits.size() * cols);
+        answerRows(a, rowBuffer.data());
+        const auto* bytes = reinterpret_cast<const uint8_t*>(rowBuffer.data());
+        if (Status st = out->writeAt(header.size() + first * cols * sizeof(float), {bytes, rowBuffer.size() * sizeof(float)});
+            !st)
+          failWith(st);
+      });
+  if (writeError) return cli::reportError(kProg, "", *writeError);
+  if (badRow) {
+    cli::printError(kProg, r.in.label + ": " + badRowMessage(r.in.src, *badRow));
+    return cli::kExitInvalidFile;
+  }
+  if (Status st = out->commit(); !st) return cli::reportError(kProg, "", st.error());
+  return std::nullopt;
+}
+
+// Answers into memory, then writes them formatted (CSV, JSON lines, or .npy to standard output).
+std::optional<int> answerFormatted(const Run& r, OutputFormat format, const std::string& output) {
+  const RaySource& src = r.in.src;
+  const bool sites = needsSites(r.columns), visibility = hasColumn(r.columns, Column::kVisibility);
+  std::vector<QueryHit> hits(src.size);
+  std::vector<LookupSite> where(sites ? src.size : 0);
+  std::vector<float> vis(visibility ? src.size : 0);
+  const std::optional<size_t> badRow =
+      answer(r.target, src, r.qo, r.columns, r.threads, [&](size_t first, const Answers& a) {
+        std::copy(a.hits.begin(), a.hits.end(), hits.begin() + ptrdiff_t(first));
+        std::copy(a.sites.begin(), a.sites.end(), where.begin() + ptrdiff_t(first));
+        std::copy(a.visibility.begin(), a.visibility.end(), vis.begin() + ptrdiff_t(first));
+      });
+  if (badRow) {
+    cli::printError(kProg, r.in.label + ": " + badRowMessage(src, *badRow));
+    return cli::kExitInvalidFile;
+  }
+  const std::vector<uint8_t> out = formatAnswers({hits, where, vis, r.columns}, format);
+  if (auto st = cli::writeFileAtomic(output, out); !st) return cli::reportError(kProg, "", st.error());
+  return std::nullopt;
+}
+
+using Clock = std::chrono::steady_clock;
+
+// When each stage of a run began, and when it ended.
+struct Stages {
+  Clock::time_point open, read, query, end;
+};
+
+// --timing: the stages' seconds and the end-to-end rate, beside the baselines it compares with, on
+// the same rays already in memory as vff::Ray, warm (best of 3 each), over the same threads in the
+// same chunks: the batch calls as a library caller makes them, every answer kept in an array of all
+// of them; and the batch calls alone, each chunk's answers dropped (a bound no caller reaches: its
+// answers never leave the cache). Intersect only: no lookup sites, no visibility. The field as a
+// library caller (and the Python module) opens it: File::open's mapping, not this tool's copy.
+std::optional<int> printTiming(const Options& o, const Run& r, const std::optional<Instance>& inst, const Stages& at) {
+  auto sec = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
+  const RaySource& src = r.in.src;
+  const double n = double(src.size) / 1e6;
+  auto mappedFile = File::open(o.field, readOptions(o));
+  if (!mappedFile) return cli::reportError(kProg, o.field, mappedFile.error());
+  auto mapped = FieldQuery::fromFile(*mappedFile);
+  if (!mapped) return cli::reportError(kProg, o.field, mapped.error());
+  std::optional<Instance> mappedInstance;
+  if (inst) mappedInstance = Instance{&*mapped, inst->transform};
+  const Target baseline{&*mapped, mappedInstance};
+  std::vector<Ray> held(src.rows ? src.size : 0);
+  for (size_t i = 0; i < held.size(); ++i) held[i] = src.row(i);
+  const std::span<const Ray> warmRays = src.rows ? std::span<const Ray>(held) : src.rays;
+  const RaySource warm{nullptr, 0, warmRays, src.size, o.tmin, o.tmax};
+  std::vector<QueryHit> kept(src.size);
+  const Column hitColumns[] = {Column::kHit, Column::kT};
+  double batch = 1e30, keptBatch = 1e30;
+  for (int k = 0; k < 3; ++k) {
+    auto b0 = Clock::now();
+    parallel::parallelFor(src.size, kChunk, r.threads, [&](size_t first, size_t end) {
+      baseline.intersect(warmRays.subspan(first, end - first), std::span(kept).subspan(first, end - first), r.qo);
+    });
+    keptBatch = std::min(keptBatch, sec(b0, Clock::now()));
+    b0 = Clock::now();
+    answer(baseline, warm, r.qo, hitColumns, r.threads, [](size_t, const Answers&) {});
+    batch = std::min(batch, sec(b0, Clock::now()));
+  }
+  std::fprintf(stderr,
+               "vff-query: timing: %zu rays, %u threads, %s: field %.4f s, read %.4f s, query and write %.4f s, total %.4f s "
+               "(%.1f Mrays/s); batch, answers kept, warm: %.4f s (%.1f Mrays/s); batch alone, warm: %.4f s (%.1f Mrays/s)\n",
+               src.size, r.threads, o.interpolated ? "interpolated" : "nearest", sec(at.open, at.read), sec(at.read, at.query),
+               sec(at.query, at.end), sec(at.open, at.end), n / std::max(1e-9, sec(at.open, at.end)), keptBatch,
+               n / std::max(1e-9, keptBatch), batch, n / std::max(1e-9, batch));
+  return std::nullopt;
+}
+
+int run(int argc, char** argv) {
+  Options o;
+  if (auto rc = parseCommandLine(argc, argv, o)) return *rc;
+  const OutputFormat format = outputFormat(o);
+
+  // The field first: a field that cannot be read answers nothing. Read whole into memory of its
+  // own (file_bytes.h), which the File and the query borrow.
+  Stages at;
+  at.open = Clock::now();
   auto fieldBytes = FileBytes::read(o.field);
   if (!fieldBytes) return cli::reportError(kProg, o.field, fieldBytes.error());
-  auto file = File::openMemory(fieldBytes->bytes(), ro);
+  auto file = File::openMemory(fieldBytes->bytes(), readOptions(o));
   if (!file) return cli::reportError(kProg, o.field, file.error());
   auto q = FieldQuery::fromFile(*file);
   if (!q) return cli::reportError(kProg, o.field, q.error());
   std::optional<Instance> inst;
-  if (!o.rotate.empty() || !o.translate.empty() || o.scale != 1.0f) {
-    const Vec3 axis = o.rotate.empty() ? Vec3{0, 0, 1} : Vec3{o.rotate[0], o.rotate[1], o.rotate[2]};
-    if (axis.x == 0 && axis.y == 0 && axis.z == 0) {
-      cli::usageError(kProg, "--rotate needs a non-zero axis");
-      return cli::kExitUsage;
-    }
-    const Vec3 t = o.translate.empty() ? Vec3{} : Vec3{o.translate[0], o.translate[1], o.translate[2]};
-    inst = Instance{&*q, RigidTransform::fromAxisAngle(axis, o.rotate.empty() ? 0.0f : o.rotate[3], t, o.scale)};
-  }
+  if (auto rc = placeField(o, &*q, &inst)) return *rc;
 
-  // The rays.
-  const auto t0 = std::chrono::steady_clock::now();
-  std::vector<Ray> rays;
-  std::optional<Input> input;  // (the .npy rows are read from it in place)
-  RaySource src{nullptr, 0, {}, 0, o.tmin, o.tmax};
-  std::optional<std::string> badInput;  // the diagnostic of a bad line or array, printed after the answers
-  std::string label;
-  if (!o.rays.empty()) {
-    for (size_t i = 0; i < o.rays.size(); ++i) {
-      const auto& r = o.rays[i];
-      if (r.size() != 6) {
-        cli::usageError(kProg, "--ray number " + std::to_string(i + 1) + " has " + std::to_string(r.size()) +
-                                   " numbers: it takes 6 (ox oy oz dx dy dz)");
-        return cli::kExitUsage;
-      }
-      Ray ray{{r[0], r[1], r[2]}, {r[3], r[4], r[5]}, o.tmin, o.tmax};
-      if (auto bad = checkRay(ray)) {
-        cli::usageError(kProg, "--ray number " + std::to_string(i + 1) + ": " + bad->first);
-        return cli::kExitUsage;
-      }
-      rays.push_back(ray);
-    }
-  } else {
-    const std::string path = o.input.empty() ? "-" : o.input;
-    label = path == "-" ? "<stdin>" : path;
-    auto in = Input::open(path);
-    if (!in) return cli::reportError(kProg, label, in.error());
-    input.emplace(std::move(*in));
-    const std::span<const uint8_t> bytes = input->bytes();
-    if (bytes.size() >= 6 && std::memcmp(bytes.data(), "\x93NUMPY", 6) == 0) {
-      NpyMatrix m;
-      std::optional<std::string> e = readNpyMatrix(bytes, &m);
-      if (!e && m.cols != 6 && m.cols != 8)
-        e = "expected shape (N, 6) or (N, 8), found (" + std::to_string(m.rows) + ", " + std::to_string(m.cols) + ")";
-      if (e) {
-        cli::printError(kProg, label + ": " + *e);
-        return cli::kExitInvalidFile;
-      }
-      src.rows = m.data.data();
-      src.cols = size_t(m.cols);
-      src.size = size_t(m.rows);
-    } else {
-      ParsedRays parsed = parseRayLines({reinterpret_cast<const char*>(bytes.data()), bytes.size()}, o.tmin, o.tmax);
-      rays = std::move(parsed.rays);
-      if (parsed.error)
-        badInput = label + ":" + std::to_string(parsed.error->line) + ":" + std::to_string(parsed.error->column) +
-                   ": " + parsed.error->message;
-    }
-  }
-  if (!src.rows) src.rays = rays, src.size = rays.size();
+  at.read = Clock::now();
+  RayInput in;
+  if (auto rc = readRays(o, &in)) return *rc;
 
   QueryOptions qo;
   qo.reconstruction = o.interpolated ? Reconstruction::kInterpolated : Reconstruction::kNearest;
   qo.intraBias = o.intraBias;
-  const unsigned threads = o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
+  std::vector<Column> columns;
+  if (auto rc = chooseColumns(o, format, &columns)) return *rc;
   const Target target{&*q, inst};
-  std::vector<Column> columns = defaultColumns(!o.noSites, o.visibility);
-  if (!o.columns.empty()) {
-    if (auto bad = parseColumns(o.columns, &columns)) {
-      cli::usageError(kProg, "--columns: " + *bad);
-      return cli::kExitUsage;
-    }
-    if (format == OutputFormat::kJsonLines) {
-      cli::usageError(kProg, "--columns applies to csv and npy answers (JSON lines name their keys)");
-      return cli::kExitUsage;
-    }
-  }
-  const bool sites = needsSites(columns), visibility = hasColumn(columns, Column::kVisibility);
-  const size_t cols = columns.size();
-  const auto t1 = std::chrono::steady_clock::now();
-  std::optional<size_t> badRow;
-  if (format == OutputFormat::kNpy && o.output != "-") {
-    // Straight into the output file: each thread formats its chunks' rows and writes them at their
-    // offset (no whole copy of the answers is made).
-    auto out = cli::AtomicFile::create(o.output);
-    if (!out) return cli::reportError(kProg, "", out.error());
-    const std::vector<uint8_t> header = npyMatrixHeader(src.size, cols);
-    std::atomic<bool> failed{false};
-    std::optional<Error> writeError;
-    auto failWith = [&](Status st) {
-      if (!failed.exchange(true)) writeError = st.error();  // (the first failure only)
-    };
-    if (Status st = out->writeAt(0, header); !st) failWith(st);
-    badRow = answer(target, src, qo, columns, threads, [&](size_t first, const Answers& a) {
-      if (failed) return;
-      thread_local std::vector<float> rowBuffer;
-      rowBuffer.resize(a.hits.size() * cols);
-      answerRows(a, rowBuffer.data());
-      const auto* bytes = reinterpret_cast<const uint8_t*>(rowBuffer.data());
-      if (Status st = out->writeAt(header.size() + first * cols * sizeof(float), {bytes, rowBuffer.size() * sizeof(float)}); !st)
-        failWith(st);
-    });
-    if (writeError) return cli::reportError(kProg, "", *writeError);
-    if (badRow) {
-      cli::printError(kProg, label + ": " + badRowMessage(src, *badRow));
-      return cli::kExitInvalidFile;
-    }
-    if (Status st = out->commit(); !st) return cli::reportError(kProg, "", st.error());
-  } else {
-    std::vector<QueryHit> hits(src.size);
-    std::vector<LookupSite> where(sites ? src.size : 0);
-    std::vector<float> vis(visibility ? src.size : 0);
-    badRow = answer(target, src, qo, columns, threads, [&](size_t first, const Answers& a) {
-      std::copy(a.hits.begin(), a.hits.end(), hits.begin() + ptrdiff_t(first));
-      std::copy(a.sites.begin(), a.sites.end(), where.begin() + ptrdiff_t(first));
-      std::copy(a.visibility.begin(), a.visibility.end(), vis.begin() + ptrdiff_t(first));
-    });
-    if (badRow) {
-      cli::printError(kProg, label + ": " + badRowMessage(src, *badRow));
-      return cli::kExitInvalidFile;
-    }
-    const std::vector<uint8_t> out = formatAnswers({hits, where, vis, columns}, format);
-    if (auto st = cli::writeFileAtomic(o.output, out); !st) return cli::reportError(kProg, "", st.error());
-  }
-  if (o.timing) {
-    const auto t2 = std::chrono::steady_clock::now();
-    auto sec = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
-    const double n = double(src.size) / 1e6;
-    // The baselines the end-to-end rate compares with, on the same rays already in memory as
-    // vff::Ray, warm (best of 3 each), over the same threads in the same chunks: the batch calls
-    // as a library caller makes them, every answer kept in an array of all of them; and the batch
-    // calls alone, each chunk's answers dropped (a bound no caller reaches: its answers never
-    // leave the cache). Intersect only: no lookup sites, no visibility. The field as a library
-    // caller (and the Python module) opens it: File::open's mapping, not this tool's copy.
-    auto mappedFile = File::open(o.field, ro);
-    if (!mappedFile) return cli::reportError(kProg, o.field, mappedFile.error());
-    auto mapped = FieldQuery::fromFile(*mappedFile);
-    if (!mapped) return cli::reportError(kProg, o.field, mapped.error());
-    std::optional<Instance> mappedInstance;
-    if (inst) mappedInstance = Instance{&*mapped, inst->transform};
-    const Target baseline{&*mapped, mappedInstance};
-    std::vector<Ray> held(src.rows ? src.size : 0);
-    for (size_t i = 0; i < held.size(); ++i) held[i] = src.row(i);
-    const std::span<const Ray> warmRays = src.rows ? std::span<const Ray>(held) : src.rays;
-    const RaySource warm{nullptr, 0, warmRays, src.size, o.tmin, o.tmax};
-    std::vector<QueryHit> kept(src.size);
-    const Column hitColumns[] = {Column::kHit, Column::kT};
-    double batch = 1e30, keptBatch = 1e30;
-    for (int r = 0; r < 3; ++r) {
-      auto b0 = std::chrono::steady_clock::now();
-      inChunks(src.size, threads, [&](size_t first, size_t count) {
-        baseline.intersect(warmRays.subspan(first, count), std::span(kept).subspan(first, count), qo);
-      });
-      keptBatch = std::min(keptBatch, sec(b0, std::chrono::steady_clock::now()));
-      b0 = std::chrono::steady_clock::now();
-      answer(baseline, warm, qo, hitColumns, threads, [](size_t, const Answers&) {});
-      batch = std::min(batch, sec(b0, std::chrono::steady_clock::now()));
-    }
-    std::fprintf(stderr,
-                 "vff-query: timing: %zu rays, %u threads, %s: field %.4f s, read %.4f s, query and write %.4f s, total %.4f s "
-                 "(%.1f Mrays/s); batch, answers kept, warm: %.4f s (%.1f Mrays/s); batch alone, warm: %.4f s (%.1f Mrays/s)\n",
-                 src.size, threads, o.interpolated ? "interpolated" : "nearest", sec(tOpen, t0), sec(t0, t1), sec(t1, t2), sec(tOpen, t2),
-                 n / std::max(1e-9, sec(tOpen, t2)), keptBatch, n / std::max(1e-9, keptBatch), batch, n / std::max(1e-9, batch));
-  }
-  if (badInput) {
-    cli::printError(kProg, *badInput);
+  const Run r{target, in, qo, columns, parallel::resolveThreads(o.threads)};
+  at.query = Clock::now();
+  if (auto rc = format == OutputFormat::kNpy && o.output != "-" ? answerIntoNpyFile(r, o.output)
+                                                                  : answerFormatted(r, format, o.output))
+    return *rc;
+  at.end = Clock::now();
+  if (o.timing)
+    if (auto rc = printTiming(o, r, inst, at)) return *rc;
+  if (in.badInput) {
+    cli::printError(kProg, *in.badInput);
     return cli::kExitInvalidFile;
   }
   return cli::kExitSuccess;

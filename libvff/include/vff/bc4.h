@@ -22,24 +22,26 @@
 #include <cstdint>
 #include <span>
 
+#include "vff/export.h"
+
 namespace vff {
 
 inline constexpr uint32_t kBc4BlockBytes = 8;
 
 // The code of texel u = 4y + x (u < 16) of one block.
-uint32_t bc4Texel(const uint8_t* block, uint32_t u) noexcept;
+VFF_API uint32_t bc4Texel(const uint8_t* block, uint32_t u) noexcept;
 
 // All 16 codes of one block, in texel order.
-void decodeBc4Block(const uint8_t* block, uint8_t codes[16]) noexcept;
+VFF_API void decodeBc4Block(const uint8_t* block, uint8_t codes[16]) noexcept;
 
 // Encodes 16 unorm8-diameter codes (texel order, 255 = miss) into one block: misses decode to 255,
 // hits to a code <= 254 chosen to minimise the squared code error (endpoints searched around the
 // hits' range; deterministic).
-void encodeBc4Block(const uint8_t codes[16], uint8_t* block) noexcept;
+VFF_API void encodeBc4Block(const uint8_t codes[16], uint8_t* block) noexcept;
 
 // A whole map: M x M row-major codes <-> (M/4)^2 blocks. M must be a multiple of 4; `codes` holds
 // M*M bytes and `blocks` M*M/2 (no checks beyond that).
-void encodeBc4Map(std::span<const uint8_t> codes, uint32_t m, std::span<uint8_t> blocks) noexcept;
-void decodeBc4Map(std::span<const uint8_t> blocks, uint32_t m, std::span<uint8_t> codes) noexcept;
+VFF_API void encodeBc4Map(std::span<const uint8_t> codes, uint32_t m, std::span<uint8_t> blocks) noexcept;
+VFF_API void decodeBc4Map(std::span<const uint8_t> blocks, uint32_t m, std::span<uint8_t> codes) noexcept;
 
 }  // namespace vff

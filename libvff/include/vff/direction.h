@@ -11,6 +11,7 @@
 
 #include <cstdint>
 
+#include "vff/export.h"
 #include "vff/format.h"
 
 namespace vff {
@@ -29,23 +30,23 @@ struct Vec2 {
 struct Frame {
   Vec3 t, b, n;
 };
-Frame frameFromNormal(Vec3 n) noexcept;
+VFF_API Frame frameFromNormal(Vec3 n) noexcept;
 
 // Local (frame) coordinates <-> world coordinates.
-Vec3 toLocal(const Frame& f, Vec3 world) noexcept;
-Vec3 toWorld(const Frame& f, Vec3 local) noexcept;
+VFF_API Vec3 toLocal(const Frame& f, Vec3 world) noexcept;
+VFF_API Vec3 toWorld(const Frame& f, Vec3 local) noexcept;
 
 // Square [-1,1]^2 -> unit local direction with z >= 0.
-Vec3 squareToHemisphere(DirectionScheme scheme, Vec2 uv) noexcept;
+VFF_API Vec3 squareToHemisphere(DirectionScheme scheme, Vec2 uv) noexcept;
 // Unit local direction with z >= 0 -> square [-1,1]^2 (inverse of the above). Directions with z < 0
 // are treated as z = 0 (the horizon).
-Vec2 hemisphereToSquare(DirectionScheme scheme, Vec3 dir) noexcept;
+VFF_API Vec2 hemisphereToSquare(DirectionScheme scheme, Vec3 dir) noexcept;
 
 // Texel (i, j) containing square point uv, clamped to [0, M-1].
-void squareToTexel(Vec2 uv, uint32_t mapResolution, uint32_t* i, uint32_t* j) noexcept;
+VFF_API void squareToTexel(Vec2 uv, uint32_t mapResolution, uint32_t* i, uint32_t* j) noexcept;
 // Centre of texel (i, j) in square coordinates.
-Vec2 texelCenter(uint32_t i, uint32_t j, uint32_t mapResolution) noexcept;
+VFF_API Vec2 texelCenter(uint32_t i, uint32_t j, uint32_t mapResolution) noexcept;
 // The local direction through the centre of texel (i, j).
-Vec3 texelDirection(DirectionScheme scheme, uint32_t mapResolution, uint32_t i, uint32_t j) noexcept;
+VFF_API Vec3 texelDirection(DirectionScheme scheme, uint32_t mapResolution, uint32_t i, uint32_t j) noexcept;
 
 }  // namespace vff

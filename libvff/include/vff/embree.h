@@ -1,5 +1,6 @@
 // vff/embree.h - field instances as Embree 3 user geometry: the optional component vff::embree
-// (find_package(vff CONFIG REQUIRED COMPONENTS embree), link vff::embree).
+// (find_package(vff CONFIG REQUIRED COMPONENTS embree), link vff::embree). Experimental as a whole
+// (VFF_EMBREE_EXPERIMENTAL, vff/export.h): the interface may change between minor versions.
 //
 // A renderer that already traces its static environment with Embree attaches its moving objects
 // as fields to the same RTCScene: one rtcIntersect*/rtcOccluded* call then answers exact
@@ -44,11 +45,12 @@
 #include <memory>
 
 #include "vff/error.h"
+#include "vff/export.h"
 #include "vff/query.h"
 
 namespace vff::embree {
 
-class FieldGeometry {
+class VFF_EMBREE_EXPERIMENTAL FieldGeometry {
  public:
   FieldGeometry() noexcept;
   FieldGeometry(FieldGeometry&&) noexcept;

@@ -17,6 +17,8 @@
 #include <utility>
 #include <variant>
 
+#include "vff/export.h"
+
 namespace vff {
 
 enum class Code : uint32_t {
@@ -109,14 +111,14 @@ enum class Code : uint32_t {
 };
 
 // Stable kebab-case name of a code ("header-checksum"); "unknown" for values not listed above.
-const char* codeName(Code code) noexcept;
+VFF_API const char* codeName(Code code) noexcept;
 
 // A FourCC section tag as four printable characters ("DIST"); non-printable bytes become '?'.
-std::string sectionTagName(uint32_t tag);
+VFF_API std::string sectionTagName(uint32_t tag);
 
 inline constexpr uint64_t kNoOffset = ~uint64_t{0};
 
-struct Error {
+struct VFF_API Error {
   Code code = Code::kOk;
   uint32_t section = 0;          // FourCC, 0 when not tied to a section
   uint64_t offset = kNoOffset;   // absolute file offset, kNoOffset when not tied to a place
@@ -164,6 +166,6 @@ class [[nodiscard]] Result<void> {
 using Status = Result<void>;
 
 // Builds an Error; used by the library and handy for callers that wrap libvff.
-Error makeError(Code code, std::string message, uint32_t section = 0, uint64_t offset = kNoOffset);
+VFF_API Error makeError(Code code, std::string message, uint32_t section = 0, uint64_t offset = kNoOffset);
 
 }  // namespace vff

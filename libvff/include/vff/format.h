@@ -11,6 +11,7 @@
 #include <string>
 
 #include "vff/error.h"
+#include "vff/export.h"
 
 namespace vff {
 
@@ -63,8 +64,8 @@ enum class Filter : uint8_t {
   kNone = 0,
   kHitsMed = 1,  // 1.1: hit mask + median-predicted hit codes; 8-bit distance planes, zstd blocks only
 };
-const char* codecName(Codec codec) noexcept;    // "stored", "zstd", "unknown"
-const char* filterName(Filter filter) noexcept;  // "none", "hits-med", "unknown"
+VFF_API const char* codecName(Codec codec) noexcept;    // "stored", "zstd", "unknown"
+VFF_API const char* filterName(Filter filter) noexcept;  // "none", "hits-med", "unknown"
 
 // ---- Sampling geometry -------------------------------------------------------------------------
 // Positional samples on the bounding sphere (spec/geometry.md).
@@ -101,26 +102,26 @@ enum class NormalEncoding : uint32_t {
   kOctSnorm16 = 1,   // octahedral normal, two snorm16 LE (4 bytes per ray)
 };
 
-const char* positionSchemeName(PositionScheme s) noexcept;     // "octa-hemi2", ...
-const char* directionSchemeName(DirectionScheme s) noexcept;   // "concentric-equal-area", ...
-const char* frameConventionName(FrameConvention f) noexcept;   // "duff2017"
-const char* distanceEncodingName(DistanceEncoding e) noexcept; // "unorm8-diameter", ...
-const char* normalEncodingName(NormalEncoding e) noexcept;     // "none", "oct-snorm16"
+VFF_API const char* positionSchemeName(PositionScheme s) noexcept;     // "octa-hemi2", ...
+VFF_API const char* directionSchemeName(DirectionScheme s) noexcept;   // "concentric-equal-area", ...
+VFF_API const char* frameConventionName(FrameConvention f) noexcept;   // "duff2017"
+VFF_API const char* distanceEncodingName(DistanceEncoding e) noexcept; // "unorm8-diameter", ...
+VFF_API const char* normalEncodingName(NormalEncoding e) noexcept;     // "none", "oct-snorm16"
 
 // The number of positional samples (maps) a scheme yields for its parameter; an error for an unknown
 // scheme or an out-of-range parameter (octa-hemi2: 1 <= n <= 1024; ea-octa-grid: 1 <= n <= 2048;
 // fibonacci: 1 <= n <= 2^24).
-Result<uint32_t> positionCount(PositionScheme scheme, uint32_t param);
+VFF_API Result<uint32_t> positionCount(PositionScheme scheme, uint32_t param);
 
 // The reserved miss code of an encoding (255, 65535, or 0 for kBit1), and the largest hit code.
 // kBc4Diameter's codes are those of kUnorm8Diameter (see vff/bc4.h for the blocks).
-uint32_t missCode(DistanceEncoding e) noexcept;
-uint32_t maxHitCode(DistanceEncoding e) noexcept;
+VFF_API uint32_t missCode(DistanceEncoding e) noexcept;
+VFF_API uint32_t maxHitCode(DistanceEncoding e) noexcept;
 
 // Bytes per map of the distance plane (kBit1: M*M/8, kBc4Diameter: M*M/2) and of the normal plane;
 // 0 if invalid.
-uint64_t distanceMapBytes(DistanceEncoding e, uint32_t mapResolution) noexcept;
-uint64_t normalMapBytes(NormalEncoding e, uint32_t mapResolution) noexcept;
+VFF_API uint64_t distanceMapBytes(DistanceEncoding e, uint32_t mapResolution) noexcept;
+VFF_API uint64_t normalMapBytes(NormalEncoding e, uint32_t mapResolution) noexcept;
 
 struct Sphere {
   float center[3] = {0, 0, 0};
@@ -141,11 +142,11 @@ struct FieldDesc {
 };
 
 // Checks a FieldDesc against the spec's rules 5001-5010; the error code names the rule.
-Status checkFieldDesc(const FieldDesc& desc);
+VFF_API Status checkFieldDesc(const FieldDesc& desc);
 
 // ---- Packed slice layout -------------------------------------------------------------------------
 enum class LayoutTarget : uint32_t { kInvalid = 0, kTexture2DArray = 1, kTexture3D = 2 };
-const char* layoutTargetName(LayoutTarget t) noexcept;  // "2d-array", "3d"
+VFF_API const char* layoutTargetName(LayoutTarget t) noexcept;  // "2d-array", "3d"
 
 // GPU limits a layout must respect. The defaults are the minimums OpenGL 4.3 guarantees for array
 // layers and 3D textures (2048), which also keeps 2D slices within every GL 4.x implementation.
@@ -175,16 +176,16 @@ struct LayoutDesc {
 // The canonical layout for a field under the given limits (spec/format.md, "Packed slice layout"):
 // as many tiles per row as fit (at most mapCount), as many rows as needed (at most what fits), then
 // slices. Fails with kLayoutGeometry naming the limit when the field does not fit.
-Result<LayoutDesc> computeLayout(const FieldDesc& field, const LayoutLimits& limits);
+VFF_API Result<LayoutDesc> computeLayout(const FieldDesc& field, const LayoutLimits& limits);
 
 // Checks a LayoutDesc against a field (rules 7001-7003).
-Status checkLayout(const LayoutDesc& layout, const FieldDesc& field);
+VFF_API Status checkLayout(const LayoutDesc& layout, const FieldDesc& field);
 
 struct TilePlacement {
   uint32_t slice = 0;
   uint32_t x = 0;  // texel column of the map's texel (0,0) in the slice (inside the gutter)
   uint32_t y = 0;  // texel row
 };
-TilePlacement placeMap(const LayoutDesc& layout, uint32_t map) noexcept;
+VFF_API TilePlacement placeMap(const LayoutDesc& layout, uint32_t map) noexcept;
 
 }  // namespace vff

@@ -30,6 +30,7 @@
 
 #include "vff/direction.h"
 #include "vff/error.h"
+#include "vff/export.h"
 #include "vff/format.h"
 
 namespace vff {
@@ -37,7 +38,7 @@ namespace vff {
 // An immutable description of a positional sample set. Holds a few scalars: cheap to copy, and
 // every member function is const and thread-safe. A default-constructed PositionSet is empty
 // (scheme kInvalid, count 0); only create() and fromField() make a usable one.
-class PositionSet {
+class VFF_API PositionSet {
  public:
   PositionSet() = default;
 

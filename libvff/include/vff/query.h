@@ -63,6 +63,7 @@
 
 #include "vff/direction.h"
 #include "vff/error.h"
+#include "vff/export.h"
 #include "vff/format.h"
 #include "vff/positions.h"
 
@@ -110,20 +111,21 @@ struct QueryOptions {
 // origin's own surface must not count as an occluder. (Measured with vff-experiments intra-ao on
 // the bunny: half a spacing gives RMS 8.9, one spacing 5.3, 1.5 spacings 3.9 but larger misses at
 // contacts.)
-float defaultIntraBias(const FieldDesc& field) noexcept;
+VFF_API float defaultIntraBias(const FieldDesc& field) noexcept;
 
 // The kernel the batch functions use for kNearest on this CPU: "avx512", "avx2", "sse2" or
 // "scalar".
-const char* batchKernelName() noexcept;
+VFF_API const char* batchKernelName() noexcept;
 
 // The neighbour lists kInterpolated blends over: for every positional sample, up to
 // kQueryNeighbours other samples around it (the samples nearest to two rings of probe directions
 // at 1 and 1.6 mean spacings), padded with UINT32_MAX: mapCount * kQueryNeighbours entries. A GPU
-// port of kInterpolated uploads them (gpu/loader).
+// port of kInterpolated uploads them (gpu/loader). Experimental (vff/export.h): the lists change
+// with the blend.
 inline constexpr uint32_t kQueryNeighbours = 8;
 // The radius of kInterpolated's kernel, in mean sample spacings sqrt(4 pi / mapCount).
 inline constexpr float kQueryKernelSpacings = 1.3f;
-std::vector<uint32_t> queryNeighbours(const PositionSet& positions);
+VFF_EXPERIMENTAL std::vector<uint32_t> queryNeighbours(const PositionSet& positions);
 
 struct QueryHit {
   bool hit = false;
@@ -145,7 +147,7 @@ struct QueryHit {
 // hugePageBytes() says how many bytes it got): the TLB then covers the field. The bytes stay as
 // they are, and the caller's. The kernel declines for file mappings (a File's stored blocks) and
 // where transparent huge pages are off.
-class FieldQuery {
+class VFF_API FieldQuery {
  public:
   FieldQuery() noexcept;  // empty: every ray misses
   FieldQuery(FieldQuery&&) noexcept;
@@ -199,7 +201,7 @@ class FieldQuery {
 
 // world = translation + scale * (rotation * object). rotation is row-major and orthonormal
 // (det +1); scale > 0.
-struct RigidTransform {
+struct VFF_API RigidTransform {
   float rotation[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   Vec3 translation;
   float scale = 1.0f;
@@ -214,7 +216,7 @@ struct RigidTransform {
 
 // A field placed in a world. Borrows the FieldQuery. Rays and results are in world space; t is
 // the same parameter as in object space, because the direction is transformed with the ray.
-struct Instance {
+struct VFF_API Instance {
   const FieldQuery* field = nullptr;
   RigidTransform transform;
 

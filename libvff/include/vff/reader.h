@@ -20,12 +20,13 @@
 #include <vector>
 
 #include "vff/error.h"
+#include "vff/export.h"
 #include "vff/format.h"
 
 namespace vff {
 
 enum class Plane : uint8_t { kDistance = 0, kNormal = 1 };
-const char* planeName(Plane p) noexcept;  // "distance", "normal"
+VFF_API const char* planeName(Plane p) noexcept;  // "distance", "normal"
 
 enum class ChecksumPolicy : uint8_t {
   kVerifyAll = 0,  // header, every section and every block at open (XXH3: cheap next to reading the bytes)
@@ -96,7 +97,7 @@ struct FileInfo {
   std::vector<SectionInfo> sections;  // in table order
 };
 
-class File {
+class VFF_API File {
  public:
   // Maps the file read-only. The file must not change while the File is alive.
   static Result<File> open(const std::string& path, const ReadOptions& options = {});
@@ -140,7 +141,7 @@ class File {
   Status readSlice(Plane p, uint32_t slice, std::span<uint8_t> out) const;
 
   struct Impl;  // opaque
-  explicit File(std::unique_ptr<Impl> impl);  // used by the library only
+  VFF_HIDDEN explicit File(std::unique_ptr<Impl> impl);  // used by the library only (not exported)
 
  private:
   std::unique_ptr<Impl> impl_;

@@ -68,6 +68,7 @@
 #include <vector>
 
 #include "vff/error.h"
+#include "vff/export.h"
 #include "vff/query.h"
 #include "vff/scene_hierarchy.h"
 
@@ -79,7 +80,7 @@ struct SceneHit : QueryHit {
   uint32_t instance = kNoInstance;  // the id of the instance hit; kNoInstance when nothing was
 };
 
-class Scene {
+class VFF_API Scene {
  public:
   Scene() noexcept;
   Scene(Scene&&) noexcept;
@@ -119,7 +120,8 @@ class Scene {
 
   // The committed top-level hierarchy, copied into a flat layout (vff/scene_hierarchy.h) for a
   // walker outside libvff, such as the GLSL scene query. Errors: kBadState when not committed.
-  Result<SceneHierarchy> hierarchy() const;
+  // Experimental (vff/export.h): the layout follows the GLSL walker.
+  VFF_EXPERIMENTAL Result<SceneHierarchy> hierarchy() const;
 
   struct Impl;  // opaque
 
@@ -130,6 +132,6 @@ class Scene {
 // Checks that `transform` is rigid: a finite translation, a finite scale > 0, and a rotation whose
 // rows are orthonormal to within 1e-3 with determinant +1. Errors: kInvalidArgument naming the
 // problem.
-Status checkTransform(const RigidTransform& transform);
+VFF_API Status checkTransform(const RigidTransform& transform);
 
 }  // namespace vff

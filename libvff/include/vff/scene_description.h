@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "vff/error.h"
+#include "vff/export.h"
 #include "vff/query.h"
 #include "vff/reader.h"
 #include "vff/scene.h"
@@ -38,7 +39,7 @@ struct SceneField {
   std::string sourceJson;  // the `source` object as JSON text, or empty
 };
 
-struct SceneInstance {
+struct VFF_API SceneInstance {
   uint32_t field = 0;                    // index into SceneDescription::fields
   std::string name;                      // may be empty
   Vec3 translation;                      // world = translation + rotate(rotation, scale * p)
@@ -61,24 +62,24 @@ struct SceneDescription {
 // checked: kSceneJson (not one JSON object), kSceneVersion (not a vff-scene, or not version 1),
 // kSceneValue (a missing or wrong member; the message gives its JSON location, such as
 // "instances[3].rotation"). Rotations are normalised.
-Result<SceneDescription> parseSceneDescription(std::string_view json, const std::string& name);
+VFF_API Result<SceneDescription> parseSceneDescription(std::string_view json, const std::string& name);
 
 // Reads and parses a file (kIoOpen, kIoRead; then as above, messages naming the file).
-Result<SceneDescription> readSceneDescription(const std::string& path);
+VFF_API Result<SceneDescription> readSceneDescription(const std::string& path);
 
 // The description as JSON text: two-space indented, members in a fixed order, floats written with
 // the fewest digits that read back to the same float, so that equal descriptions give equal bytes.
 // Empty names, sources and extras are left out. It fails with kSceneValue on what
 // parseSceneDescription would refuse (a field index out of range, a non-finite number, ...).
-Result<std::string> formatSceneDescription(const SceneDescription& scene);
+VFF_API Result<std::string> formatSceneDescription(const SceneDescription& scene);
 
 // Writes formatSceneDescription's text to `path` atomically (a temporary file renamed over it):
 // either the whole new file or the old one (kIoOpen, kIoWrite).
-Status writeSceneDescription(const std::string& path, const SceneDescription& scene);
+VFF_API Status writeSceneDescription(const std::string& path, const SceneDescription& scene);
 
 // The path of a field's `uri` for a description read from `descriptionPath`: absolute URIs as they
 // are, relative ones joined to the description's folder.
-std::string resolveSceneUri(const std::string& descriptionPath, const std::string& uri);
+VFF_API std::string resolveSceneUri(const std::string& descriptionPath, const std::string& uri);
 
 // A scene description with its fields open and its instances placed in a committed vff::Scene:
 // instance i of the scene is description.instances[i]. It owns everything the scene borrows; it
@@ -94,10 +95,10 @@ struct LoadedScene {
 // and places the instances. Errors: those of readSceneDescription; those of File::open and
 // FieldQuery::fromFile, the message naming the field's uri and the description; those of
 // Scene::add for an instance (a transform checkTransform refuses), naming the instance.
-Result<std::unique_ptr<LoadedScene>> loadScene(const std::string& path, const ReadOptions& options = {});
+VFF_API Result<std::unique_ptr<LoadedScene>> loadScene(const std::string& path, const ReadOptions& options = {});
 
 // The rotation part of a transform as a unit quaternion x, y, z, w (w >= 0); `rotation` must be a
 // rotation matrix (orthonormal, determinant +1).
-std::array<float, 4> quaternionFromRotation(const float rotation[3][3]) noexcept;
+VFF_API std::array<float, 4> quaternionFromRotation(const float rotation[3][3]) noexcept;
 
 }  // namespace vff

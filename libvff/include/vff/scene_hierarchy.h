@@ -9,6 +9,9 @@
 // coordinate's magnitude), so that a float slab test never misses a ray that the instance's own
 // sphere test lets through. A walker that visits every instance whose box the segment [0, tmax]
 // of a ray reaches, and answers each as vff::Instance does, answers as the Scene does.
+//
+// Experimental (VFF_EXPERIMENTAL, vff/export.h): the layout follows the GLSL walker and may change
+// with it.
 #pragma once
 
 #include <cstdint>

@@ -12,12 +12,13 @@
 #include <vector>
 
 #include "vff/error.h"
+#include "vff/export.h"
 #include "vff/reader.h"
 
 namespace vff {
 
 enum class Severity : uint8_t { kWarning = 0, kError = 1 };
-const char* severityName(Severity s) noexcept;  // "warning", "error"
+VFF_API const char* severityName(Severity s) noexcept;  // "warning", "error"
 
 struct Issue {
   Code code = Code::kOk;
@@ -32,13 +33,13 @@ struct ValidateOptions {
   bool decodeBlocks = true;  // decode every compressed block and check every value
 };
 
-struct Report {
+struct VFF_API Report {
   std::vector<Issue> issues;
   bool valid() const noexcept;        // no issue of severity kError
   bool has(Code code) const noexcept;  // some issue carries this code
 };
 
-Report validate(std::span<const uint8_t> bytes, const ValidateOptions& options = {});
-Report validateFile(const std::string& path, const ValidateOptions& options = {});
+VFF_API Report validate(std::span<const uint8_t> bytes, const ValidateOptions& options = {});
+VFF_API Report validateFile(const std::string& path, const ValidateOptions& options = {});
 
 }  // namespace vff

@@ -5,6 +5,7 @@
 #include "vff/direction.h"
 #include "vff/encoding.h"
 #include "vff/error.h"
+#include "vff/export.h"
 #include "vff/format.h"
 #include "vff/positions.h"
 #include "vff/query.h"

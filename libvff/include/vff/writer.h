@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "vff/error.h"
+#include "vff/export.h"
 #include "vff/format.h"
 #include "vff/reader.h"
 
@@ -48,7 +49,7 @@ struct WriteOptions {
   std::function<void(uint64_t done, uint64_t total)> progress;
 };
 
-class Writer {
+class VFF_API Writer {
  public:
   // Starts a file at `path` ("-" is not supported: files need seeking). Fails with
   // kInvalidArgument for an invalid field or options, kIoWrite when the temporary cannot be made.
@@ -73,17 +74,17 @@ class Writer {
   const LayoutDesc& layout() const noexcept;
 
   struct Impl;  // opaque
-  explicit Writer(std::unique_ptr<Impl> impl);  // used by the library only
+  VFF_HIDDEN explicit Writer(std::unique_ptr<Impl> impl);  // used by the library only (not exported)
 
  private:
   std::unique_ptr<Impl> impl_;
 };
 
 // One call for a field held in memory.
-Status writeFile(const std::string& path, const FieldDesc& field, std::span<const uint8_t> distance,
-                 std::span<const uint8_t> normals = {}, const WriteOptions& options = {});
-Result<std::vector<uint8_t>> writeMemory(const FieldDesc& field, std::span<const uint8_t> distance,
-                                         std::span<const uint8_t> normals = {},
-                                         const WriteOptions& options = {});
+VFF_API Status writeFile(const std::string& path, const FieldDesc& field, std::span<const uint8_t> distance,
+                         std::span<const uint8_t> normals = {}, const WriteOptions& options = {});
+VFF_API Result<std::vector<uint8_t>> writeMemory(const FieldDesc& field, std::span<const uint8_t> distance,
+                                                 std::span<const uint8_t> normals = {},
+                                                 const WriteOptions& options = {});
 
 }  // namespace vff

@@ -76,7 +76,7 @@ struct FieldBlock {
                             // (unorm16-diameter); 0 for unorm8-chord (per texel) and bit1
   float invRadius = 0;      // 1 / R
   float twoRadius = 0;      // 2 R
-  // Reconstruction::kInterpolated (libvff/src/query.cpp, FieldQuery::Impl::build): where the
+  // Reconstruction::kInterpolated (libvff/src/query/query_build.cpp, FieldQuery::Impl::build): where the
   // neighbour lists start in the positions buffer (in vec4 units), and the squared chord radius of
   // the kernel, (1.3 sqrt(4 pi / mapCount))^2, computed with the CPU's float expressions.
   uint32_t neighbourOffset = 0;

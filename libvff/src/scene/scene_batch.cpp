@@ -1,0 +1,190 @@
+// scene_batch.cpp - vff::Scene's batches (vff/scene.h). The rays of a chunk are paired with the
+// instances whose spheres they reach; each pair's ray is taken into its instance's object space
+// exactly as Instance's one-ray functions do; each field then answers the rays of all its
+// instances in one call of its batch path (a thousand instances of one field make one large batch,
+// which keeps the batch path's memory pipeline full); the answers are combined per ray in id order,
+// as the one-ray functions and the loop over instances do.
+#include <algorithm>
+#include <memory>
+#include <mutex>
+#include <new>
+#include <string>
+
+#include "query/query_impl.h"
+#include "scene/scene_impl.h"
+
+namespace vff {
+
+namespace {
+
+// Rays a chunk. Few enough that a chunk's rays, box rays, traversal lists and pairs stay near the
+// core's own caches (larger chunks run slower, the more so on two threads); many enough that the
+// traversal's cost per node, and its partly filled vector steps near the leaves, are shared by
+// many rays (smaller chunks run slower, the more so the more instances). The field's batch path
+// gets the pairs of all its instances at once either way.
+constexpr size_t kChunk = 8192;
+
+// How far ahead pairing asks for the rays and the instances' steps it will read.
+constexpr size_t kRaysAhead = 8, kLeavesAhead = 2;
+
+using Pairs = detail::ScenePairs;
+using Scratch = detail::SceneScratch;
+
+// A scratch of the scene's spares (Scene::Impl::spare), or a new one, for the length of a call.
+class ScratchLease {
+ public:
+  explicit ScratchLease(const Scene::Impl& m) : m_(m) {
+    {
+      std::lock_guard<std::mutex> lock(m.spareLock);
+      if (!m.spare.empty()) {
+        s_ = std::move(m.spare.back());
+        m.spare.pop_back();
+      }
+    }
+    if (!s_) s_ = std::make_unique<Scratch>();
+  }
+  ~ScratchLease() {
+    std::lock_guard<std::mutex> lock(m_.spareLock);
+    try {
+      m_.spare.push_back(std::move(s_));
+    } catch (const std::bad_alloc&) {  // (the scratch is then freed: the next call makes another)
+    }
+  }
+  ScratchLease(const ScratchLease&) = delete;
+  ScratchLease& operator=(const ScratchLease&) = delete;
+  Scratch& operator*() const { return *s_; }
+
+ private:
+  const Scene::Impl& m_;
+  std::unique_ptr<Scratch> s_;
+};
+
+void pairUp(const Scene::Impl& m, std::span<const Ray> chunk, Scratch* s) {
+  Pairs* p = &s->pairs;
+  s->boxRays.assign(chunk);
+  const detail::RayLists& l = s->lists;
+  m.bvh.collect(s->boxRays, &s->lists);
+  p->count.assign(m.instances.size(), 0);
+  for (size_t c = 0; c < l.prim.size(); ++c) p->count[l.prim[c]] = l.count[c];
+  p->first.resize(m.instances.size());
+  uint32_t at = 0;
+  for (uint32_t id : m.byField) {
+    p->first[id] = at;
+    at += p->count[id];
+  }
+  p->ray.resize(at);
+  p->rays.resize(at);
+  // The rays of a leaf's list lie anywhere in the chunk, and the leaves' instances anywhere in
+  // the table: each is asked for a few steps ahead (the loop is too short for the core to find
+  // the loads itself).
+  const size_t listed = l.rays.size();
+  for (size_t c = 0; c < l.prim.size(); ++c) {
+    const uint32_t id = l.prim[c], to = p->first[id];
+    const detail::ToObject& x = m.toObject[id];
+    if (c + kLeavesAhead < l.prim.size()) __builtin_prefetch(&m.toObject[l.prim[c + kLeavesAhead]]);
+    for (uint32_t k = 0; k < l.count[c]; ++k) {
+      const size_t item = l.first[c] + k;
+      const uint32_t r = l.rays[item];
+      if (item + kRaysAhead < listed) __builtin_prefetch(&chunk[l.rays[item + kRaysAhead]]);
+      p->ray[to + k] = r;
+      p->rays[to + k] = x.ray(chunk[r]);
+    }
+  }
+}
+
+Status sizes(size_t rays, size_t out) {
+  if (rays == out) return {};
+  return makeError(Code::kInvalidArgument,
+                   "scene: out has " + std::to_string(out) + " entries for " + std::to_string(rays) + " rays");
+}
+
+// Runs answer(field, object-space rays, answers) once per field, over the pairs of all its
+// instances.
+template <class T, class Answer>
+void answerPairs(const Scene::Impl& m, const Pairs& p, std::vector<T>* answers, Answer&& answer) {
+  answers->resize(p.rays.size());
+  const std::span<const Ray> rays(p.rays);
+  const std::span<T> out(*answers);
+  for (size_t g = 0; g + 1 < m.fieldStart.size(); ++g) {
+    const uint32_t lo = m.byField[m.fieldStart[g]], hi = m.byField[m.fieldStart[g + 1] - 1];
+    const uint32_t a = p.first[lo], b = p.first[hi] + p.count[hi];
+    if (a < b) answer(*m.instances[lo].field, rays.subspan(a, b - a), out.subspan(a, b - a));
+  }
+}
+
+}  // namespace
+
+Status Scene::intersect(std::span<const Ray> rays, std::span<SceneHit> out, const QueryOptions& options) const {
+  if (Status s = Impl::ready(impl_.get()); !s) return s;
+  if (Status s = sizes(rays.size(), out.size()); !s) return s;
+  std::fill(out.begin(), out.end(), SceneHit{});
+  if (!impl_) return {};
+  const Impl& m = *impl_;
+  const ScratchLease lease(m);
+  Scratch& s = *lease;
+  const Pairs& p = s.pairs;
+  std::vector<QueryHit>& hits = s.hits;
+  for (size_t c = 0; c < rays.size(); c += kChunk) {
+    const std::span<const Ray> chunk = rays.subspan(c, std::min(kChunk, rays.size() - c));
+    pairUp(m, chunk, &s);
+    answerPairs(m, p, &hits, [&](const FieldQuery& f, std::span<const Ray> r, std::span<QueryHit> h) {
+      f.intersect(r, h, options);
+    });
+    for (uint32_t i = 0; i < m.instances.size(); ++i)
+      for (uint32_t k = p.first[i]; k < p.first[i] + p.count[i]; ++k) {
+        SceneHit& best = out[c + p.ray[k]];
+        if (hits[k].hit && hits[k].t < best.t) {
+          QueryHit h = hits[k];
+          detail::toWorld(m.instances[i].transform, chunk[p.ray[k]], &h);
+          static_cast<QueryHit&>(best) = h;
+          best.instance = i;
+        }
+      }
+  }
+  return {};
+}
+
+Status Scene::occluded(std::span<const Ray> rays, std::span<uint8_t> out, const QueryOptions& options) const {
+  if (Status s = Impl::ready(impl_.get()); !s) return s;
+  if (Status s = sizes(rays.size(), out.size()); !s) return s;
+  std::fill(out.begin(), out.end(), uint8_t(0));
+  if (!impl_) return {};
+  const Impl& m = *impl_;
+  const ScratchLease lease(m);
+  Scratch& s = *lease;
+  const Pairs& p = s.pairs;
+  std::vector<uint8_t>& blocked = s.blocked;
+  for (size_t c = 0; c < rays.size(); c += kChunk) {
+    const std::span<const Ray> chunk = rays.subspan(c, std::min(kChunk, rays.size() - c));
+    pairUp(m, chunk, &s);
+    answerPairs(m, p, &blocked, [&](const FieldQuery& f, std::span<const Ray> r, std::span<uint8_t> o) {
+      f.occluded(r, o, options);
+    });
+    for (size_t k = 0; k < p.ray.size(); ++k) out[c + p.ray[k]] |= blocked[k];
+  }
+  return {};
+}
+
+Status Scene::visibility(std::span<const Ray> rays, std::span<float> out, const QueryOptions& options) const {
+  if (Status s = Impl::ready(impl_.get()); !s) return s;
+  if (Status s = sizes(rays.size(), out.size()); !s) return s;
+  std::fill(out.begin(), out.end(), 1.0f);
+  if (!impl_) return {};
+  const Impl& m = *impl_;
+  const ScratchLease lease(m);
+  Scratch& s = *lease;
+  const Pairs& p = s.pairs;
+  std::vector<float>& vis = s.vis;
+  for (size_t c = 0; c < rays.size(); c += kChunk) {
+    const std::span<const Ray> chunk = rays.subspan(c, std::min(kChunk, rays.size() - c));
+    pairUp(m, chunk, &s);
+    answerPairs(m, p, &vis, [&](const FieldQuery& f, std::span<const Ray> r, std::span<float> o) {
+      f.visibility(r, o, options);
+    });
+    for (uint32_t i = 0; i < m.instances.size(); ++i)  // the product in id order
+      for (uint32_t k = p.first[i]; k < p.first[i] + p.count[i]; ++k) out[c + p.ray[k]] *= vis[k];
+  }
+  return {};
+}
+
+}  // namespace vff
