@@ -4,6 +4,8 @@
 // node (split_bake.cpp).
 #pragma once
 
+#include <sys/types.h>
+
 #include <string>
 #include <vector>
 
@@ -19,6 +21,10 @@ int mergeParts(const Options& o);
 // Removes the temporaries of `output` (.NAME.tmp-PID-N beside it) left by processes that no longer
 // exist; those of live processes stay.
 void removeStaleTemporaries(const std::string& output);
+// The folder of a path ("." for a bare name, "/" at the root).
+std::string folderOf(const std::string& path);
+// The process `pid` no longer exists (kill(pid, 0) says ESRCH): its temporaries are stale.
+bool processIsGone(pid_t pid);
 // Once the Writer of `output` exists: on SIGINT, SIGTERM or SIGHUP, its temporary is removed and the
 // process ends killed by the signal (the old file at `output`, if any, stays as it was), and so are
 // the files `finished` (the outputs this run completed before, which are incomplete without it). A

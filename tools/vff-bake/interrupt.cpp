@@ -48,8 +48,7 @@ void onSignal(int sig) {
 // The folder of `output` and the prefix of its temporaries' names (".NAME.tmp-").
 std::pair<std::filesystem::path, std::string> temporaryPattern(const std::string& output) {
   const size_t slash = output.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : output.substr(0, slash));
-  return {dir, "." + (slash == std::string::npos ? output : output.substr(slash + 1)) + ".tmp-"};
+  return {folderOf(output), "." + (slash == std::string::npos ? output : output.substr(slash + 1)) + ".tmp-"};
 }
 
 // The PID in a temporary's name PREFIX PID-N, or 0 when the name is not one.
@@ -78,10 +77,16 @@ std::vector<std::filesystem::path> temporaries(const std::string& output, Keep k
 
 }  // namespace
 
+std::string folderOf(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+}
+
+bool processIsGone(pid_t pid) { return ::kill(pid, 0) == -1 && errno == ESRCH; }
+
 void removeStaleTemporaries(const std::string& output) {
-  auto dead = [](pid_t pid) { return ::kill(pid, 0) == -1 && errno == ESRCH; };
   std::error_code ec;
-  for (const auto& p : temporaries(output, dead)) std::filesystem::remove(p, ec);
+  for (const auto& p : temporaries(output, processIsGone)) std::filesystem::remove(p, ec);
 }
 
 void removeTemporaryOnSignal(const std::string& output, const std::vector<std::string>& finished) {

@@ -51,12 +51,6 @@ std::string fieldPath(const std::string& stem, const bake::GltfObject& obj, bake
   return p + ".vff";
 }
 
-// The folder of a path ("." for a bare name).
-std::string folderOf(const std::string& path) {
-  const size_t slash = path.find_last_of('/');
-  return slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
-}
-
 // This run's temporary of `path`: DIR/.NAME.tmp-PID-0, the pattern of the Writer's temporaries, so
 // that removeStaleTemporaries(path) removes it once this process is gone (killed outright).
 std::string temporaryOf(const std::string& path) {
@@ -64,8 +58,6 @@ std::string temporaryOf(const std::string& path) {
   const std::string dir = slash == std::string::npos ? "" : path.substr(0, slash + 1);
   return dir + "." + baseName(path) + ".tmp-" + std::to_string(getpid()) + "-0";
 }
-
-bool processIsGone(pid_t pid) { return ::kill(pid, 0) == -1 && errno == ESRCH; }
 
 // Removes what a split bake killed outright (SIGKILL, a crash) left of `path`: its finished
 // temporaries (removeStaleTemporaries) and the Writer's temporaries of those, ..NAME.tmp-PID-0.tmp-PID-N,
