@@ -168,6 +168,67 @@ TEST(Scene, RandomScenesMatchTheLoopInterpolated) {
   checkAgainstLoop(sceneOf(v), v, randomRays(rng, v, 800, 3.0f), o);
 }
 
+// Rays with sources: the scene's *From functions against the loop in which the source instance
+// answers by section 7.3 and every other by section 7.4 (vff/scene.h), one ray and batched.
+void checkSourcesAgainstLoop(const Scene& scene, const std::vector<Instance>& v, const std::vector<Ray>& rays,
+                             const std::vector<uint32_t>& sources, const QueryOptions& o) {
+  std::vector<SceneHit> hits(rays.size());
+  std::vector<uint8_t> blocked(rays.size());
+  std::vector<float> vis(rays.size());
+  ASSERT_TRUE(scene.intersectFrom(rays, sources, hits, o).ok());
+  ASSERT_TRUE(scene.occludedFrom(rays, sources, blocked, o).ok());
+  ASSERT_TRUE(scene.visibilityFrom(rays, sources, vis, o).ok());
+  for (size_t i = 0; i < rays.size(); ++i) {
+    SceneHit want;
+    bool occ = false;
+    float vi = 1.0f;
+    for (uint32_t k = 0; k < v.size(); ++k) {
+      QueryOptions ok = o;
+      ok.origin = k == sources[i] ? RayOrigin::kOnObject : RayOrigin::kOffObject;
+      const QueryHit h = v[k].intersect(rays[i], ok);
+      if (h.hit && h.t < want.t) {
+        static_cast<QueryHit&>(want) = h;
+        want.instance = k;
+      }
+      occ = occ || v[k].occluded(rays[i], ok);
+      vi *= v[k].visibility(rays[i], ok);
+    }
+    expectSameHit(scene.intersectFrom(rays[i], sources[i], o).value(), want, i);
+    expectSameHit(hits[i], want, i);
+    ASSERT_EQ(scene.occludedFrom(rays[i], sources[i], o).value(), occ) << "ray " << i;
+    ASSERT_EQ(blocked[i] != 0, occ) << "ray " << i;
+    ASSERT_EQ(bits(scene.visibilityFrom(rays[i], sources[i], o).value()), bits(vi)) << "ray " << i;
+    ASSERT_EQ(bits(vis[i]), bits(vi)) << "ray " << i;
+  }
+}
+
+TEST(Scene, RaySourcesMatchTheLoop) {
+  Rng rng(3);
+  for (Reconstruction r : {Reconstruction::kNearest, Reconstruction::kInterpolated}) {
+    QueryOptions o;
+    o.reconstruction = r;
+    for (size_t n : {2, 40}) {
+      const auto v = randomInstances(rng, n, 2.5f);  // close: the spheres overlap
+      const Scene s = sceneOf(v);
+      const auto rays = randomRays(rng, v, 1200, 2.5f);
+      // Rays from a point on instance i % n (randomRays' kind 3) start on it; the others on none,
+      // or (every seventh) on a random instance.
+      std::vector<uint32_t> sources(rays.size(), kNoInstance);
+      for (size_t i = 0; i < rays.size(); ++i) {
+        if (i % 4 == 3) sources[i] = uint32_t(i % v.size());
+        if (i % 7 == 0) sources[i] = uint32_t(rng.uniform(0, float(n) - 0.01f));
+      }
+      checkSourcesAgainstLoop(s, v, rays, sources, o);
+      if (HasFatalFailure()) return;
+    }
+  }
+  // Without sources, the scene answers as before: every instance by options.origin.
+  const auto v = randomInstances(rng, 10, 2.5f);
+  QueryOptions o;
+  o.origin = RayOrigin::kOffObject;
+  checkAgainstLoop(sceneOf(v), v, randomRays(rng, v, 600, 2.5f), o);
+}
+
 TEST(Scene, TiesGoToTheLowerId) {
   // The same instance twice: every hit is a tie, and the lower id wins.
   const Instance a{&fields()[0]->query, RigidTransform::fromAxisAngle({0, 1, 0}, 0.3f, {1, 0, 0})};
@@ -297,6 +358,16 @@ TEST(Scene, ErrorsAreValues) {
   EXPECT_EQ(s.setTransform(0, bad).error().code, Code::kInvalidArgument);
   EXPECT_TRUE(s.committed());  // a refused move changes nothing
   EXPECT_TRUE(s.occluded(Ray{{5, 0, 0}, {-1, 0, 0}}).value());
+  // Sources: one per ray, each an instance's id or kNoInstance.
+  std::vector<uint32_t> sources{0, kNoInstance};
+  EXPECT_EQ(s.visibilityFrom(rays, sources, vis).error().code, Code::kInvalidArgument);
+  sources = {0, kNoInstance, 1};
+  Status st = s.visibilityFrom(rays, sources, vis);
+  ASSERT_FALSE(st.ok());
+  EXPECT_EQ(st.error().code, Code::kOutOfRange);
+  EXPECT_NE(st.error().message.find("sources[2] = 1"), std::string::npos) << st.error().message;
+  EXPECT_EQ(s.occludedFrom(rays[0], 1).error().code, Code::kOutOfRange);
+  EXPECT_TRUE(s.occludedFrom(rays[0], kNoInstance).value());
 }
 
 }  // namespace

@@ -14,11 +14,22 @@
 // * A ray whose origin is outside the bounding sphere (inter-object) enters the sphere at distance
 //   tEntry; the map of the positional sample nearest to the entry point, looked up in the ray's
 //   direction, gives the distance d to the surface: the hit is at t = tEntry + d (section 7.2).
-// * A ray whose origin is inside the sphere (intra-object: a point on the object looking out) is
-//   answered by the paper's test (section 7.3): the ray leaves the sphere at d1; the reversed ray,
-//   entering there, reports the surface at d2 from the exit point. The ray is occluded when
-//   d2 < d1 - bias. The field only sees the surface from outside, so intersect() then reports the
-//   LAST surface crossing before the exit, at t = d1 - d2, not necessarily the first.
+// * A ray whose origin is inside the sphere is answered by one of two tests, chosen by
+//   QueryOptions::origin (where the ray starts):
+//   - RayOrigin::kOnObject (the default): a point on the object looking out, the paper's test
+//     (section 7.3). The ray leaves the sphere at d1; the reversed ray, entering there, reports the
+//     surface at d2 from the exit point. The ray is occluded when d2 < d1 - bias. The field only
+//     sees the surface from outside, so intersect() then reports the LAST surface crossing before
+//     the exit, at t = d1 - d2, not necessarily the first.
+//   - RayOrigin::kOffObject: a point elsewhere inside the sphere (the ground under the object,
+//     another object touching it), section 7.4. The ray extended backwards enters the sphere before
+//     its origin; the forward lookup from that entry point gives the first surface along the line.
+//     When it lies ahead of the origin it is the answer (the first surface, as for a ray from
+//     outside); when it lies behind (the origin sits in a hollow of the object), the ray is
+//     answered by section 7.3 with no bias. The kOnObject test misses a contact shadow whenever the
+//     last surface lies beyond tmax (ambient occlusion at ranges below 2R); this one does not.
+//   Rays from outside the sphere get the same answer under both. vff::Scene chooses per ray and
+//   instance from each ray's source (vff/scene.h).
 // * Reconstruction::kNearest is the paper's: one sample, one texel. kInterpolated blends the few
 //   samples within one mean spacing of the entry point (each looked up in the ray's direction, its hit point projected
 //   back onto the ray) and, within each map, the 2 x 2 texels around the direction, with weights
@@ -26,11 +37,12 @@
 //   hits and of the misses are summed separately, the ray hits when the hits outweigh the misses,
 //   and the distance is the weighted mean of the hits' distances only. visibility() returns the
 //   misses' share of the weight (1: certainly unoccluded): a smooth value for ambient occlusion.
-//   Rays from inside the sphere are answered as with kNearest (blending takes the origin's own
-//   surface, seen by the neighbouring samples' rays, for an occluder).
-// * Limits. From inside, the field knows only the last surface before the exit point: with a
+//   Rays answered by section 7.3 are answered as with kNearest (blending takes the origin's own
+//   surface, seen by the neighbouring samples' rays, for an occluder); kOffObject rays blend their
+//   forward lookups from the entry point.
+// * Limits. Under section 7.3 the field knows only the last surface before the exit point: with a
 //   finite tmax, a ray whose first surface lies before tmax and whose last lies beyond it is
-//   reported unoccluded. A bit1 field has no distances: an outside ray's hit is reported at the
+//   reported unoccluded (kOffObject rays only when their origin lies in a hollow of the object). A bit1 field has no distances: an outside ray's hit is reported at the
 //   entry point, and rays from inside are never occluded.
 //
 // Units. A Ray's direction need not be unit length; t is measured in multiples of it, as in Embree
@@ -96,12 +108,19 @@ struct LookupSite {
   uint32_t i = 0, j = 0;
 };
 
+// Where the rays of a call start, for the rays that start inside the bounding sphere (see above).
+enum class RayOrigin : uint8_t {
+  kOnObject = 0,   // on this object's own surface: section 7.3, with QueryOptions::intraBias
+  kOffObject = 1,  // anywhere else (not on this object): section 7.4; intraBias is not used
+};
+
 struct QueryOptions {
   Reconstruction reconstruction = Reconstruction::kNearest;
+  RayOrigin origin = RayOrigin::kOnObject;
   // Intra-object bias, as a fraction of the radius R: a ray from inside is occluded when
-  // d2 < d1 - bias * R. Negative: the default, defaultIntraBias(field). A ray that starts inside
-  // the sphere but not on the object (a point of the ground under it) has no surface of its own
-  // to skip: use 0.
+  // d2 < d1 - bias * R. Negative: the default, defaultIntraBias(field). Only for
+  // RayOrigin::kOnObject: a ray that starts off the object (a point of the ground under it) has no
+  // surface of its own to skip, and is answered by section 7.4 instead (origin above).
   float intraBias = -1.0f;
 };
 
@@ -133,7 +152,8 @@ struct QueryHit {
   Vec3 point;              // origin + t * direction (object space for FieldQuery, world for Instance)
   Vec3 normal;             // unit surface normal, when hasNormal (object or world space, as point)
   bool hasNormal = false;  // the field has a normal plane and the ray hit
-  bool inside = false;     // the origin was inside the bounding sphere (answered by section 7.3)
+  bool inside = false;     // answered by section 7.3 (the origin was inside the bounding sphere, and
+                           // the ray started on the object or, off it, in a hollow of it)
 };
 
 // A query-ready view of one field. Borrows its maps: from a File (which must outlive the

@@ -25,19 +25,24 @@
 // segment never reaches: those answer a miss and a visibility of 1 anyway, so culling changes no
 // answer.
 //
-// Rays that start on an object. Each instance answers as Instance does: a ray whose origin lies
-// inside an instance's bounding sphere is answered for that instance by the intra-object test
-// (spec/geometry.md section 7.3, QueryOptions::intraBias), and for every other instance by the
-// inter-object lookup. A ray cast from a point of instance k's surface is therefore answered by
-// the intra-object test for k and the lookup for the rest, with no flag from the caller.
+// Rays that start on an object. A ray whose origin lies inside an instance's bounding sphere
+// starts either on that object's surface or somewhere else inside its sphere (the ground under
+// it, another object touching it), and the field answers the two differently (vff/query.h,
+// RayOrigin; spec/geometry.md sections 7.3 and 7.4). The *From functions take each ray's source:
+// the id of the instance the ray starts on, or kNoInstance. That instance answers the ray by
+// section 7.3 with options.intraBias; every other instance by section 7.4, which finds the first
+// surface ahead, so contact shadows stay at any ray range. This is what a renderer wants: the
+// source is the object its G-buffer pixel or its path vertex lies on.
 //
-// Overlapping spheres. Where the bounding spheres of two instances overlap (objects close to or
-// touching each other), a ray from a point of one that lies inside the other's sphere is answered
-// for that other object by the intra-object test as well: the field then reports the LAST surface
-// of that object before the ray leaves its sphere (vff/query.h), which can be beyond a nearer
-// surface of it, and the intra bias (a fraction of its radius) can hide a surface closer than the
-// bias. Between the two objects, occlusion is approximate by that much; elsewhere overlap costs
-// nothing but the extra lookups of the instances whose spheres the ray crosses.
+//   std::vector<uint32_t> sources(rays.size());   // per ray: the instance it starts on, or
+//   ...                                           // vff::kNoInstance (the ground)
+//   vff::Status s = scene.occludedFrom(rays, sources, blocked);
+//
+// The functions without sources apply options.origin to every instance: by default
+// (RayOrigin::kOnObject) every instance whose sphere holds the origin answers by section 7.3, as if
+// the ray started on each of them. For a ray from the ground under an object, or from one object
+// into the sphere of another it touches, that reports the LAST surface of the other object before
+// the ray leaves its sphere, and loses the contact shadow at ranges below 2R: pass sources.
 //
 // Speed. The batch functions send a chunk of rays down the hierarchy together (each node tested
 // once against the rays that reached it), take each (ray, instance) pair into the instance's
@@ -113,6 +118,20 @@ class VFF_API Scene {
   Status intersect(std::span<const Ray> rays, std::span<SceneHit> out, const QueryOptions& options = {}) const;
   Status occluded(std::span<const Ray> rays, std::span<uint8_t> out, const QueryOptions& options = {}) const;
   Status visibility(std::span<const Ray> rays, std::span<float> out, const QueryOptions& options = {}) const;
+
+  // The same queries for rays with sources (see above): sources[r] (or `source`) is the id of the
+  // instance ray r starts on, or kNoInstance when it starts on none; options.origin is not used.
+  // Errors: those above; kInvalidArgument when sources.size() differs from rays.size();
+  // kOutOfRange for a source that is neither an instance's id nor kNoInstance.
+  Result<SceneHit> intersectFrom(const Ray& ray, uint32_t source, const QueryOptions& options = {}) const;
+  Result<bool> occludedFrom(const Ray& ray, uint32_t source, const QueryOptions& options = {}) const;
+  Result<float> visibilityFrom(const Ray& ray, uint32_t source, const QueryOptions& options = {}) const;
+  Status intersectFrom(std::span<const Ray> rays, std::span<const uint32_t> sources, std::span<SceneHit> out,
+                       const QueryOptions& options = {}) const;
+  Status occludedFrom(std::span<const Ray> rays, std::span<const uint32_t> sources, std::span<uint8_t> out,
+                      const QueryOptions& options = {}) const;
+  Status visibilityFrom(std::span<const Ray> rays, std::span<const uint32_t> sources, std::span<float> out,
+                        const QueryOptions& options = {}) const;
 
   // The instance ids whose enlarged world spheres the ray's [tmin, tmax] segment reaches, in
   // ascending order (what the queries consider). Errors: kBadState when not committed.

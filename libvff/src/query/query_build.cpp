@@ -78,6 +78,7 @@ void FieldQuery::Impl::build() {
   const float r = kQueryKernelSpacings * spacing;
   kernelRadius2 = r * r;
   defaultBias = defaultIntraBias(field);
+  offTolerance = 2.0f * radius / 255.0f;
   if (field.distanceEncoding == DistanceEncoding::kUnorm8Chord) {
     chordScale.resize(size_t(m) * m);
     for (uint32_t j = 0; j < m; ++j)
@@ -225,6 +226,7 @@ detail::GroupTables FieldQuery::Impl::groupTables(const QueryOptions& o, bool de
   t.m = m;
   t.bit1 = field.distanceEncoding == DistanceEncoding::kBit1;
   t.insideLo = (o.intraBias >= 0 ? o.intraBias : defaultBias) * radius;
+  t.offObject = o.origin == RayOrigin::kOffObject;
   t.gridGuard = detail::gridGuard(t.octaN);
   t.texelGuard = detail::texelGuard(m);
   t.maps = dist.data();
@@ -234,7 +236,9 @@ detail::GroupTables FieldQuery::Impl::groupTables(const QueryOptions& o, bool de
     t.texels = dist[0];
     t.mapBytes = int32_t(distMapBytes);
   }
-  t.decodeHits = decodeHits && byteTexels && field.distanceEncoding == DistanceEncoding::kUnorm8Diameter;
+  // (Section 7.4's step 3 needs a second lookup: off-object rays are decoded by offHitsAt.)
+  t.decodeHits = decodeHits && byteTexels && field.distanceEncoding == DistanceEncoding::kUnorm8Diameter &&
+                 !t.offObject;
   t.distanceScale = distanceStep;
   return t;
 }

@@ -148,6 +148,8 @@ struct VFF_HIDDEN FieldQuery::Impl {  // (VFF_HIDDEN: not exported with its clas
   float spacing = 0;                 // mean angular spacing sqrt(4 pi / mapCount)
   float kernelRadius2 = 0;           // squared chord radius of the interpolation kernel
   float defaultBias = 0;             // fraction of R
+  // Section 7.4's tolerance near the origin, in object units (2R/255).
+  float offTolerance = 0;
   // quantizationStep (encoding.h) of the diameter encodings: a code's distance. build() takes it
   // once, so that every decoder of a texel (texel(), the group kernel's decode and blend) scales
   // by the same value.
@@ -218,7 +220,8 @@ struct VFF_HIDDEN FieldQuery::Impl {  // (VFF_HIDDEN: not exported with its clas
   struct Lookup {
     Vec3 w, v, eu;
     float len = 0, t0 = 0, lo = 0, hi = 0;
-    bool inside = false;
+    bool inside = false;  // answered by section 7.3: the reversed lookup from the exit point
+    bool off = false;     // answered by section 7.4: the origin is inside the sphere, t0 < 0
     uint32_t k0 = 0, i = 0, j = 0;  // i, j: the nearest lookup's texel
   };
   bool prepare(const Ray& ray, const QueryOptions& o, Lookup* l) const noexcept;
@@ -226,6 +229,29 @@ struct VFF_HIDDEN FieldQuery::Impl {  // (VFF_HIDDEN: not exported with its clas
   // (the group kernel's, for interpolated batches).
   void lookupFrom(const Ray& ray, float len, float t0, bool inside, float lo, float hi, Lookup* l) const noexcept;
   QueryHit nearestHit(const Ray& ray, const Lookup& l, float* visibility) const noexcept;
+  // The kNearest answer of a prepared lookup: nearestHit, or offHitAt for section 7.4.
+  QueryHit nearestAnswer(const Ray& ray, const Lookup& l, float* visibility) const noexcept {
+    return l.off ? offHitAt(ray, l.k0, l.i, l.j, l.t0, l.lo, l.hi, l.len, visibility) : nearestHit(ray, l, visibility);
+  }
+  // Section 7.4 (RayOrigin::kOffObject, origin inside the sphere). offHitAt: the nearest answer
+  // from the forward lookup's texel (k, i, j) at entry distance t0 < 0 and window [lo, hi];
+  // offHitsAt: its hit flag; behindOrigin: step 3, section 7.3 with no bias; offInterpolated: the
+  // blend of a planned lane.
+  QueryHit offHitAt(const Ray& ray, uint32_t k, uint32_t i, uint32_t j, float t0, float lo, float hi, float len,
+                    float* visibility) const noexcept;
+  bool offHitsAt(const Ray& ray, uint32_t k, uint32_t i, uint32_t j, float t0, float lo, float hi) const noexcept;
+  QueryHit behindOrigin(const Ray& ray, float* visibility) const noexcept;
+  // Whether the forward lookup's first surface lies behind the origin by more than the tolerance
+  // (step 3 applies).
+  bool behindAt(uint32_t k, uint32_t i, uint32_t j, float t0, float lo) const noexcept {
+    const detail::Sample s = texel(k, i, j);
+    return s.hit && t0 + s.distance < lo - offTolerance;
+  }
+  QueryHit offInterpolated(const Ray& ray, const Lookup& l, const detail::PlanBlock& plan, size_t lane,
+                           const detail::BlendSums* sums, float* visibility) const noexcept;
+  // A hit at distance t (along the unit direction) read from texel (i, j) of map k.
+  QueryHit hitOf(const Ray& ray, uint32_t k, uint32_t i, uint32_t j, float t, bool inside, float len,
+                 float* visibility) const noexcept;
   // The answer of a nearest lookup at texel (i, j) of map k (nearestHit, from its parts).
   QueryHit hitAt(const Ray& ray, uint32_t k, uint32_t i, uint32_t j, float t0, bool inside, float lo, float hi,
                  float len, float* visibility) const noexcept;
@@ -312,6 +338,8 @@ struct VFF_HIDDEN FieldQuery::Impl {  // (VFF_HIDDEN: not exported with its clas
   // kHitOnly: emit(base, n, hits) per run of rays; otherwise emit(r, const QueryHit&, float
   // visibility) per ray (see the definition).
   // With `to`, the rays are in world space: the kernel and prepare() take them to object space.
+  // Batches of at most this many rays (an Embree packet) skip the group kernel (batchNearest).
+  static constexpr size_t kPacketRays = 16;
   template <bool kHitOnly, class Emit>
   void batchNearest(std::span<const Ray> rays, const QueryOptions& o, const detail::ToObject* to, Emit&& emit) const noexcept;
   // The batch calls of FieldQuery (x null: object-space rays) and of Instance (world-space rays, x

@@ -16,6 +16,7 @@ void FieldQuery::Impl::lookupFrom(const Ray& ray, float len, float t0, bool insi
   l->len = len;
   l->t0 = t0;
   l->inside = inside;
+  l->off = !inside && t0 < 0;  // (only RayOrigin::kOffObject leaves t0 below 0)
   l->v = inside ? -w : w;
   l->lo = lo;
   l->hi = hi;
@@ -36,15 +37,19 @@ bool FieldQuery::Impl::prepare(const Ray& ray, const QueryOptions& o, Lookup* l)
   const float sq = std::sqrt(disc);
   const float t1 = -beta + sq;
   if (t1 < 0) return false;
-  const bool inside = gamma <= 0;
-  // The lookup: the ray enters at `e` looking along `v`. From inside (section 7.3) the reversed
-  // ray enters at the exit point, looking back at the origin.
-  const float t0 = inside ? t1 : std::max(-beta - sq, 0.0f);  // the lookup's entry point along the ray
-  // A hit counts when its t lies in [lo, hi]. From inside, the surface must also be more than the
-  // bias in front of the origin (the origin's own surface is not an occluder).
+  const bool inSphere = gamma <= 0;
+  const bool offObject = o.origin == RayOrigin::kOffObject;
+  const bool inside = inSphere && !offObject;
+  if (inSphere && field.distanceEncoding == DistanceEncoding::kBit1) return false;  // no distances: cannot tell
+  // The lookup: the ray enters at `e` looking along `v`. On the object (section 7.3) the reversed
+  // ray enters at the exit point, looking back at the origin; off it (section 7.4) the ray
+  // extended backwards enters before the origin, at a negative t0.
+  const float tIn = -beta - sq;
+  const float t0 = inside ? t1 : (offObject && inSphere ? tIn : std::max(tIn, 0.0f));
+  // A hit counts when its t lies in [lo, hi]. On the object, the surface must also be more than
+  // the bias in front of the origin (the origin's own surface is not an occluder).
   float lo = tmin;
   if (inside) {
-    if (field.distanceEncoding == DistanceEncoding::kBit1) return false;  // no distances: cannot tell
     const float bias = o.intraBias >= 0 ? o.intraBias : defaultBias;
     lo = std::max(lo, bias * radius);
   }
@@ -63,9 +68,14 @@ QueryHit FieldQuery::Impl::nearestHit(const Ray& ray, const Lookup& l, float* vi
 
 QueryHit FieldQuery::Impl::hitAt(const Ray& ray, uint32_t k, uint32_t i, uint32_t j, float t0, bool inside, float lo,
                                  float hi, float len, float* visibility) const noexcept {
-  QueryHit out;
   float t = 0;
-  if (!hitsAt(k, i, j, t0, inside, lo, hi, &t)) return out;
+  if (!hitsAt(k, i, j, t0, inside, lo, hi, &t)) return {};
+  return hitOf(ray, k, i, j, t, inside, len, visibility);
+}
+
+QueryHit FieldQuery::Impl::hitOf(const Ray& ray, uint32_t k, uint32_t i, uint32_t j, float t, bool inside, float len,
+                                 float* visibility) const noexcept {
+  QueryHit out;
   if (visibility) *visibility = 0.0f;
   out.hit = true;
   out.inside = inside;
@@ -84,8 +94,68 @@ QueryHit FieldQuery::Impl::query(const Ray& ray, const QueryOptions& o, float* v
   if (!prepare(ray, o, &l)) return {};
   // From inside, kInterpolated answers like kNearest: the blended samples' rays pass beside the
   // origin and take its own surface for an occluder (tests/query, intra-object occlusion).
-  if (o.reconstruction == Reconstruction::kNearest || l.inside) return nearestHit(ray, l, visibility);
+  if (o.reconstruction == Reconstruction::kNearest || l.inside) return nearestAnswer(ray, l, visibility);
   return interpolated(ray, l, visibility);
+}
+
+// Section 7.4. Step 1 is the lookup at (k, i, j) from the entry point at t0 < 0; a surface within
+// the tolerance behind lo touches the origin and counts as a hit at lo (step 2).
+QueryHit FieldQuery::Impl::offHitAt(const Ray& ray, uint32_t k, uint32_t i, uint32_t j, float t0, float lo, float hi,
+                                    float len, float* visibility) const noexcept {
+  const detail::Sample s = texel(k, i, j);
+  if (!s.hit) return {};
+  const float t = t0 + s.distance;
+  if (t < lo - offTolerance) return behindOrigin(ray, visibility);  // step 3
+  if (t > hi) return {};
+  return hitOf(ray, k, i, j, std::max(t, lo), false, len, visibility);
+}
+
+bool FieldQuery::Impl::offHitsAt(const Ray& ray, uint32_t k, uint32_t i, uint32_t j, float t0, float lo,
+                                 float hi) const noexcept {
+  const detail::Sample s = texel(k, i, j);
+  if (!s.hit) return false;
+  const float t = t0 + s.distance;
+  if (t < lo - offTolerance) return behindOrigin(ray, nullptr).hit;
+  return t <= hi;
+}
+
+// Step 3: the origin lies in a hollow of the object (or inside it), so the forward lookup says
+// nothing of the part after it; section 7.3 with no bias (the origin has no surface of its own
+// here to skip) finds whether any surface lies ahead.
+QueryHit FieldQuery::Impl::behindOrigin(const Ray& ray, float* visibility) const noexcept {
+  QueryOptions o;
+  o.intraBias = 0.0f;
+  Lookup l;
+  if (!prepare(ray, o, &l)) return {};
+  return nearestHit(ray, l, visibility);
+}
+
+// Interpolated, section 7.4: step 3 when the nearest sample's lookup lies behind the origin;
+// otherwise the blend of the planned lane over [lo - tolerance, hi], its distance clamped to lo
+// (sums: the kernel's blend of the lane, already made over that window).
+QueryHit FieldQuery::Impl::offInterpolated(const Ray& ray, const Lookup& l, const detail::PlanBlock& plan,
+                                           size_t lane, const detail::BlendSums* sums,
+                                           float* visibility) const noexcept {
+  if (behindAt(l.k0, l.i, l.j, l.t0, l.lo)) return behindOrigin(ray, visibility);
+  Lookup wide = l;
+  wide.lo = l.lo - offTolerance;
+  QueryHit h;
+  if (sums) {
+    detail::Blend bl;
+    bl.hitWeight = sums->hit[lane];
+    bl.missWeight = sums->miss[lane];
+    bl.farWeight = sums->far[lane];
+    bl.tSum = sums->tSum[lane];
+    bl.normalSum = {sums->nx[lane], sums->ny[lane], sums->nz[lane]};
+    h = blendResult(ray, wide, bl, visibility);
+  } else {
+    h = blendInterpolated(ray, wide, plan, lane, visibility);
+  }
+  if (h.hit && h.t * l.len < l.lo) {
+    h.t = l.lo / l.len;
+    h.point = ray.origin + l.w * l.lo;
+  }
+  return h;
 }
 
 // Interpolated: the kernel's samples, each looked up along v from its own sample point (parallel
@@ -180,6 +250,7 @@ QueryHit FieldQuery::Impl::interpolated(const Ray& ray, const Lookup& l, float* 
   needNeighbours();
   detail::PlanBlock plan;  // (lane 0 only)
   planInterpolated(ray, l, &plan, 0);
+  if (l.off) return offInterpolated(ray, l, plan, 0, nullptr, visibility);
   return blendInterpolated(ray, l, plan, 0, visibility);
 }
 

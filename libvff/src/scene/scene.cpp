@@ -150,14 +150,25 @@ void Scene::Impl::gather(const Ray& ray, std::vector<uint32_t>* ids) const {
   std::sort(ids->begin(), ids->end());
 }
 
-Result<SceneHit> Scene::intersect(const Ray& ray, const QueryOptions& options) const {
-  if (Status s = Impl::ready(impl_.get()); !s) return std::move(s).error();
+namespace {
+
+// The options instance `id` answers a ray with: the caller's, or, for a ray with a source, section
+// 7.3's for the instance it starts on and section 7.4's for the rest.
+struct OptionsFor {
+  const QueryOptions& options;
+  const uint32_t* source;  // null: options as given
+  QueryOptions operator()(uint32_t id) const noexcept {
+    QueryOptions o = options;
+    if (source) o.origin = id == *source ? RayOrigin::kOnObject : RayOrigin::kOffObject;
+    return o;
+  }
+};
+
+SceneHit nearest(const Scene::Impl& m, const Ray& ray, OptionsFor options) {
   SceneHit best;
-  if (!impl_) return best;
-  const Impl& m = *impl_;
   const float margin = m.margin(ray);
   m.bvh.walk(detail::boxRay(ray), [&](uint32_t id) {
-    const QueryHit h = m.instances[id].intersect(ray, options);
+    const QueryHit h = m.instances[id].intersect(ray, options(id));
     if (h.hit && (h.t < best.t || (h.t == best.t && id < best.instance))) {
       static_cast<QueryHit&>(best) = h;
       best.instance = id;
@@ -170,26 +181,63 @@ Result<SceneHit> Scene::intersect(const Ray& ray, const QueryOptions& options) c
   return best;
 }
 
-Result<bool> Scene::occluded(const Ray& ray, const QueryOptions& options) const {
-  if (Status s = Impl::ready(impl_.get()); !s) return std::move(s).error();
+bool anyOccludes(const Scene::Impl& m, const Ray& ray, OptionsFor options) {
   bool any = false;
-  if (!impl_) return any;
-  const Impl& m = *impl_;
   m.bvh.walk(detail::boxRay(ray), [&](uint32_t id) {
-    any = m.instances[id].occluded(ray, options);
+    any = m.instances[id].occluded(ray, options(id));
     return any ? -1.0f : ray.tmax;
   });
   return any;
 }
 
+float product(const Scene::Impl& m, const Ray& ray, OptionsFor options) {
+  float v = 1.0f;
+  std::vector<uint32_t> ids;
+  m.gather(ray, &ids);
+  for (uint32_t id : ids) v *= m.instances[id].visibility(ray, options(id));
+  return v;
+}
+
+Status checkSource(const Scene::Impl* m, uint32_t source) {
+  const size_t n = m ? m->instances.size() : 0;
+  if (source == kNoInstance || source < n) return {};
+  return makeError(Code::kOutOfRange, "scene: source " + std::to_string(source) + " is no instance (the scene has " +
+                                          std::to_string(n) + "; kNoInstance for none)");
+}
+
+}  // namespace
+
+Result<SceneHit> Scene::intersect(const Ray& ray, const QueryOptions& options) const {
+  if (Status s = Impl::ready(impl_.get()); !s) return std::move(s).error();
+  return impl_ ? nearest(*impl_, ray, {options, nullptr}) : SceneHit{};
+}
+
+Result<bool> Scene::occluded(const Ray& ray, const QueryOptions& options) const {
+  if (Status s = Impl::ready(impl_.get()); !s) return std::move(s).error();
+  return impl_ && anyOccludes(*impl_, ray, {options, nullptr});
+}
+
 Result<float> Scene::visibility(const Ray& ray, const QueryOptions& options) const {
   if (Status s = Impl::ready(impl_.get()); !s) return std::move(s).error();
-  float v = 1.0f;
-  if (!impl_) return v;
-  std::vector<uint32_t> ids;
-  impl_->gather(ray, &ids);
-  for (uint32_t id : ids) v *= impl_->instances[id].visibility(ray, options);
-  return v;
+  return impl_ ? product(*impl_, ray, {options, nullptr}) : 1.0f;
+}
+
+Result<SceneHit> Scene::intersectFrom(const Ray& ray, uint32_t source, const QueryOptions& options) const {
+  if (Status s = Impl::ready(impl_.get()); !s) return std::move(s).error();
+  if (Status s = checkSource(impl_.get(), source); !s) return std::move(s).error();
+  return impl_ ? nearest(*impl_, ray, {options, &source}) : SceneHit{};
+}
+
+Result<bool> Scene::occludedFrom(const Ray& ray, uint32_t source, const QueryOptions& options) const {
+  if (Status s = Impl::ready(impl_.get()); !s) return std::move(s).error();
+  if (Status s = checkSource(impl_.get(), source); !s) return std::move(s).error();
+  return impl_ && anyOccludes(*impl_, ray, {options, &source});
+}
+
+Result<float> Scene::visibilityFrom(const Ray& ray, uint32_t source, const QueryOptions& options) const {
+  if (Status s = Impl::ready(impl_.get()); !s) return std::move(s).error();
+  if (Status s = checkSource(impl_.get(), source); !s) return std::move(s).error();
+  return impl_ ? product(*impl_, ray, {options, &source}) : 1.0f;
 }
 
 Result<std::vector<uint32_t>> Scene::candidates(const Ray& ray) const {

@@ -112,24 +112,81 @@ void answerPairs(const Scene::Impl& m, const Pairs& p, std::vector<T>* answers, 
   }
 }
 
-}  // namespace
+// With sources (chunk-relative; null: none), answers again the pairs whose ray starts on their own
+// instance, with section 7.3's options (answerPairs gave every pair section 7.4's): once per
+// field, over the own pairs of all its instances.
+template <class T, class Answer>
+void answerOwnPairs(const Scene::Impl& m, const Pairs& p, const uint32_t* sources, const QueryOptions& on,
+                    std::vector<T>* answers, Answer&& answer) {
+  if (!sources) return;
+  std::vector<Ray> rays;
+  std::vector<uint32_t> at;
+  for (size_t g = 0; g + 1 < m.fieldStart.size(); ++g) {
+    rays.clear();
+    at.clear();
+    for (uint32_t f = m.fieldStart[g]; f < m.fieldStart[g + 1]; ++f) {
+      const uint32_t id = m.byField[f];
+      for (uint32_t k = p.first[id]; k < p.first[id] + p.count[id]; ++k)
+        if (sources[p.ray[k]] == id) {
+          rays.push_back(p.rays[k]);
+          at.push_back(k);
+        }
+    }
+    if (at.empty()) continue;
+    std::vector<T> own(at.size());
+    answer(*m.instances[m.byField[m.fieldStart[g]]].field, std::span<const Ray>(rays), std::span<T>(own), on);
+    for (size_t q = 0; q < at.size(); ++q) (*answers)[at[q]] = own[q];
+  }
+}
 
-Status Scene::intersect(std::span<const Ray> rays, std::span<SceneHit> out, const QueryOptions& options) const {
-  if (Status s = Impl::ready(impl_.get()); !s) return s;
+// The options of a call's first pass over all pairs, and of answerOwnPairs.
+struct PassOptions {
+  QueryOptions all, own;
+  PassOptions(const QueryOptions& o, bool sources) : all(o), own(o) {
+    if (sources) {
+      all.origin = RayOrigin::kOffObject;
+      own.origin = RayOrigin::kOnObject;
+    }
+  }
+};
+
+Status checkSources(const Scene::Impl* m, size_t rays, std::span<const uint32_t> sources) {
+  if (sources.size() != rays)
+    return makeError(Code::kInvalidArgument, "scene: sources has " + std::to_string(sources.size()) + " entries for " +
+                                                 std::to_string(rays) + " rays");
+  const size_t n = m ? m->instances.size() : 0;
+  for (size_t r = 0; r < sources.size(); ++r)
+    if (sources[r] != kNoInstance && sources[r] >= n)
+      return makeError(Code::kOutOfRange, "scene: sources[" + std::to_string(r) + "] = " + std::to_string(sources[r]) +
+                                              " is no instance (the scene has " + std::to_string(n) +
+                                              "; kNoInstance for none)");
+  return {};
+}
+
+// The batches, with sources (one per ray) or without (sources.data() null; with rays, checkSources
+// has made sure that a call with sources has them).
+Status intersectBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::span<const uint32_t> sources,
+                      std::span<SceneHit> out, const QueryOptions& options) {
+  if (Status s = Scene::Impl::ready(impl); !s) return s;
   if (Status s = sizes(rays.size(), out.size()); !s) return s;
   std::fill(out.begin(), out.end(), SceneHit{});
-  if (!impl_) return {};
-  const Impl& m = *impl_;
+  if (!impl) return {};
+  const Scene::Impl& m = *impl;
+  const PassOptions pass(options, sources.data() != nullptr);
   const ScratchLease lease(m);
   Scratch& s = *lease;
   const Pairs& p = s.pairs;
   std::vector<QueryHit>& hits = s.hits;
+  auto answer = [](const FieldQuery& f, std::span<const Ray> r, std::span<QueryHit> h, const QueryOptions& o) {
+    f.intersect(r, h, o);
+  };
   for (size_t c = 0; c < rays.size(); c += kChunk) {
     const std::span<const Ray> chunk = rays.subspan(c, std::min(kChunk, rays.size() - c));
     pairUp(m, chunk, &s);
     answerPairs(m, p, &hits, [&](const FieldQuery& f, std::span<const Ray> r, std::span<QueryHit> h) {
-      f.intersect(r, h, options);
+      answer(f, r, h, pass.all);
     });
+    answerOwnPairs(m, p, sources.data() ? sources.data() + c : nullptr, pass.own, &hits, answer);
     for (uint32_t i = 0; i < m.instances.size(); ++i)
       for (uint32_t k = p.first[i]; k < p.first[i] + p.count[i]; ++k) {
         SceneHit& best = out[c + p.ray[k]];
@@ -144,47 +201,91 @@ Status Scene::intersect(std::span<const Ray> rays, std::span<SceneHit> out, cons
   return {};
 }
 
-Status Scene::occluded(std::span<const Ray> rays, std::span<uint8_t> out, const QueryOptions& options) const {
-  if (Status s = Impl::ready(impl_.get()); !s) return s;
+Status occludedBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::span<const uint32_t> sources,
+                     std::span<uint8_t> out, const QueryOptions& options) {
+  if (Status s = Scene::Impl::ready(impl); !s) return s;
   if (Status s = sizes(rays.size(), out.size()); !s) return s;
   std::fill(out.begin(), out.end(), uint8_t(0));
-  if (!impl_) return {};
-  const Impl& m = *impl_;
+  if (!impl) return {};
+  const Scene::Impl& m = *impl;
+  const PassOptions pass(options, sources.data() != nullptr);
   const ScratchLease lease(m);
   Scratch& s = *lease;
   const Pairs& p = s.pairs;
   std::vector<uint8_t>& blocked = s.blocked;
+  auto answer = [](const FieldQuery& f, std::span<const Ray> r, std::span<uint8_t> o, const QueryOptions& q) {
+    f.occluded(r, o, q);
+  };
   for (size_t c = 0; c < rays.size(); c += kChunk) {
     const std::span<const Ray> chunk = rays.subspan(c, std::min(kChunk, rays.size() - c));
     pairUp(m, chunk, &s);
     answerPairs(m, p, &blocked, [&](const FieldQuery& f, std::span<const Ray> r, std::span<uint8_t> o) {
-      f.occluded(r, o, options);
+      answer(f, r, o, pass.all);
     });
+    answerOwnPairs(m, p, sources.data() ? sources.data() + c : nullptr, pass.own, &blocked, answer);
     for (size_t k = 0; k < p.ray.size(); ++k) out[c + p.ray[k]] |= blocked[k];
   }
   return {};
 }
 
-Status Scene::visibility(std::span<const Ray> rays, std::span<float> out, const QueryOptions& options) const {
-  if (Status s = Impl::ready(impl_.get()); !s) return s;
+Status visibilityBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::span<const uint32_t> sources,
+                       std::span<float> out, const QueryOptions& options) {
+  if (Status s = Scene::Impl::ready(impl); !s) return s;
   if (Status s = sizes(rays.size(), out.size()); !s) return s;
   std::fill(out.begin(), out.end(), 1.0f);
-  if (!impl_) return {};
-  const Impl& m = *impl_;
+  if (!impl) return {};
+  const Scene::Impl& m = *impl;
+  const PassOptions pass(options, sources.data() != nullptr);
   const ScratchLease lease(m);
   Scratch& s = *lease;
   const Pairs& p = s.pairs;
   std::vector<float>& vis = s.vis;
+  auto answer = [](const FieldQuery& f, std::span<const Ray> r, std::span<float> o, const QueryOptions& q) {
+    f.visibility(r, o, q);
+  };
   for (size_t c = 0; c < rays.size(); c += kChunk) {
     const std::span<const Ray> chunk = rays.subspan(c, std::min(kChunk, rays.size() - c));
     pairUp(m, chunk, &s);
     answerPairs(m, p, &vis, [&](const FieldQuery& f, std::span<const Ray> r, std::span<float> o) {
-      f.visibility(r, o, options);
+      answer(f, r, o, pass.all);
     });
+    answerOwnPairs(m, p, sources.data() ? sources.data() + c : nullptr, pass.own, &vis, answer);
     for (uint32_t i = 0; i < m.instances.size(); ++i)  // the product in id order
       for (uint32_t k = p.first[i]; k < p.first[i] + p.count[i]; ++k) out[c + p.ray[k]] *= vis[k];
   }
   return {};
+}
+
+}  // namespace
+
+Status Scene::intersect(std::span<const Ray> rays, std::span<SceneHit> out, const QueryOptions& options) const {
+  return intersectBatch(impl_.get(), rays, {}, out, options);
+}
+
+Status Scene::occluded(std::span<const Ray> rays, std::span<uint8_t> out, const QueryOptions& options) const {
+  return occludedBatch(impl_.get(), rays, {}, out, options);
+}
+
+Status Scene::visibility(std::span<const Ray> rays, std::span<float> out, const QueryOptions& options) const {
+  return visibilityBatch(impl_.get(), rays, {}, out, options);
+}
+
+Status Scene::intersectFrom(std::span<const Ray> rays, std::span<const uint32_t> sources, std::span<SceneHit> out,
+                            const QueryOptions& options) const {
+  if (Status s = checkSources(impl_.get(), rays.size(), sources); !s) return s;
+  return intersectBatch(impl_.get(), rays, sources, out, options);
+}
+
+Status Scene::occludedFrom(std::span<const Ray> rays, std::span<const uint32_t> sources, std::span<uint8_t> out,
+                           const QueryOptions& options) const {
+  if (Status s = checkSources(impl_.get(), rays.size(), sources); !s) return s;
+  return occludedBatch(impl_.get(), rays, sources, out, options);
+}
+
+Status Scene::visibilityFrom(std::span<const Ray> rays, std::span<const uint32_t> sources, std::span<float> out,
+                             const QueryOptions& options) const {
+  if (Status s = checkSources(impl_.get(), rays.size(), sources); !s) return s;
+  return visibilityBatch(impl_.get(), rays, sources, out, options);
 }
 
 }  // namespace vff

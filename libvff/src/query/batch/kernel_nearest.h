@@ -43,10 +43,14 @@ void sphereStep(const GroupTables& tb, const Ray* rays, Group* g, size_t r0, Loo
   const F nbeta = vneg(beta);
   const F t1 = nbeta + sq;
   live = band(live, nlt(t1, zero));
-  const auto inside = le(gamma, zero);
-  const F t0 = sel(inside, t1, maxStd(nbeta - sq, zero));
+  const auto inSphere = le(gamma, zero);
+  const F tIn = nbeta - sq;
+  // Off the object (section 7.4) a ray from inside looks up forward from its negative entry
+  // distance; on it (section 7.3), backward from the exit point.
+  const auto inside = tb.offObject ? band(inSphere, bnot(inSphere)) : inSphere;
+  const F t0 = tb.offObject ? sel(inSphere, tIn, maxStd(tIn, zero)) : sel(inside, t1, maxStd(tIn, zero));
   const F lo = sel(inside, maxStd(tminL, F(tb.insideLo)), tminL);
-  if (tb.bit1) live = bandnot(inside, live);
+  if (tb.bit1) live = bandnot(inSphere, live);
   live = bandnot(bandnot(inside, gt(t0, tmaxL)), live);
   const F vx = sel(inside, vneg(wx), wx), vy = sel(inside, vneg(wy), wy), vz = sel(inside, vneg(wz), wz);
   const F invR(1.0f / tb.radius);

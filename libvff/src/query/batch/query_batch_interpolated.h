@@ -12,8 +12,8 @@ namespace vff {
 // third of the AO rays reach the sphere: blocks cut at each group's end would run part-empty), and
 // each block is planned together (the kernel's plan(), as planInterpolated() one ray at a time)
 // with all its taps' texels requested from memory, then blended, 16 at a time too where the kernel
-// can (its blend(), as blendInterpolated() one ray at a time). Rays from inside the sphere are
-// answered as kNearest (query()). (Blending a block while the next is planned, so that its texels
+// can (its blend(), as blendInterpolated() one ray at a time). Rays answered by section 7.3 are
+// answered as kNearest (query()); section 7.4's as offInterpolated() says. (Blending a block while the next is planned, so that its texels
 // had longer to arrive, gained nothing measurable.)
 template <class Emit>
 void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryOptions& o, Emit&& emit) const noexcept {
@@ -40,7 +40,7 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
       for (size_t c = 0; c < kPlanned; ++c) {
         const bool blended = c < count && live[c] && !l[c].inside;
         any = any || blended;
-        br.lo[c] = blended ? l[c].lo : 0.0f;
+        br.lo[c] = blended ? (l[c].off ? l[c].lo - offTolerance : l[c].lo) : 0.0f;  // (offInterpolated's window)
         br.hi[c] = blended ? l[c].hi : 0.0f;
       }
       if (any && kernel && kernel->blend) {
@@ -54,6 +54,8 @@ void FieldQuery::Impl::batchInterpolated(std::span<const Ray> rays, const QueryO
       QueryHit h;
       if (live[c] && l[c].inside) {
         h = nearestHit(ray, l[c], &vis);
+      } else if (live[c] && l[c].off) {
+        h = offInterpolated(ray, l[c], plan, c, summed ? &sums : nullptr, &vis);
       } else if (live[c] && summed) {
         detail::Blend bl;
         bl.hitWeight = sums.hit[c];

@@ -18,10 +18,32 @@ template <bool kHitOnly, class Emit>
 void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOptions& o, const detail::ToObject* to,
                                     Emit&& emit) const noexcept {
   auto objectRay = [&](size_t r) { return to ? to->ray(rays[r]) : rays[r]; };
-  // A batch of one ray (an Embree callback for rtcIntersect1 or rtcOccluded1) takes the reference
-  // path: a group's fixed cost is larger than the ray's own, and there are no other texel reads
-  // for its read to overlap. (batchInterpolated does the same.)
-  const detail::GroupKernel* kernel = rays.size() > 1 ? detail::groupKernel() : nullptr;
+  // A packet (an Embree callback's 1, 4, 8 or 16 rays) takes the reference steps without the
+  // group kernel, whose fixed cost is larger than a packet's own: every ray prepared, then all
+  // their texels requested from memory, then decoded, so that their reads overlap.
+  if (rays.size() <= kPacketRays) {
+    Ray local[kPacketRays];
+    Lookup l[kPacketRays];
+    bool live[kPacketRays];
+    for (size_t r = 0; r < rays.size(); ++r) {
+      local[r] = objectRay(r);
+      live[r] = prepare(local[r], o, &l[r]);
+      if (live[r]) __builtin_prefetch(texelAddress(l[r].k0, l[r].i, l[r].j));
+    }
+    uint64_t hits = 0;
+    for (size_t r = 0; r < rays.size(); ++r) {
+      float vis = 1.0f;
+      const QueryHit h = live[r] ? nearestAnswer(local[r], l[r], &vis) : QueryHit{};
+      if constexpr (kHitOnly) {
+        hits |= uint64_t(h.hit) << r;
+      } else {
+        emit(r, h, vis);
+      }
+    }
+    if constexpr (kHitOnly) emit(size_t(0), rays.size(), hits);
+    return;
+  }
+  const detail::GroupKernel* kernel = detail::groupKernel();
   if (!kernel) {
     for (size_t base = 0; base < rays.size(); base += detail::kGroupRays) {
       const size_t n = std::min(detail::kGroupRays, rays.size() - base);
@@ -30,7 +52,7 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
         float vis = 1.0f;
         Lookup l;
         const Ray ray = objectRay(base + r);
-        const QueryHit h = prepare(ray, o, &l) ? nearestHit(ray, l, &vis) : QueryHit{};
+        const QueryHit h = prepare(ray, o, &l) ? nearestAnswer(ray, l, &vis) : QueryHit{};
         if constexpr (kHitOnly) {
           hits |= uint64_t(h.hit) << r;
         } else {
@@ -73,16 +95,24 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
       const uint64_t left = tables.decodeHits ? g.redo : detail::packedBits(g.count);
       for (uint64_t todo = left & ~dead; todo != 0; todo &= todo - 1) {
         const uint32_t p = uint32_t(__builtin_ctzll(todo)), r = g.ray[p];
-        if (hitsAt(g.k[p], g.i[p], g.j[p], g.t0[r], (g.inside >> r) & 1u, g.lo[r], g.hi[r])) hits |= uint64_t(1) << r;
+        // (t0 < 0: an off-object ray from inside the sphere, section 7.4)
+        const bool hit = g.t0[r] < 0 ? offHitsAt(objectRay(base + r), g.k[p], g.i[p], g.j[p], g.t0[r], g.lo[r], g.hi[r])
+                                     : hitsAt(g.k[p], g.i[p], g.j[p], g.t0[r], (g.inside >> r) & 1u, g.lo[r], g.hi[r]);
+        if (hit) hits |= uint64_t(1) << r;
       }
       emit(base, n, hits);
     } else {
       for (uint32_t p = 0; p < g.count; ++p) {
         const uint32_t r = g.ray[p];
         float vis = 1.0f;
-        const QueryHit h = (dead >> p) & 1u ? QueryHit{}
-                                            : hitAt(objectRay(base + r), g.k[p], g.i[p], g.j[p], g.t0[r],
-                                                    (g.inside >> r) & 1u, g.lo[r], g.hi[r], g.len[r], &vis);
+        QueryHit h;
+        if ((dead >> p) & 1u) {
+        } else if (g.t0[r] < 0) {
+          h = offHitAt(objectRay(base + r), g.k[p], g.i[p], g.j[p], g.t0[r], g.lo[r], g.hi[r], g.len[r], &vis);
+        } else {
+          h = hitAt(objectRay(base + r), g.k[p], g.i[p], g.j[p], g.t0[r], (g.inside >> r) & 1u, g.lo[r], g.hi[r],
+                    g.len[r], &vis);
+        }
         emit(base + r, h, vis);
       }
     }

@@ -51,6 +51,7 @@ struct GroupTables {
   uint32_t m = 0;                   // map resolution
   bool bit1 = false;                // the distance encoding has no distances (rays from inside miss)
   float insideLo = 0;               // intra-object bias times the radius (QueryOptions::intraBias)
+  bool offObject = false;           // RayOrigin::kOffObject: rays from inside look up forward from a t0 < 0
   float gridGuard = 0, texelGuard = 0;  // fast_lookup.h's gridGuard(octaN) and texelGuard(m)
   // The distance maps, to prefetch the texels while the group is being looked up (null: none).
   const uint8_t* const* maps = nullptr;
