@@ -1,56 +1,37 @@
 // vff_query.glsl - the visibility-field lookup in GLSL 4.30 core (spec/geometry.md section 7,
 // spec/positions.md, spec/format.md "Packed slice layout" and "Value encodings").
 //
-// Include it after `#version 430` (or later). It answers the same rays as the CPU query
-// vff::FieldQuery::intersect with Reconstruction::kNearest (libvff/src/query/query_ray.cpp): the same
-// sphere test, the same nearest positional sample, the same texel and the same decoded distance,
-// up to rounding of atan/sqrt/division near a texel or sample boundary (spec/geometry.md section 8).
+// Include it after `#version 430` (or later). It answers rays as vff::FieldQuery does (query_ray.cpp),
+// up to rounding near a texel or sample boundary (spec/geometry.md section 8).
 //
-// Resources (filled by the C++ loader vff::gl::loadField, gpu/loader/include/vff/gl/loader.h):
-//   binding VFF_FIELD_BINDING      (default 0): uniform block VffFieldBlock (std140, vff::gl::FieldBlock)
-//   binding VFF_MAPS_BINDING       (default 1): the packed distance slices, usampler2DArray
-//                                               (usampler3D when VFF_MAPS_3D is defined);
-//                                               R8UI for unorm8-* and bit1, R16UI for unorm16-diameter;
-//                                               for bc4-diameter define VFF_MAPS_BC4: a sampler2DArray
-//                                               of GL_COMPRESSED_RED_RGTC1 (vff::gl::shaderDefines
-//                                               gives the defines a field needs)
-//   binding VFF_POSITIONS_BINDING  (default 2): buffer VffPositionsBlock, the binary32 unit vectors
-//                                               of the samples (vff::PositionSet::position), one vec4
-//                                               each, then (unorm8-chord) the per-texel decode scales,
-//                                               then the neighbour lists of kInterpolated
-//   binding VFF_NORMALS_BINDING    (default 3): the packed normal slices (oct-snorm16 as GL_RG16I),
-//                                               isampler2DArray (isampler3D); read only when the
-//                                               field has normals; define VFF_NO_NORMALS to omit it
-// The three bindings are distinct numbers, so the same declarations are valid for OpenGL (where
-// uniform blocks, texture units and storage blocks are separate namespaces) and for Vulkan (one
-// namespace per descriptor set, set 0).
+// Resources (filled by the C++ loader vff::gl::loadField, gpu/loader/include/vff/gl/loader.h, which
+// documents each): bindings VFF_FIELD_BINDING (default 0, uniform block VffFieldBlock),
+// VFF_MAPS_BINDING (1, the packed distance slices; VFF_MAPS_3D, VFF_MAPS_BC4 select other texture
+// kinds: vff::gl::shaderDefines), VFF_POSITIONS_BINDING (2, buffer VffPositionsBlock) and
+// VFF_NORMALS_BINDING (3, the normal slices; VFF_NO_NORMALS omits them). Distinct numbers, so the
+// declarations are valid for OpenGL and for Vulkan (one namespace per descriptor set, set 0).
 //
 // Entry points:
 //   VffHit vffIntersect(vec3 origin, vec3 direction, float tmin, float tmax, float intraBias)
-//     direction need not be unit length; t is in multiples of it (as vff::Ray). intraBias < 0
-//     selects the field's default (vff::defaultIntraBias), as vff::QueryOptions::intraBias.
+//     direction need not be unit length; t is in multiples of it (as vff::Ray). intraBias says how
+//     a ray from inside the sphere is answered: >= 0, on the object (section 7.3) with that bias;
+//     VFF_OFF_OBJECT, off it (section 7.4: vff::RayOrigin::kOffObject); other negatives, on the
+//     object with the field's default bias (vff::defaultIntraBias).
 //   bool vffOccluded(...)  the same arguments; hit within [tmin, tmax].
 //   VffHit vffIntersectInterpolated(...)  Reconstruction::kInterpolated (the miss-aware blend).
 //   float vffVisibility(...)  kInterpolated FieldQuery::visibility: the unoccluded share in [0, 1].
 //   VffHit vffQuery(..., bool interpolated, out float visibility)  the core of all four.
 // A hit carries the object-space normal (hasNormal) when the field has a normal plane.
 //
-// Several fields at once (a scene: gpu/glsl/vff_scene.glsl). Every lookup step reads its field
-// through VFF_FIELD (default: the uniform block vffField, declared only when VFF_FIELD is not
-// defined) and finds the field's data at VFF_POSITIONS_BASE (vec4 index in vffPositions),
-// VFF_MAPS_LAYER and VFF_NORMALS_LAYER (first slice in vffMaps, vffNormals); all default to the
-// single field's 0. vff_scene.glsl defines the four to read the field of the instance being
-// queried from its field table, so the scene and the single field share every function below.
-// Building blocks (names as in spec/geometry.md 5.4 and spec/positions.md 6): vffFrame, vffToLocal,
-// vffHemisphereToSquare, vffSquareToHemisphere, vffSquareToTexel, vffTexelCenter, vffNearestSample,
-// vffFetchCode, vffDecode. vffQuery's steps, named as vff::FieldQuery::Impl's: vffPrepare (sphere and
-// nearest sample), vffNearestHit, vffInterpolated (the kernel's samples blended), vffBlendResult.
+// Several fields at once (gpu/glsl/vff_scene.glsl): every lookup step reads its field through
+// VFF_FIELD (default: the uniform block vffField) at VFF_POSITIONS_BASE, VFF_MAPS_LAYER and
+// VFF_NORMALS_LAYER (default 0); the scene defines the four for the instance being queried.
+// vffQuery's steps are named as vff::FieldQuery::Impl's: vffPrepare, vffNearestHit,
+// vffInterpolated, vffBlendResult; docs/source-map.md lists every step's copies.
 //
 // Exactness. Variables on the path whose bits matter are `precise` (no fused multiply-add, no
-// reassociation), and divisions and square roots go through vffDivide and vffSqrt, which refine the
-// driver's result to the correctly rounded one (a driver may implement '/' as a reciprocal and a
-// multiply, and sqrt from an approximate inverse square root; llvmpipe's sqrt is not correctly
-// rounded). The decoded distance of a texel is then bit-identical to the CPU's.
+// reassociation); divisions and square roots go through vffDivide and vffSqrt, which refine the
+// driver's result to the correctly rounded one. A texel's decoded distance is the CPU's, bit for bit.
 #ifndef VFF_QUERY_GLSL
 #define VFF_QUERY_GLSL
 
@@ -102,9 +83,8 @@ layout(std140, binding = VFF_FIELD_BINDING) uniform VffFieldBlock {
 } vffField;
 #define VFF_FIELD vffField
 #endif
-// Where the field's data lie in the resources below: the vec4 index of its sample positions in
-// vffPositions, and its first slice in vffMaps and in vffNormals. 0 for a single field; a scene
-// (vff_scene.glsl) defines them, with VFF_FIELD, to select the field of the instance it queries.
+// Where the field's data lie in vffPositions (vec4 index), vffMaps and vffNormals (first slice):
+// 0 for a single field; vff_scene.glsl defines them for the instance it queries.
 #ifndef VFF_POSITIONS_BASE
 #define VFF_POSITIONS_BASE 0u
 #endif
@@ -133,12 +113,9 @@ layout(binding = VFF_NORMALS_BINDING) uniform highp isampler2DArray vffNormals;
 #endif
 #endif
 
-// vffPositions[k], k < mapCount: xyz = the outward unit vector of sample k (binary32), w = 0.
-// For unorm8-chord it continues with the decode scale of every texel of a map, 2R cos(alpha) / 254
-// with cos(alpha) of the texel centre, computed by the CPU exactly as the CPU query does: texel
-// t = j M + i is component t % 4 of vffPositions[mapCount + t / 4]. From vec4 index
-// VFF_FIELD.neighbourOffset: the neighbour lists of kInterpolated, VFF_NEIGHBOURS sample indices per
-// map (VFF_NEIGHBOURS / 4 vec4, as floats; -1 pads), the lists the CPU query builds.
+// vffPositions[k], k < mapCount: the outward unit vector of sample k (w = 0); then, for
+// unorm8-chord, the decode scale of texel t = j M + i at component t % 4 of [mapCount + t / 4]; from
+// VFF_FIELD.neighbourOffset, kInterpolated's neighbour lists (VFF_NEIGHBOURS floats a map, -1 pads).
 layout(std430, binding = VFF_POSITIONS_BINDING) readonly buffer VffPositionsBlock {
   vec4 vffPositions[];
 };
@@ -168,8 +145,7 @@ float vffDivide(float a, float b) {
   return (isinf(q) || isnan(c) || b == 0.0) ? q : c;
 }
 
-// sqrt(a), correctly rounded (one Newton correction with a fused residual), for drivers whose sqrt
-// is an approximation.
+// sqrt(a), correctly rounded (one Newton correction with a fused residual; drivers approximate).
 float vffSqrt(float a) {
   precise float s = sqrt(a);
   precise float r = fma(-s, s, a);
@@ -445,7 +421,8 @@ VffTexel vffDecode(uint code, uvec2 ij) {
   return o;
 }
 
-// ---- The ray query (spec/geometry.md 7.2, 7.3; vff::FieldQuery, kNearest and kInterpolated) ------
+// ---- The ray query (spec/geometry.md 7.2-7.4; vff::FieldQuery, kNearest and kInterpolated) ------
+const float VFF_OFF_OBJECT = -2.0;  // intraBias of a ray that starts off the object (section 7.4)
 struct VffHit {
   bool hit;       // the ray hits the object with t in [tmin, tmax]
   bool inside;    // the origin was inside the bounding sphere (the reversed-ray test of 7.3)
@@ -470,14 +447,13 @@ float vffKernel(vec3 eu, uint k) {
   return x > 0.0 ? w : 0.0;
 }
 
-// A ray where it enters the field's sphere, as vff::FieldQuery::Impl::Lookup: its unit direction w
-// and length len; the direction looked up, v (w, or -w from inside: the reversed ray); the entry
-// point t0 (from inside: the exit point) and the range [lo, hi], along w; the entry point on the
-// unit sphere, eu, and its nearest sample k0.
+// A ray where it enters the field's sphere, as vff::FieldQuery::Impl::Lookup: unit direction w,
+// length len; the direction looked up, v (-w for section 7.3's reversed ray); the entry point t0 and
+// the range [lo, hi], along w; the entry point on the unit sphere, eu, and its nearest sample k0.
 struct VffLookup {
   vec3 w, v, eu;
   float len, t0, lo, hi;
-  bool inside;
+  bool inside, off;  // answered by section 7.3; by 7.4 (origin inside the sphere, t0 < 0)
   int k0;
 };
 
@@ -500,25 +476,31 @@ bool vffPrepare(vec3 origin, vec3 direction, float tmin, float tmax, float intra
   precise float sq = vffSqrt(disc);
   precise float t1 = -beta + sq;
   if (t1 < 0.0) return false;
-  bool inside = gamma <= 0.0;
-  // From inside, the reversed ray enters at the exit point and looks back at the origin.
-  precise float t0 = inside ? t1 : max(-beta - sq, 0.0);
+  bool inSphere = gamma <= 0.0, offObject = intraBias == VFF_OFF_OBJECT, inside = inSphere && !offObject;
+  if (inSphere && VFF_FIELD.distanceEncoding == VFF_ENCODING_BIT1) return false;  // no distances: cannot tell
+  // On the object the reversed ray enters at the exit point and looks back at the origin; off it,
+  // the ray extended backwards enters before the origin (t0 < 0).
+  precise float tIn = -beta - sq;
+  precise float t0 = inside ? t1 : (offObject && inSphere ? tIn : max(tIn, 0.0));
   precise vec3 e = origin + w * t0;
   vec3 v = inside ? -w : w;
   if (inside) {
-    if (VFF_FIELD.distanceEncoding == VFF_ENCODING_BIT1) return false;  // no distances: cannot tell
     precise float bias = (intraBias >= 0.0 ? intraBias : VFF_FIELD.intraBias) * R;
     lo = max(lo, bias);
   }
   precise vec3 eu = (e - c) * VFF_FIELD.invRadius;
-  l = VffLookup(w, v, eu, len, t0, lo, hi, inside, vffNearestSample(eu));
+  l = VffLookup(w, v, eu, len, t0, lo, hi, inside, !inside && t0 < 0.0, vffNearestSample(eu));
   return true;
 }
 
-// kNearest (and every ray from inside), as vff::FieldQuery::Impl::nearestHit: 3. the texel of the
-// nearest sample's map in direction v, 4. its decode, 5. the result. `o` is the answer so far (the
-// sample looked up); `visibility` becomes 0 on a hit.
-VffHit vffNearestHit(VffHit o, VffLookup l, bool normals, inout float visibility) {
+float vffOffTolerance() { return vffDivide(2.0 * VFF_FIELD.sphereRadius, 255.0); }  // section 7.4's, 2R/255
+
+// kNearest (and every ray from inside), as vff::FieldQuery::Impl::nearestHit and, off the object,
+// offHitAt: 3. the texel of the nearest sample's map in direction v, 4. its decode, 5. the result.
+// `o` is the answer so far (the sample looked up); `visibility` becomes 0 on a hit. behind: an
+// off-object lookup's surface lies behind the origin (section 7.4 step 3 applies; o is no answer).
+VffHit vffNearestHit(VffHit o, VffLookup l, bool normals, inout float visibility, out bool behind) {
+  behind = false;
   int k = l.k0;
   int M = int(VFF_FIELD.mapResolution);
   vec3 ek = vffPosition(k);
@@ -534,7 +516,9 @@ VffHit vffNearestHit(VffHit o, VffLookup l, bool normals, inout float visibility
   if (!s.hit) return o;
   // 5. The result.
   precise float t = l.inside ? l.t0 - s.distance : l.t0 + s.distance;
-  if (t < l.lo || t > l.hi) return o;
+  behind = l.off && t < l.lo - vffOffTolerance();
+  if (l.off) t = max(t, l.lo);  // (within the tolerance behind: a hit at lo)
+  if (behind || t < l.lo || t > l.hi) return o;
   visibility = 0.0;
   o.hit = true;
   o.inside = l.inside;
@@ -652,7 +636,7 @@ VffHit vffInterpolated(VffHit o, vec3 origin, VffLookup l, bool normals, inout f
 
 // The core of every query, as vff::FieldQuery::Impl::query. `visibility` receives the unoccluded
 // share: 0 or 1 for kNearest (interpolated == false), the misses' and far hits' share of the blend
-// weight for kInterpolated. Rays from inside the sphere are answered as kNearest in both modes.
+// weight for kInterpolated. Rays answered by section 7.3 are answered as kNearest in both modes.
 VffHit vffQuery(vec3 origin, vec3 direction, float tmin, float tmax, float intraBias, bool interpolated,
                 out float visibility) {
   // No hit (t = +inf), nothing looked up.
@@ -667,8 +651,25 @@ VffHit vffQuery(vec3 origin, vec3 direction, float tmin, float tmax, float intra
 #else
   bool normals = VFF_FIELD.normalEncoding != VFF_NORMAL_NONE;
 #endif
-  if (!interpolated || l.inside) return vffNearestHit(o, l, normals, visibility);
-  return vffInterpolated(o, origin, l, normals, visibility);
+  bool behind = false;
+  if (!interpolated || l.inside || l.off) {
+    VffHit n = vffNearestHit(o, l, normals, visibility, behind);
+    if (!behind && (!interpolated || l.inside)) return n;
+    visibility = 1.0;
+  }
+  if (behind) {  // section 7.4 step 3: section 7.3 with no bias
+    if (!vffPrepare(origin, direction, tmin, tmax, 0.0, l)) return o;
+    o.sampleIndex = uint(l.k0);
+    return vffNearestHit(o, l, normals, visibility, behind);
+  }
+  if (!l.off) return vffInterpolated(o, origin, l, normals, visibility);
+  // Section 7.4, interpolated: the blend over [lo - tolerance, hi], its distance clamped to lo.
+  precise float lo = l.lo;
+  l.lo = lo - vffOffTolerance();
+  VffHit h = vffInterpolated(o, origin, l, normals, visibility);
+  precise float tl = h.t * l.len;
+  if (h.hit && tl < lo) h.t = vffDivide(lo, l.len);
+  return h;
 }
 
 // vff::FieldQuery::intersect with Reconstruction::kNearest (the paper's lookup).

@@ -34,7 +34,10 @@
 //   float vffSceneVisibility(...) vff::Scene::visibility: the product of the instances'
 //     visibility (multiplied in the walk's order, not in id order: equal to the CPU's within
 //     float rounding for kInterpolated; exact for kNearest, whose factors are 0 or 1).
-// intraBias < 0 selects each field's default; interpolated selects Reconstruction::kInterpolated.
+// intraBias as vff_query.glsl's (VFF_OFF_OBJECT: every instance answers by section 7.4);
+// interpolated selects Reconstruction::kInterpolated. The *From variants take the ray's source,
+// the id of the instance it starts on or VFF_NO_INSTANCE, as vff::Scene's *From calls: that
+// instance answers with intraBias (section 7.3), every other as VFF_OFF_OBJECT (section 7.4).
 // Like the CPU, the walk skips only instances whose enlarged world box the segment [0, tmax]
 // never reaches, so culling changes no answer. The stack holds VFF_SCENE_STACK entries (default
 // 64); vff::gl::GpuScene::update refuses a hierarchy that could need more.
@@ -181,6 +184,8 @@ struct VffSceneHit {
   vec3 normal;        // world-space unit normal, when hasNormal
 };
 
+const uint VFF_NO_INSTANCE = 0xFFFFFFFFu;    // vff::kNoInstance: a ray that starts on no instance
+const uint VFF_SCENE_NO_SOURCE = 0xFFFFFFFEu;  // (the walk's: no sources, intraBias for every instance)
 const uint VFF_SCENE_INTERSECT = 0u;
 const uint VFF_SCENE_OCCLUDED = 1u;
 const uint VFF_SCENE_VISIBILITY = 2u;
@@ -189,7 +194,7 @@ const uint VFF_SCENE_VISIBILITY = 2u;
 // Nearest child first, as the CPU's; intersect narrows the segment to the best hit plus the
 // largest instance diameter (a kInterpolated hit can lie that far before its sphere's entry).
 VffSceneHit vffSceneWalk(vec3 origin, vec3 direction, float tmin, float tmax, float intraBias, bool interpolated,
-                         uint mode, out float visibility) {
+                         uint source, uint mode, out float visibility) {
   VffSceneHit best;
   best.hit = false;
   best.t = uintBitsToFloat(0x7f800000u);
@@ -224,7 +229,8 @@ VffSceneHit vffSceneWalk(vec3 origin, vec3 direction, float tmin, float tmax, fl
       for (uint i = 0u; i < count; ++i) {
         VffSceneInstance x = vffSceneInstances[first + i];
         float v;
-        VffHit h = vffSceneQuery(x, origin, direction, tmin, tmax, intraBias, interpolated, v);
+        float bias = source == VFF_SCENE_NO_SOURCE || x.id == source ? intraBias : VFF_OFF_OBJECT;
+        VffHit h = vffSceneQuery(x, origin, direction, tmin, tmax, bias, interpolated, v);
         if (mode == VFF_SCENE_VISIBILITY) {
           visibility *= v;
         } else if (mode == VFF_SCENE_OCCLUDED) {
@@ -272,24 +278,33 @@ VffSceneHit vffSceneWalk(vec3 origin, vec3 direction, float tmin, float tmax, fl
   return best;
 }
 
-// vff::Scene::intersect.
+// vff::Scene::intersect, occluded and visibility; with a source, intersectFrom, occludedFrom and
+// visibilityFrom.
+VffSceneHit vffSceneIntersectFrom(vec3 origin, vec3 direction, float tmin, float tmax, float intraBias,
+                                  bool interpolated, uint source) {
+  float v;
+  return vffSceneWalk(origin, direction, tmin, tmax, intraBias, interpolated, source, VFF_SCENE_INTERSECT, v);
+}
+bool vffSceneOccludedFrom(vec3 origin, vec3 direction, float tmin, float tmax, float intraBias, bool interpolated,
+                          uint source) {
+  float v;
+  return vffSceneWalk(origin, direction, tmin, tmax, intraBias, interpolated, source, VFF_SCENE_OCCLUDED, v).hit;
+}
+float vffSceneVisibilityFrom(vec3 origin, vec3 direction, float tmin, float tmax, float intraBias, bool interpolated,
+                             uint source) {
+  float v;
+  vffSceneWalk(origin, direction, tmin, tmax, intraBias, interpolated, source, VFF_SCENE_VISIBILITY, v);
+  return v;
+}
 VffSceneHit vffSceneIntersect(vec3 origin, vec3 direction, float tmin, float tmax, float intraBias,
                               bool interpolated) {
-  float v;
-  return vffSceneWalk(origin, direction, tmin, tmax, intraBias, interpolated, VFF_SCENE_INTERSECT, v);
+  return vffSceneIntersectFrom(origin, direction, tmin, tmax, intraBias, interpolated, VFF_SCENE_NO_SOURCE);
 }
-
-// vff::Scene::occluded.
 bool vffSceneOccluded(vec3 origin, vec3 direction, float tmin, float tmax, float intraBias, bool interpolated) {
-  float v;
-  return vffSceneWalk(origin, direction, tmin, tmax, intraBias, interpolated, VFF_SCENE_OCCLUDED, v).hit;
+  return vffSceneOccludedFrom(origin, direction, tmin, tmax, intraBias, interpolated, VFF_SCENE_NO_SOURCE);
 }
-
-// vff::Scene::visibility.
 float vffSceneVisibility(vec3 origin, vec3 direction, float tmin, float tmax, float intraBias, bool interpolated) {
-  float v;
-  vffSceneWalk(origin, direction, tmin, tmax, intraBias, interpolated, VFF_SCENE_VISIBILITY, v);
-  return v;
+  return vffSceneVisibilityFrom(origin, direction, tmin, tmax, intraBias, interpolated, VFF_SCENE_NO_SOURCE);
 }
 
 #endif  // VFF_SCENE_GLSL

@@ -108,6 +108,7 @@ const std::map<std::string, std::string>& localConstants() {
       {"kVffPi", "float"},          // pi, for the concentric map's angles
       {"kVffQuarterPi", "float"},   // pi / 4
       {"VFF_FIB", "uint[22]"},      // Fibonacci numbers, for the nearest Fibonacci sample
+      {"VFF_OFF_OBJECT", "float"},  // the intraBias that selects spec/geometry.md 7.4 (vff::RayOrigin::kOffObject)
   };
   return k;
 }

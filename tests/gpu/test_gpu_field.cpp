@@ -87,7 +87,10 @@ std::vector<GpuRay> makeRays(const FieldDesc& f, uint32_t count, uint64_t seed) 
       o = Vec3{c.x + a.x * s, c.y + a.y * s, c.z + a.z * s};
       d = rng.direction();
     }
-    rays[r] = GpuRay{{o.x, o.y, o.z, 0}, {d.x, d.y, d.z, 0}, {tmin, tmax, r % 3 == 0 ? 0.0f : -1.0f, 0}};
+    if (r % 8 == 7) tmax = 0.6f * R * rng.uniform();  // (short rays from inside: the contact case)
+    // intraBias: 0, the default (-1), or VFF_OFF_OBJECT (-2: section 7.4) for half the rays from inside.
+    const float bias = r % 8 == 7 ? -2.0f : r % 3 == 0 ? 0.0f : -1.0f;
+    rays[r] = GpuRay{{o.x, o.y, o.z, 0}, {d.x, d.y, d.z, 0}, {tmin, tmax, bias, 0}};
   }
   return rays;
 }
@@ -155,6 +158,7 @@ TEST_P(GpuField, NormalsAndInterpolatedMatchCpu) {
     // kNearest and its normal.
     QueryOptions qn;
     qn.intraBias = g.range[2];
+    if (g.range[2] == -2.0f) qn.origin = RayOrigin::kOffObject;  // VFF_OFF_OBJECT
     const QueryHit h = cpu->intersect(ray, qn);
     const bool gh = o.nearest[0] != 0;
     if (gh != h.hit) {

@@ -59,8 +59,10 @@ layout(location = 0) uniform int queries;
     // (vffSceneOccluded), 3 visibility kInterpolated (vffSceneVisibility).
     uint mode = q < 2 ? VFF_SCENE_INTERSECT : (q == 2 ? VFF_SCENE_OCCLUDED : VFF_SCENE_VISIBILITY);
     float v;
+    // range.w: the ray's source, an instance id, -1 for none, -2 for a call without sources.
+    uint source = r.range.w == -2.0 ? VFF_SCENE_NO_SOURCE : (r.range.w < 0.0 ? VFF_NO_INSTANCE : uint(r.range.w));
     VffSceneHit h = vffSceneWalk(r.origin.xyz, r.direction.xyz, r.range.x, r.range.y, r.range.z, q == 1 || q == 3,
-                                 mode, v);
+                                 source, mode, v);
     if (q == 0) {
       o.nearestHit = h.hit ? 1u : 0u;
       o.nearestT = h.t;
@@ -187,9 +189,27 @@ std::vector<GpuRay> makeRays(const Scene& scene, uint32_t count, uint64_t seed) 
       d = dir();
       if (r % 8 == 3) tmax = s.radius * 2.0f * uni(rng);
     }
-    rays[r] = GpuRay{{o.x, o.y, o.z, 0}, {d.x, d.y, d.z, 0}, {0.0f, tmax, r % 3 == 0 ? 0.0f : -1.0f, 0}};
+    // Sources (vff::Scene's *From calls): rays from inside a sphere start on its instance or on
+    // none; a quarter of all rays have none given (the calls without sources).
+    const float source = r % 4 == 0 ? -2.0f : r % 4 == 1 ? float(r % kInstances) : -1.0f;
+    rays[r] = GpuRay{{o.x, o.y, o.z, 0}, {d.x, d.y, d.z, 0}, {0.0f, tmax, r % 3 == 0 ? 0.0f : -1.0f, source}};
   }
   return rays;
+}
+
+// A ray's source as vff::Scene takes it (kNoSources: a call without sources).
+constexpr uint32_t kNoSources = 0xFFFFFFFEu;
+uint32_t sourceOf(const GpuRay& g) {
+  return g.range[3] == -2.0f ? kNoSources : g.range[3] < 0 ? kNoInstance : uint32_t(g.range[3]);
+}
+
+// The CPU Scene's answers with the ray's source, or without.
+template <class T>
+T sceneAnswer(const Scene& scene, const GpuRay& g, const Ray& ray, const QueryOptions& o,
+              Result<T> (Scene::*plain)(const Ray&, const QueryOptions&) const,
+              Result<T> (Scene::*from)(const Ray&, uint32_t, const QueryOptions&) const) {
+  const uint32_t s = sourceOf(g);
+  return s == kNoSources ? (scene.*plain)(ray, o).value() : (scene.*from)(ray, s, o).value();
 }
 
 Ray toRay(const GpuRay& g) {
@@ -236,10 +256,10 @@ uint32_t compareWithScene(const Scene& scene, const std::vector<GpuRay>& rays, c
     const Ray ray = toRay(rays[r]);
     const QueryOptions nearest{.reconstruction = Reconstruction::kNearest, .intraBias = rays[r].range[2]};
     const QueryOptions interp{.reconstruction = Reconstruction::kInterpolated, .intraBias = rays[r].range[2]};
-    const SceneHit a = scene.intersect(ray, nearest).value();
-    const SceneHit b = scene.intersect(ray, interp).value();
-    const bool occ = scene.occluded(ray, nearest).value();
-    const float vis = scene.visibility(ray, interp).value();
+    const SceneHit a = sceneAnswer<SceneHit>(scene, rays[r], ray, nearest, &Scene::intersect, &Scene::intersectFrom);
+    const SceneHit b = sceneAnswer<SceneHit>(scene, rays[r], ray, interp, &Scene::intersect, &Scene::intersectFrom);
+    const bool occ = sceneAnswer<bool>(scene, rays[r], ray, nearest, &Scene::occluded, &Scene::occludedFrom);
+    const float vis = sceneAnswer<float>(scene, rays[r], ray, interp, &Scene::visibility, &Scene::visibilityFrom);
     hits += a.hit;
     interpHits += b.hit;
     const bool dn = !sameHit(scene, ray, g[r].nearestHit, g[r].nearestT, g[r].nearestInstance, a, kNearestT);
@@ -295,10 +315,13 @@ void compareWithLoop(const Scene& scene, const std::vector<GpuRay>& rays, const 
     const QueryOptions o{.reconstruction = Reconstruction::kNearest, .intraBias = rays[r].range[2]};
     SceneHit best;
     bool occ = false;
+    const uint32_t source = sourceOf(rays[r]);
     for (uint32_t i = 0; i < scene.size(); ++i) {
       const Instance in = scene.instance(i).value();
-      const QueryHit h = in.intersect(ray, o);
-      occ = occ || in.occluded(ray, o);
+      QueryOptions oi = o;  // with a source: 7.3 for the instance the ray starts on, 7.4 for the rest
+      if (source != kNoSources) oi.origin = i == source ? RayOrigin::kOnObject : RayOrigin::kOffObject;
+      const QueryHit h = in.intersect(ray, oi);
+      occ = occ || in.occluded(ray, oi);
       if (h.hit && h.t < best.t) {  // ascending ids: the lowest id keeps an equal t
         static_cast<QueryHit&>(best) = h;
         best.instance = i;
