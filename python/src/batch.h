@@ -121,8 +121,15 @@ struct RayBatch {
   }
 };
 
+// The RayOrigin named by `origin`: "on-object" or "off-object" (a ValueError otherwise).
+inline RayOrigin rayOriginOf(const std::string& name) {
+  if (name == "on-object") return RayOrigin::kOnObject;
+  if (name == "off-object") return RayOrigin::kOffObject;
+  throw py::value_error("ray_origin: expected 'on-object' or 'off-object', got '" + name + "'");
+}
+
 inline RayBatch batchOf(const py::object& origins, const py::object& directions, const py::object& tmin,
-                 const py::object& tmax, bool interpolated, float intraBias, unsigned threads) {
+                 const py::object& tmax, bool interpolated, float intraBias, const std::string& rayOrigin, unsigned threads) {
   py::array o = vectors(origins, "origins"), d = vectors(directions, "directions");
   if (o.shape(0) != d.shape(0))
     throw py::value_error("origins and directions differ in length: " + std::to_string(o.shape(0)) + " and " +
@@ -138,6 +145,7 @@ inline RayBatch batchOf(const py::object& origins, const py::object& directions,
   if (b.tmax.array) b.tmaxData = static_cast<const uint8_t*>(b.tmax.array->data()), b.tmaxStride = b.tmax.array->strides(0);
   b.options.reconstruction = interpolated ? Reconstruction::kInterpolated : Reconstruction::kNearest;
   b.options.intraBias = intraBias;
+  b.options.origin = rayOriginOf(rayOrigin);
   b.threads = vff::parallel::resolveThreads(threads);
   return b;
 }
@@ -154,6 +162,24 @@ void parallel(const RayBatch& b, Work work) {
     b.fill(first, end - first, rays.data());
     work(first, std::span<const Ray>(rays.data(), end - first));
   });
+}
+
+// A target's batch call for the chunk of rays that starts at ray `first` of the batch: the
+// target's *At(first, ...) where it has one (a scene with per-ray sources), else its plain call.
+template <class Target, class Out>
+void intersectChunk(const Target& t, size_t first, std::span<const Ray> rays, Out out, const QueryOptions& qo) {
+  if constexpr (requires { t.intersectAt(first, rays, out, qo); }) t.intersectAt(first, rays, out, qo);
+  else (void)t.intersect(rays, out, qo);
+}
+template <class Target>
+void occludedChunk(const Target& t, size_t first, std::span<const Ray> rays, std::span<uint8_t> out, const QueryOptions& qo) {
+  if constexpr (requires { t.occludedAt(first, rays, out, qo); }) t.occludedAt(first, rays, out, qo);
+  else t.occluded(rays, out, qo);
+}
+template <class Target>
+void visibilityChunk(const Target& t, size_t first, std::span<const Ray> rays, std::span<float> out, const QueryOptions& qo) {
+  if constexpr (requires { t.visibilityAt(first, rays, out, qo); }) t.visibilityAt(first, rays, out, qo);
+  else t.visibility(rays, out, qo);
 }
 
 // Hits as numpy arrays.
@@ -194,7 +220,7 @@ Hits fillHits(const Target& target, const RayBatch& b, Hits h) {
   parallel(b, [&](size_t first, std::span<const Ray> rays) {
     thread_local std::vector<Hit> out;
     out.resize(rays.size());
-    (void)target.intersect(rays, out, qo);
+    intersectChunk(target, first, rays, std::span<Hit>(out), qo);
     // Selects by bit masks, not branches: whether a ray hit is as good as random, and a
     // mispredicted branch a ray cost more than the rest of this loop.
     const uint32_t nan = 0x7fc00000u;  // the quiet NaN's bits
@@ -227,7 +253,7 @@ py::array_t<bool> occludedBatch(const Target& target, const RayBatch& b) {
   uint8_t* dst = reinterpret_cast<uint8_t*>(out.mutable_data());
   const QueryOptions qo = b.options;
   parallel(b, [&](size_t first, std::span<const Ray> rays) {
-    target.occluded(rays, std::span<uint8_t>(dst + first, rays.size()), qo);
+    occludedChunk(target, first, rays, std::span<uint8_t>(dst + first, rays.size()), qo);
     for (size_t k = 0; k < rays.size(); ++k) dst[first + k] = dst[first + k] ? 1 : 0;  // numpy bools are 0 or 1
   });
   return out;
@@ -239,7 +265,7 @@ py::array_t<float> visibilityBatch(const Target& target, const RayBatch& b) {
   float* dst = out.mutable_data();
   const QueryOptions qo = b.options;
   parallel(b, [&](size_t first, std::span<const Ray> rays) {
-    target.visibility(rays, std::span<float>(dst + first, rays.size()), qo);
+    visibilityChunk(target, first, rays, std::span<float>(dst + first, rays.size()), qo);
   });
   return out;
 }
@@ -250,10 +276,11 @@ inline Vec3 vec3(const py::object& o, const char* name) {
   return {v[0], v[1], v[2]};
 }
 
-inline QueryOptions optionsOf(bool interpolated, float intraBias) {
+inline QueryOptions optionsOf(bool interpolated, float intraBias, const std::string& rayOrigin) {
   QueryOptions qo;
   qo.reconstruction = interpolated ? Reconstruction::kInterpolated : Reconstruction::kNearest;
   qo.intraBias = intraBias;
+  qo.origin = rayOriginOf(rayOrigin);
   return qo;
 }
 
@@ -268,8 +295,11 @@ inline constexpr const char* kBatchDoc = R"doc(
 Answers a batch of rays. origins, directions: float32 arrays of shape (N, 3), any strides;
 directions need not be unit length (t is in multiples of them). tmin, tmax: None (0 and infinity),
 a number, or a float32 array of shape (N,). interpolated: the miss-aware blend instead of the
-paper's nearest lookup. intra_bias: for rays from inside the sphere, a fraction of R (negative: the
-field's default). threads: 0 for all cores; the answers do not depend on it. The GIL is released.)doc";
+paper's nearest lookup. ray_origin: where rays that start inside a bounding sphere start, 'on-object' (on
+the object's own surface: spec/geometry.md section 7.3, the default) or 'off-object' (the ground under
+it, another object: section 7.4, which keeps contact shadows at short ranges). intra_bias: for
+'on-object' rays, a fraction of R (negative: the field's default). threads: 0 for all cores; the
+answers do not depend on it. The GIL is released.)doc";
 
 
 inline RigidTransform transformOf(const py::object& rotation, const py::object& translation, float scale) {

@@ -35,60 +35,60 @@ py::tuple sitesBatch(const Target& target, const RayBatch& b) {
 template <class Py, class Get>
 void addQueries(py::class_<Py>& c, Get get) {
   c.def("intersect", [get](const Py& self, const py::object& o, const py::object& d, const py::object& tmin, const py::object& tmax,
-                           bool interpolated, float intraBias, unsigned threads, const py::object& out) {
-        return intersectBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, intraBias, threads), out);
+                           bool interpolated, float intraBias, const std::string& rayOrigin, unsigned threads, const py::object& out) {
+        return intersectBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, intraBias, rayOrigin, threads), out);
       },
       py::arg("origins"), py::arg("directions"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(), py::kw_only(),
-      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("threads") = 0u, py::arg("out") = py::none(),
+      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("threads") = 0u, py::arg("out") = py::none(),
       (std::string(kBatchDoc) + "\nReturns a vff.Hits: hit (N,) bool, t (N,) float32 (inf for a miss), point (N, 3) and "
                                 "normal (N, 3) float32 (NaN where there is none), inside (N,) bool. out: the Hits of an "
                                 "earlier call of the same length, filled again instead of new arrays (fresh arrays "
                                 "cost the first touch of their memory; a loop over batches saves it).").c_str());
   c.def("occluded", [get](const Py& self, const py::object& o, const py::object& d, const py::object& tmin, const py::object& tmax,
-                          bool interpolated, float intraBias, unsigned threads) {
-        return occludedBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, intraBias, threads));
+                          bool interpolated, float intraBias, const std::string& rayOrigin, unsigned threads) {
+        return occludedBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, intraBias, rayOrigin, threads));
       },
       py::arg("origins"), py::arg("directions"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(), py::kw_only(),
-      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("threads") = 0u,
+      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("threads") = 0u,
       (std::string(kBatchDoc) + "\nReturns an (N,) bool array: the ray hits the object within [tmin, tmax].").c_str());
   c.def("visibility", [get](const Py& self, const py::object& o, const py::object& d, const py::object& tmin, const py::object& tmax,
-                            bool interpolated, float intraBias, unsigned threads) {
-        return visibilityBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, intraBias, threads));
+                            bool interpolated, float intraBias, const std::string& rayOrigin, unsigned threads) {
+        return visibilityBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, intraBias, rayOrigin, threads));
       },
       py::arg("origins"), py::arg("directions"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(), py::kw_only(),
-      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("threads") = 0u,
+      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("threads") = 0u,
       (std::string(kBatchDoc) + "\nReturns an (N,) float32 array: the probability that each ray reaches tmax unoccluded "
                                 "(0 or 1 with nearest).").c_str());
   c.def("sites", [get](const Py& self, const py::object& o, const py::object& d, const py::object& tmin, const py::object& tmax,
-                       bool interpolated, float intraBias, unsigned threads) {
-        return sitesBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, intraBias, threads));
+                       bool interpolated, float intraBias, const std::string& rayOrigin, unsigned threads) {
+        return sitesBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, intraBias, rayOrigin, threads));
       },
       py::arg("origins"), py::arg("directions"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(), py::kw_only(),
-      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("threads") = 0u,
+      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("threads") = 0u,
       (std::string(kBatchDoc) + "\nWhich map and texel answer each ray (libvff's LookupSite, as vff-query's columns "
                                 "sample, i, j): returns (sample, texel), (N,) int32 and (N, 2) int32 [i, j] (texel (i, "
                                 "j) is element [j, i] of File.distances(sample)); -1 for a ray that makes no lookup. "
                                 "The nearest reconstruction reads exactly that texel; the interpolated one centres "
                                 "its blend on it.").c_str());
   c.def("intersect_ray", [get](const Py& self, const py::object& o, const py::object& d, float tmin, float tmax, bool interpolated,
-                               float intraBias) {
-        return hitTuple(get(self).intersect(Ray{vec3(o, "origin"), vec3(d, "direction"), tmin, tmax}, optionsOf(interpolated, intraBias)));
+                               float intraBias, const std::string& rayOrigin) {
+        return hitTuple(get(self).intersect(Ray{vec3(o, "origin"), vec3(d, "direction"), tmin, tmax}, optionsOf(interpolated, intraBias, rayOrigin)));
       },
       py::arg("origin"), py::arg("direction"), py::arg("tmin") = 0.0f, py::arg("tmax") = std::numeric_limits<float>::infinity(),
-      py::kw_only(), py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f,
+      py::kw_only(), py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object",
       "One ray, through libvff's one-ray call: (hit, t, point, normal, inside) with point and normal as (x, y, z) tuples.");
   c.def("occluded_ray", [get](const Py& self, const py::object& o, const py::object& d, float tmin, float tmax, bool interpolated,
-                              float intraBias) {
-        return get(self).occluded(Ray{vec3(o, "origin"), vec3(d, "direction"), tmin, tmax}, optionsOf(interpolated, intraBias));
+                              float intraBias, const std::string& rayOrigin) {
+        return get(self).occluded(Ray{vec3(o, "origin"), vec3(d, "direction"), tmin, tmax}, optionsOf(interpolated, intraBias, rayOrigin));
       },
       py::arg("origin"), py::arg("direction"), py::arg("tmin") = 0.0f, py::arg("tmax") = std::numeric_limits<float>::infinity(),
-      py::kw_only(), py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, "One ray: libvff's one-ray occluded().");
+      py::kw_only(), py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", "One ray: libvff's one-ray occluded().");
   c.def("visibility_ray", [get](const Py& self, const py::object& o, const py::object& d, float tmin, float tmax, bool interpolated,
-                                float intraBias) {
-        return get(self).visibility(Ray{vec3(o, "origin"), vec3(d, "direction"), tmin, tmax}, optionsOf(interpolated, intraBias));
+                                float intraBias, const std::string& rayOrigin) {
+        return get(self).visibility(Ray{vec3(o, "origin"), vec3(d, "direction"), tmin, tmax}, optionsOf(interpolated, intraBias, rayOrigin));
       },
       py::arg("origin"), py::arg("direction"), py::arg("tmin") = 0.0f, py::arg("tmax") = std::numeric_limits<float>::infinity(),
-      py::kw_only(), py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, "One ray: libvff's one-ray visibility().");
+      py::kw_only(), py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", "One ray: libvff's one-ray visibility().");
 }
 
 

@@ -25,13 +25,52 @@ struct PyScene {
 // handed to them (every batch call then succeeds).
 struct SceneTarget {
   const Scene* scene;
-  void occluded(std::span<const Ray> r, std::span<uint8_t> out, const QueryOptions& qo) const {
-    (void)scene->occluded(r, out, qo);
+  const uint32_t* sources = nullptr;  // one per ray of the batch, or none
+  void intersectAt(size_t first, std::span<const Ray> r, std::span<SceneHit> out, const QueryOptions& qo) const {
+    if (sources) (void)scene->intersectFrom(r, std::span<const uint32_t>(sources + first, r.size()), out, qo);
+    else (void)scene->intersect(r, out, qo);
   }
-  void visibility(std::span<const Ray> r, std::span<float> out, const QueryOptions& qo) const {
-    (void)scene->visibility(r, out, qo);
+  void occludedAt(size_t first, std::span<const Ray> r, std::span<uint8_t> out, const QueryOptions& qo) const {
+    if (sources) (void)scene->occludedFrom(r, std::span<const uint32_t>(sources + first, r.size()), out, qo);
+    else (void)scene->occluded(r, out, qo);
+  }
+  void visibilityAt(size_t first, std::span<const Ray> r, std::span<float> out, const QueryOptions& qo) const {
+    if (sources) (void)scene->visibilityFrom(r, std::span<const uint32_t>(sources + first, r.size()), out, qo);
+    else (void)scene->visibility(r, out, qo);
   }
 };
+
+// The per-ray sources of a batch: None, or an (N,) integer array of instance ids, -1 for a ray
+// that starts on no instance. Checked here, so that every batch call then succeeds.
+std::vector<uint32_t> sourcesOf(const py::object& obj, const Scene& scene, size_t n) {
+  std::vector<uint32_t> out;
+  if (obj.is_none()) return out;
+  if (!py::isinstance<py::array>(obj)) throw py::type_error("sources: expected None or an integer array of shape (N,)");
+  py::array a = py::reinterpret_borrow<py::array>(obj);
+  if (a.dtype().kind() != 'i' && a.dtype().kind() != 'u')
+    throw py::type_error("sources: expected an integer array, got dtype " + std::string(py::str(py::handle(a.dtype()))));
+  if (a.ndim() != 1 || size_t(a.shape(0)) != n)
+    throw py::value_error("sources: expected shape (" + std::to_string(n) + ",), one instance id (or -1) per ray");
+  py::array_t<int64_t, py::array::forcecast> v(a);
+  out.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const int64_t s = v.at(py::ssize_t(i));
+    if (s < -1 || s >= int64_t(scene.size()))
+      throw py::value_error("sources[" + std::to_string(i) + "] = " + std::to_string(s) + ": not an instance id (the scene has " +
+                            std::to_string(scene.size()) + "; -1 for none)");
+    out[i] = s < 0 ? kNoInstance : uint32_t(s);
+  }
+  return out;
+}
+
+uint32_t sourceOf(const py::object& obj, const Scene& scene) {
+  if (obj.is_none()) return kNoInstance;
+  const int64_t s = obj.cast<int64_t>();
+  if (s < -1 || s >= int64_t(scene.size()))
+    throw py::value_error("source = " + std::to_string(s) + ": not an instance id (the scene has " +
+                          std::to_string(scene.size()) + "; -1 or None for none)");
+  return s < 0 ? kNoInstance : uint32_t(s);
+}
 
 const Scene& committedScene(const PyScene& s) {
   if (!s.scene().committed())
@@ -55,8 +94,8 @@ Hits sceneHitsFor(const py::object& out, size_t count) {
   return h;
 }
 
-Hits sceneIntersect(const Scene& scene, const RayBatch& b, const py::object& reuse) {
-  return fillHits<SceneHit>(scene, b, sceneHitsFor(reuse, b.n));
+Hits sceneIntersect(const SceneTarget& target, const RayBatch& b, const py::object& reuse) {
+  return fillHits<SceneHit>(target, b, sceneHitsFor(reuse, b.n));
 }
 
 Ray rayOf(const py::object& o, const py::object& d, float tmin, float tmax) {
@@ -71,56 +110,88 @@ PyInstance instanceOf(const py::object& self, const PyScene& s, uint32_t id) {
   return PyInstance{self, in};
 }
 
+constexpr const char* kSourcesDoc = R"doc(
+sources: None, or an (N,) integer array: for each ray the id of the instance it starts on, -1 for
+none (the ground, the static world). That instance answers the ray as 'on-object', every other as
+'off-object' (ray_origin is then not used): what a renderer wants for rays from its G-buffer.)doc";
+
+// A one-ray query: plain, or with the ray's source (None: the plain call, options.origin for
+// every instance; an id or -1: the *From call).
+template <class T>
+T sceneRay(const PyScene& self, const Ray& ray, const QueryOptions& qo, const py::object& source,
+           Result<T> (Scene::*plain)(const Ray&, const QueryOptions&) const,
+           Result<T> (Scene::*from)(const Ray&, uint32_t, const QueryOptions&) const) {
+  const Scene& scene = committedScene(self);
+  if (source.is_none()) return take((scene.*plain)(ray, qo));
+  return take((scene.*from)(ray, sourceOf(source, scene), qo));
+}
+
 void addSceneQueries(py::class_<PyScene>& c) {
   c.def("intersect", [](const PyScene& self, const py::object& o, const py::object& d, const py::object& tmin,
-                        const py::object& tmax, bool interpolated, float intraBias, unsigned threads, const py::object& out) {
+                        const py::object& tmax, bool interpolated, float intraBias, const std::string& rayOrigin,
+                        const py::object& sources, unsigned threads, const py::object& out) {
         const Scene& scene = committedScene(self);
-        return sceneIntersect(scene, batchOf(o, d, tmin, tmax, interpolated, intraBias, threads), out);
+        const RayBatch b = batchOf(o, d, tmin, tmax, interpolated, intraBias, rayOrigin, threads);
+        const std::vector<uint32_t> src = sourcesOf(sources, scene, b.n);
+        return sceneIntersect(SceneTarget{&scene, src.empty() ? nullptr : src.data()}, b, out);
       },
       py::arg("origins"), py::arg("directions"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(), py::kw_only(),
-      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("threads") = 0u, py::arg("out") = py::none(),
-      (std::string(kBatchDoc) + "\nReturns a vff.Hits as Instance.intersect does, the nearest hit of any instance (of "
+      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("sources") = py::none(), py::arg("threads") = 0u, py::arg("out") = py::none(),
+      (std::string(kBatchDoc) + kSourcesDoc + "\nReturns a vff.Hits as Instance.intersect does, the nearest hit of any instance (of "
                                 "hits at the same t, the lowest id's), with instance: (N,) int32, the id of the "
                                 "instance hit, -1 for a miss. out: the Hits of an earlier Scene.intersect of the same "
                                 "length, filled again. Raises vff.OperationError (bad-state) before a commit().").c_str());
   c.def("occluded", [](const PyScene& self, const py::object& o, const py::object& d, const py::object& tmin,
-                       const py::object& tmax, bool interpolated, float intraBias, unsigned threads) {
-        const SceneTarget target{&committedScene(self)};
-        return occludedBatch(target, batchOf(o, d, tmin, tmax, interpolated, intraBias, threads));
+                       const py::object& tmax, bool interpolated, float intraBias, const std::string& rayOrigin,
+                       const py::object& sources, unsigned threads) {
+        const Scene& scene = committedScene(self);
+        const RayBatch b = batchOf(o, d, tmin, tmax, interpolated, intraBias, rayOrigin, threads);
+        const std::vector<uint32_t> src = sourcesOf(sources, scene, b.n);
+        return occludedBatch(SceneTarget{&scene, src.empty() ? nullptr : src.data()}, b);
       },
       py::arg("origins"), py::arg("directions"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(), py::kw_only(),
-      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("threads") = 0u,
-      (std::string(kBatchDoc) + "\nReturns an (N,) bool array: some instance reports the ray occluded.").c_str());
+      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("sources") = py::none(), py::arg("threads") = 0u,
+      (std::string(kBatchDoc) + kSourcesDoc + "\nReturns an (N,) bool array: some instance reports the ray occluded.").c_str());
   c.def("visibility", [](const PyScene& self, const py::object& o, const py::object& d, const py::object& tmin,
-                         const py::object& tmax, bool interpolated, float intraBias, unsigned threads) {
-        const SceneTarget target{&committedScene(self)};
-        return visibilityBatch(target, batchOf(o, d, tmin, tmax, interpolated, intraBias, threads));
+                       const py::object& tmax, bool interpolated, float intraBias, const std::string& rayOrigin,
+                       const py::object& sources, unsigned threads) {
+        const Scene& scene = committedScene(self);
+        const RayBatch b = batchOf(o, d, tmin, tmax, interpolated, intraBias, rayOrigin, threads);
+        const std::vector<uint32_t> src = sourcesOf(sources, scene, b.n);
+        return visibilityBatch(SceneTarget{&scene, src.empty() ? nullptr : src.data()}, b);
       },
       py::arg("origins"), py::arg("directions"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(), py::kw_only(),
-      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("threads") = 0u,
-      (std::string(kBatchDoc) + "\nReturns an (N,) float32 array: the product, in id order, of the instances' "
+      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("sources") = py::none(), py::arg("threads") = 0u,
+      (std::string(kBatchDoc) + kSourcesDoc + "\nReturns an (N,) float32 array: the product, in id order, of the instances' "
                                 "visibility (instances the ray never comes near give exactly 1).").c_str());
   c.def("intersect_ray", [](const PyScene& self, const py::object& o, const py::object& d, float tmin, float tmax,
-                            bool interpolated, float intraBias) {
-        const SceneHit h = take(committedScene(self).intersect(rayOf(o, d, tmin, tmax), optionsOf(interpolated, intraBias)));
+                            bool interpolated, float intraBias, const std::string& rayOrigin, const py::object& source) {
+        const SceneHit h = sceneRay<SceneHit>(self, rayOf(o, d, tmin, tmax), optionsOf(interpolated, intraBias, rayOrigin), source, &Scene::intersect,
+                             &Scene::intersectFrom);
         py::tuple t = hitTuple(h);
         return py::make_tuple(t[0], t[1], t[2], t[3], t[4], h.instance == kNoInstance ? -1 : int64_t(h.instance));
       },
       py::arg("origin"), py::arg("direction"), py::arg("tmin") = 0.0f, py::arg("tmax") = std::numeric_limits<float>::infinity(),
-      py::kw_only(), py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f,
-      "One ray, through libvff's one-ray call: (hit, t, point, normal, inside, instance), instance -1 for a miss.");
+      py::kw_only(), py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object",
+      py::arg("source") = py::none(),
+      "One ray, through libvff's one-ray call: (hit, t, point, normal, inside, instance), instance -1 for a miss. "
+      "source: the instance the ray starts on, -1 for none (see the batch's sources), or None.");
   c.def("occluded_ray", [](const PyScene& self, const py::object& o, const py::object& d, float tmin, float tmax,
-                           bool interpolated, float intraBias) {
-        return take(committedScene(self).occluded(rayOf(o, d, tmin, tmax), optionsOf(interpolated, intraBias)));
+                           bool interpolated, float intraBias, const std::string& rayOrigin, const py::object& source) {
+        return sceneRay<bool>(self, rayOf(o, d, tmin, tmax), optionsOf(interpolated, intraBias, rayOrigin), source, &Scene::occluded,
+                             &Scene::occludedFrom);
       },
       py::arg("origin"), py::arg("direction"), py::arg("tmin") = 0.0f, py::arg("tmax") = std::numeric_limits<float>::infinity(),
-      py::kw_only(), py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, "One ray: libvff's one-ray occluded().");
+      py::kw_only(), py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object",
+      py::arg("source") = py::none(), "One ray: libvff's one-ray occluded(). source: the instance the ray starts on, -1 for none (see the batch's sources), or None.");
   c.def("visibility_ray", [](const PyScene& self, const py::object& o, const py::object& d, float tmin, float tmax,
-                             bool interpolated, float intraBias) {
-        return take(committedScene(self).visibility(rayOf(o, d, tmin, tmax), optionsOf(interpolated, intraBias)));
+                             bool interpolated, float intraBias, const std::string& rayOrigin, const py::object& source) {
+        return sceneRay<float>(self, rayOf(o, d, tmin, tmax), optionsOf(interpolated, intraBias, rayOrigin), source, &Scene::visibility,
+                             &Scene::visibilityFrom);
       },
       py::arg("origin"), py::arg("direction"), py::arg("tmin") = 0.0f, py::arg("tmax") = std::numeric_limits<float>::infinity(),
-      py::kw_only(), py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, "One ray: libvff's one-ray visibility().");
+      py::kw_only(), py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object",
+      py::arg("source") = py::none(), "One ray: libvff's one-ray visibility(). source: the instance the ray starts on, -1 for none (see the batch's sources), or None.");
   c.def("candidates", [](const PyScene& self, const py::object& o, const py::object& d, float tmin, float tmax) {
         return take(committedScene(self).candidates(rayOf(o, d, tmin, tmax)));
       },

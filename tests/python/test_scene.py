@@ -88,6 +88,62 @@ def test_batches_equal_the_loop_over_instances(interpolated):
             assert np.float32(one[1]) == h.t[r]
 
 
+@pytest.mark.parametrize("interpolated", [False, True])
+def test_sources_equal_the_loop_with_each_rays_origin(interpolated):
+    """With sources, the ray's own instance answers 'on-object' and every other 'off-object'."""
+    qs = fields()
+    scene = build(qs)
+    scene.commit()
+    instances = [scene.instance(k) for k in range(len(scene))]
+    rng = np.random.default_rng(3)
+    # Rays from inside the spheres (overlapping ones too), each with a source: its instance or none.
+    n = 2000
+    which = rng.integers(0, len(instances), n)
+    centers = np.array([instances[k].world_sphere[0] for k in which], np.float32)
+    radii = np.array([instances[k].world_sphere[1] for k in which], np.float32)
+    o = (centers + rng.uniform(-0.5, 0.5, (n, 3)) * radii[:, None]).astype(np.float32)
+    d = rng.uniform(-1, 1, (n, 3)).astype(np.float32)
+    sources = np.where(rng.uniform(size=n) < 0.5, which, -1).astype(np.int64)
+    tmax = np.float32(0.8)
+    want_occ = np.zeros(n, bool)
+    want_vis = np.ones(n, np.float32)
+    for k, inst in enumerate(instances):
+        own = sources == k
+        on = inst.occluded(o, d, tmax=tmax, interpolated=interpolated, ray_origin="on-object")
+        off = inst.occluded(o, d, tmax=tmax, interpolated=interpolated, ray_origin="off-object")
+        want_occ |= np.where(own, on, off)
+        von = inst.visibility(o, d, tmax=tmax, interpolated=interpolated, ray_origin="on-object")
+        voff = inst.visibility(o, d, tmax=tmax, interpolated=interpolated, ray_origin="off-object")
+        want_vis *= np.where(own, von, voff)
+    got = scene.occluded(o, d, tmax=tmax, interpolated=interpolated, sources=sources, threads=3)
+    assert np.array_equal(got, want_occ) and want_occ.any() and not want_occ.all()
+    assert np.array_equal(scene.visibility(o, d, tmax=tmax, interpolated=interpolated, sources=sources.astype(np.int32)),
+                          want_vis)
+    h = scene.intersect(o, d, tmax=tmax, interpolated=interpolated, sources=sources)
+    assert np.array_equal(h.hit, want_occ)
+    for r in range(0, n, 37):
+        src = int(sources[r])
+        assert scene.occluded_ray(o[r], d[r], 0.0, tmax, interpolated=interpolated, source=src) == want_occ[r]
+        one = scene.intersect_ray(o[r], d[r], 0.0, tmax, interpolated=interpolated, source=src)
+        assert one[0] == h.hit[r] and one[5] == h.instance[r]
+    # Sources change the answers of rays that start inside another instance's sphere.
+    plain = scene.occluded(o, d, tmax=tmax, interpolated=interpolated, intra_bias=0.0)
+    assert not np.array_equal(plain, got)
+    # Bad sources are named.
+    with pytest.raises(ValueError, match=r"sources\[3\] = 9"):
+        bad = sources.copy()
+        bad[3] = 9
+        scene.occluded(o, d, sources=bad)
+    with pytest.raises(ValueError, match="one instance id"):
+        scene.occluded(o, d, sources=sources[:5])
+    with pytest.raises(TypeError, match="integer array"):
+        scene.occluded(o, d, sources=sources.astype(np.float32))
+    with pytest.raises(ValueError, match="source = 7"):
+        scene.occluded_ray(o[0], d[0], source=7)
+    with pytest.raises(ValueError, match="ray_origin"):
+        instances[0].occluded(o, d, ray_origin="floor")
+
+
 def test_moves_need_a_commit():
     qs = fields()
     scene = build(qs)

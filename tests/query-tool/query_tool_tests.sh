@@ -21,7 +21,7 @@ test_help() {
   query --help
   expect_rc 0
   for opt in --ray --input --output --format --interpolated --visibility --tmin --tmax --rotate --translate --scale \
-    --threads --checksums --no-sites --columns "Exit codes:" "3  invalid input file"; do expect_out "$opt"; done
+    --threads --checksums --no-sites --columns --ray-origin "Exit codes:" "3  invalid input file"; do expect_out "$opt"; done
 }
 
 # Nearest answers, split over threads in batches, equal the one-ray calls on every encoding.
@@ -45,6 +45,26 @@ test_interpolated_equals_one_ray() {
     expect_rc 0
     same "$WORK/want.csv" "$WORK/out"
   done
+}
+
+# Rays that start off the object (--ray-origin off-object, spec/geometry.md 7.4), nearest and
+# interpolated, equal the one-ray calls; the reference's rays start inside the sphere too, and some
+# of them answer otherwise than on the object.
+test_off_object_equals_one_ray() {
+  for f in u8d-zstd-normals-meta u16d-zstd-normals-gutter2 bc4-zstd-normals-slices; do
+    "$REFERENCE" rays "$VECTORS/$f.vff" 600 5 >"$WORK/rays.csv"
+    for interp in "" --interpolated; do
+      "$REFERENCE" answer "$VECTORS/$f.vff" "$WORK/rays.csv" --off-object $interp --visibility >"$WORK/want.csv"
+      query "$VECTORS/$f.vff" -i "$WORK/rays.csv" -o "$WORK/got.csv" --ray-origin off-object $interp --visibility -j 2
+      expect_rc 0
+      same "$WORK/want.csv" "$WORK/got.csv"
+      query "$VECTORS/$f.vff" -i "$WORK/rays.csv" -o "$WORK/on.csv" $interp --visibility
+      cmp -s "$WORK/got.csv" "$WORK/on.csv" && fail "$f: off-object rays answered as on-object ones"
+    done
+  done
+  query "$VECTORS/u8d-zstd-normals-meta.vff" --ray 0 0 0 1 0 0 --ray-origin floor
+  expect_rc 1
+  expect_err "--ray-origin"
 }
 
 # An instance transform: rays in world space, answered as Instance's one-ray calls.

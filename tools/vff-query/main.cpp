@@ -49,6 +49,7 @@ struct Options {
   float tmin = 0.0f;
   float tmax = std::numeric_limits<float>::infinity();
   float intraBias = -1.0f;
+  std::string rayOrigin = "on-object";
   std::vector<float> rotate, translate;
   float scale = 1.0f;
   unsigned threads = 0;
@@ -84,7 +85,12 @@ void addOptions(CLI::App& app, Options& o) {
   app.add_flag("--visibility", o.visibility, "add a column: the ray's visibility (0..1; 0 or 1 with nearest)");
   app.add_option("--tmin", o.tmin, "the rays' tmin, unless a ray gives its own")->capture_default_str();
   app.add_option("--tmax", o.tmax, "the rays' tmax, unless a ray gives its own (default: inf)");
-  app.add_option("--intra-bias", o.intraBias, "bias of rays from inside the sphere, a fraction of R (default: the field's)");
+  app.add_option("--ray-origin", o.rayOrigin,
+                 "where rays from inside the bounding sphere start: on-object (its own surface: spec/geometry.md 7.3) or "
+                 "off-object (the ground, another object: 7.4, which keeps contact shadows at short tmax)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"on-object", "off-object"}));
+  app.add_option("--intra-bias", o.intraBias, "bias of on-object rays from inside the sphere, a fraction of R (default: the field's)");
   app.add_option("--rotate", o.rotate, "place the field: rotation about axis x y z by an angle in radians")
       ->expected(4)
       ->option_text("AX AY AZ RADIANS");
@@ -519,6 +525,7 @@ int run(int argc, char** argv) {
   QueryOptions qo;
   qo.reconstruction = o.interpolated ? Reconstruction::kInterpolated : Reconstruction::kNearest;
   qo.intraBias = o.intraBias;
+  qo.origin = o.rayOrigin == "off-object" ? RayOrigin::kOffObject : RayOrigin::kOnObject;
   std::vector<Column> columns;
   if (auto rc = chooseColumns(o, format, &columns)) return *rc;
   const Target target{&*q, inst};
