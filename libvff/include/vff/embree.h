@@ -38,11 +38,12 @@
 // callback answers through Instance::intersect, so that the filter sees the hit's distance and
 // normal.
 //
-// Speed. The callbacks answer a packet through the batch path's packet steps (vff/query.h: every
-// ray of the packet prepared, its texels requested together, then decoded), at about the cost of
-// the packet's own lookups. Embree calls them per packet and per primitive: for incoherent rays
-// mostly one active ray at a time, which waits for its own texel read as a single-ray traversal of
-// triangles waits for its nodes. vff-experiments scene-bench measures Embree's triangles, this
+// Speed. The callbacks answer a packet's lanes that reach the instance's sphere through the batch
+// path (vff/query.h: the group kernel's SIMD lanes); the lanes that miss it are answered before
+// any is taken to object space (Embree hands a packet's callback every active lane). Embree calls
+// them per packet and per primitive: with single rays and streams of incoherent rays one active ray
+// at a time, which waits for its own texel read as a single-ray traversal of triangles waits for
+// its nodes; packets of 16 (rtcOccluded16) give the callback 16. vff-experiments scene-bench measures Embree's triangles, this
 // hybrid and vff::Scene side by side, for single rays, packets of 16 and streams, on random rays
 // and on coherent ones (4 x 4 pixel tiles). For rays that only field objects and a static
 // environment can stop, the two-pass calls below answer the fields in vff::Scene's batches and

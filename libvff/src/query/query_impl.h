@@ -338,8 +338,6 @@ struct VFF_HIDDEN FieldQuery::Impl {  // (VFF_HIDDEN: not exported with its clas
   // kHitOnly: emit(base, n, hits) per run of rays; otherwise emit(r, const QueryHit&, float
   // visibility) per ray (see the definition).
   // With `to`, the rays are in world space: the kernel and prepare() take them to object space.
-  // Batches of at most this many rays (an Embree packet) skip the group kernel (batchNearest).
-  static constexpr size_t kPacketRays = 16;
   template <bool kHitOnly, class Emit>
   void batchNearest(std::span<const Ray> rays, const QueryOptions& o, const detail::ToObject* to, Emit&& emit) const noexcept;
   // The batch calls of FieldQuery (x null: object-space rays) and of Instance (world-space rays, x

@@ -18,32 +18,12 @@ template <bool kHitOnly, class Emit>
 void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOptions& o, const detail::ToObject* to,
                                     Emit&& emit) const noexcept {
   auto objectRay = [&](size_t r) { return to ? to->ray(rays[r]) : rays[r]; };
-  // A packet (an Embree callback's 1, 4, 8 or 16 rays) takes the reference steps without the
-  // group kernel, whose fixed cost is larger than a packet's own: every ray prepared, then all
-  // their texels requested from memory, then decoded, so that their reads overlap.
-  if (rays.size() <= kPacketRays) {
-    Ray local[kPacketRays];
-    Lookup l[kPacketRays];
-    bool live[kPacketRays];
-    for (size_t r = 0; r < rays.size(); ++r) {
-      local[r] = objectRay(r);
-      live[r] = prepare(local[r], o, &l[r]);
-      if (live[r]) __builtin_prefetch(texelAddress(l[r].k0, l[r].i, l[r].j));
-    }
-    uint64_t hits = 0;
-    for (size_t r = 0; r < rays.size(); ++r) {
-      float vis = 1.0f;
-      const QueryHit h = live[r] ? nearestAnswer(local[r], l[r], &vis) : QueryHit{};
-      if constexpr (kHitOnly) {
-        hits |= uint64_t(h.hit) << r;
-      } else {
-        emit(r, h, vis);
-      }
-    }
-    if constexpr (kHitOnly) emit(size_t(0), rays.size(), hits);
-    return;
-  }
-  const detail::GroupKernel* kernel = detail::groupKernel();
+  // A batch of one ray (an Embree callback for rtcIntersect1 or rtcOccluded1) takes the reference
+  // path: a group's fixed cost is larger than the ray's own, and there are no other texel reads
+  // for its read to overlap. (batchInterpolated does the same.) From two rays on, the group
+  // kernel's lanes win: vff-experiments bench --batch 16 measured it against the reference steps
+  // with the texels requested together.
+  const detail::GroupKernel* kernel = rays.size() > 1 ? detail::groupKernel() : nullptr;
   if (!kernel) {
     for (size_t base = 0; base < rays.size(); base += detail::kGroupRays) {
       const size_t n = std::min(detail::kGroupRays, rays.size() - base);
