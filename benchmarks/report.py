@@ -85,6 +85,18 @@ def md_rows(text):
     return rows
 
 
+def md_tables(text):
+    """The Markdown tables in text, each a list of rows (header first) of stripped cells."""
+    tables, current = [], []
+    for line in text.splitlines() + [""]:
+        if line.strip().startswith("|"):
+            current.append(line)
+        elif current:
+            tables.append(md_rows("\n".join(current)))
+            current = []
+    return tables
+
+
 def parse_bake(text):
     m = {k: re.search(p, text) for k, p in {
         "raw": r"embree raw\s+([\d.]+) s\s+([\d.]+) Mrays/s",
@@ -120,13 +132,24 @@ def parse_query(text):
     return {"threads": int(head.group(1)), "kernel": head.group(2), "sets": sets}
 
 
+RANGE = re.compile(r"^(.*) @ ([\d.]+) R$")
+
+
 def parse_accuracy(text):
+    """The rows of an image experiment's table: 6 columns, or 8 with the contact region's RMS and
+    the rest's (ao); a configuration ending in " @ X R" names the AO range of its pass."""
     rows = []
     for r in md_rows(text):
-        if len(r) != 6 or r[0] == "configuration":
+        if len(r) not in (6, 8) or r[0] == "configuration":
             continue
+        contact = len(r) == 8
+        ranged = RANGE.match(r[0])
         rows.append({"config": r[0], "reconstruction": r[1], "mib": number(r[2]),
-                     "rms": None if r[3].startswith("(") else number(r[3]), "time": number(r[5])})
+                     "rms": None if r[3].startswith("(") else number(r[3]), "time": number(r[-1]),
+                     "contact": number(r[4]) if contact and r[4] not in ("-", "(reference)") else None,
+                     "outside": number(r[5]) if contact and r[5] not in ("-", "(reference)") else None,
+                     "base": ranged.group(1) if ranged else r[0],
+                     "range": float(ranged.group(2)) if ranged else None})
     if not rows or not rows[0]["config"].startswith("exact"):
         raise ParseError("experiment output has no table starting with the exact row")
     return rows
@@ -180,7 +203,8 @@ def parse_gpu(text):
 
 
 def parse_scene(text):
-    rows = md_rows(text)
+    tables = md_tables(text)
+    rows = tables[0] if tables else []
     if len(rows) < 2 or rows[0][0] != "instances":
         raise ParseError("no scene-bench table")
     m = re.search(r"(\d+) AO rays per frame.*?(\d+) frames(?: \(rays best of (\d+)\))?, (\d+) threads", text)
@@ -195,6 +219,15 @@ def parse_scene(text):
         if len(r) >= 14:  # (b)'s floor: its rays time, and the field's answers alone on its pairs
             row.update({"scene_rays": number(r[4]), "pairs": number(r[11]), "answers": number(r[12])})
         out["rows"].append(row)
+    # The ray forms (Embree's triangles and the hybrid as single rays, packets, streams) and the
+    # two-pass hybrid, where the run printed them.
+    for t in tables[1:]:
+        if t and t[0][:3] == ["instances", "rays", "form"]:
+            out["forms"] = [{"instances": int(r[0]), "rays": r[1], "form": r[2], "embree": number(r[3]) if r[3] != "-" else None,
+                             "hybrid": number(r[4]), "ratio": number(r[5]), "per_call": r[6]} for r in t[1:]]
+        elif t and t[0][:3] == ["instances", "rays", "vff::Scene speed-up"]:
+            out["twopass"] = [{"instances": int(r[0]), "rays": r[1], "scene": number(r[2]), "twopass": number(r[3]),
+                               "kept": number(r[4])} for r in t[1:]]
     return out
 
 
@@ -208,7 +241,10 @@ def parse_triangles(text):
         out["rows"].append({"triangles": int(r[0]), "build": number(r[1]), "bake": number(r[2]),
                             "surface": (number(r[3]), number(r[4]), number(r[5])),
                             "aimed": (number(r[6]), number(r[7]), number(r[8]))})
-    out["summary"] = [l.strip() for l in text.splitlines() if l.startswith(("surface rays:", "aimed rays:"))]
+    out["summary"] = [l.strip() for l in text.splitlines() if l.startswith(("surface rays:", "aimed rays:", "tiles, packets"))]
+    for r, row in zip(rows[1:], out["rows"]):
+        if len(r) >= 14:  # the tiles set in packets of 16: Embree's triangles and the hybrid
+            row["tiles"] = (number(r[11]), number(r[12]), number(r[13]))
     return out
 
 
@@ -311,23 +347,45 @@ def accuracy_table(steps, only=None):
         rows = steps[name]
         exact = rows[0]
         configs = []
+        exacts = {r["range"]: r for r in rows if r["config"].startswith("exact")}  # one per AO range
         for r in rows[1:]:
-            if r["config"] not in configs:
+            if r["config"] not in configs and not r["config"].startswith("exact"):
                 configs.append(r["config"])
         for c in configs:
             sdf = re.match(r"distance field, (\S+)'s memory", c)
-            if only and c != only and not (sdf and sdf.group(1) == only):
-                continue
             by = {r["reconstruction"]: r for r in rows if r["config"] == c}
+            first_row = next(iter(by.values()))
+            if only and (first_row["base"] != only or first_row["range"] not in (None, 2.0)) and \
+                    not (sdf and sdf.group(1) == only):
+                continue
             near, interp = by.get("nearest"), by.get("interpolated")
             if sdf:  # the distance field at that field's memory: sphere tracing, and its cone estimate
                 near, interp = by.get("sphere trace"), by.get("cone")
                 c = f"distance field at {sdf.group(1)}'s memory"
             first = near or interp
+            exact = exacts.get(first["range"], rows[0])
             lines.append(f"| {name[len('accuracy-'):]} | {c} | {first['mib']:.1f} | "
                          f"{near['rms']:.2f} | " if near else f"| {name[len('accuracy-'):]} | {c} | {first['mib']:.1f} | - | ")
             lines[-1] += (f"{interp['rms']:.2f} | " if interp else "- | ") + \
                 f"{exact['time']:.2f} / {first['time']:.2f} |"
+    return lines
+
+
+def contact_table(steps):
+    """Ground AO by range (the ao experiment's passes): the error over the contact region (plane
+    pixels inside the bounding sphere) against the rest's, and each range's whole RMS against 2 R's."""
+    rows = [r for r in steps.get("accuracy-ao", []) if r["range"] is not None and r["contact"] is not None]
+    if not rows:
+        return []
+    at2 = {(r["base"], r["reconstruction"]): r["rms"] for r in rows if r["range"] == 2.0}
+    lines = ["| field | reconstruction | AO range | RMS | RMS contact | RMS outside | contact / outside "
+             "(target <= 2) | RMS / RMS at 2 R (target at 0.5 R <= 1.5) |",
+             "|---|---|---:|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        ratio = r["contact"] / r["outside"] if r["outside"] else float("nan")
+        base = at2.get((r["base"], r["reconstruction"]))
+        lines.append(f"| {r['base']} | {r['reconstruction']} | {r['range']:g} R | {r['rms']:.2f} | {r['contact']:.2f} | "
+                     f"{r['outside']:.2f} | {ratio:.1f} | " + (f"{r['rms'] / base:.2f}" if base else "-") + " |")
     return lines
 
 
@@ -410,13 +468,34 @@ def scene_table(sc):
     return lines
 
 
+def forms_table(sc):
+    lines = ["| moving instances | AO rays | form | Embree triangles, Mrays/s | hybrid, Mrays/s | hybrid / Embree | "
+             "active rays a callback |", "|---:|---|---|---:|---:|---:|---:|"]
+    for r in sc.get("forms", []):
+        lines.append(f"| {r['instances']} | {r['rays']} | {r['form']} | " + (rate(r['embree']) if r['embree'] else "-") +
+                     f" | {rate(r['hybrid'])} | {r['ratio']:.2f}x | {r['per_call']} |")
+    return lines
+
+
+def twopass_table(sc):
+    lines = ["| moving instances | AO rays | vff::Scene over Embree instancing | two-pass hybrid over Embree + ground | "
+             "kept (target 0.8) |", "|---:|---|---:|---:|---:|"]
+    for r in sc.get("twopass", []):
+        lines.append(f"| {r['instances']} | {r['rays']} | {r['scene']:.2f}x | {r['twopass']:.2f}x | {r['kept']:.2f} |")
+    return lines
+
+
 def triangles_table(t):
+    tiles = all("tiles" in r for r in t["rows"]) and t["rows"]
     lines = ["| triangles | surface AO rays: Embree, ns/ray | field, ns/ray | speed-up | aimed rays: Embree, ns/ray | "
-             "field, ns/ray | speed-up |", "|---:|---:|---:|---:|---:|---:|---:|"]
+             "field, ns/ray | speed-up |" + (" tiles, packets of 16: Embree, ns/ray | hybrid, ns/ray | hybrid speed-up |"
+                                             if tiles else ""),
+             "|---:|---:|---:|---:|---:|---:|---:|" + ("---:|---:|---:|" if tiles else "")]
     for r in t["rows"]:
         s, a = r["surface"], r["aimed"]
         lines.append(f"| {r['triangles']} | {fmt(s[0], 1)} | {fmt(s[1], 1)} | {s[2]:.1f}x | {fmt(a[0], 1)} | "
-                     f"{fmt(a[1], 1)} | {a[2]:.1f}x |")
+                     f"{fmt(a[1], 1)} | {a[2]:.1f}x |" +
+                     (f" {fmt(r['tiles'][0], 1)} | {fmt(r['tiles'][1], 1)} | {r['tiles'][2]:.2f}x |" if tiles else ""))
     if t["summary"]:
         lines += ["", *[f"- {l}" for l in t["summary"]]]
     return lines
@@ -450,11 +529,24 @@ def sections(machine, steps, heading, queries=None, only=None):
         out += [f"{heading} Accuracy against exact Embree casts (8-bit scale)", "", *accuracy_table(steps, only), ""]
         if any(r["config"].startswith("distance field") for k, v in steps.items() if k.startswith("accuracy-") for r in v):
             out += ["Distance-field rows: nearest is sphere tracing's hit or miss, interpolated its cone estimate.", ""]
+        if not only and contact_table(steps):
+            out += [f"{heading} Contact shadows: ground AO by range (rays from the ground carry no source: "
+                    "spec/geometry.md 7.4)", "", *contact_table(steps), "",
+                    "Contact: the plane pixels inside the bounding sphere, whose rays start inside it; outside: the "
+                    "rest of the plane.", ""]
     if "scene" in steps:
         sc = steps["scene"]
         best = f", rays best of {sc['best_of']}" if sc["best_of"] > 1 else ""
         out += [f"{heading} Scenes: time per frame against moving instances ({sc['rays']} AO rays per frame{best}, "
                 f"{sc['threads']} threads)", "", *scene_table(sc), ""]
+        if sc.get("forms") and not only:
+            out += [f"{heading} Ray forms: Embree's triangles and the hybrid (FieldGeometry, ray sources) as a renderer "
+                    "casts them", "", *forms_table(sc), "",
+                    "random: AO rays from random points of the instances; tiles: a G-buffer pass's, 16 a pixel, cast "
+                    "4 x 4 pixels at a time (a packet of 16 is one sample of a tile). The vff::Scene row: its batches, "
+                    "and its speed-up over Embree's single rays.", "",
+                    f"{heading} Two-pass hybrid: field objects and a static environment (a ground quad)", "",
+                    *twopass_table(sc), ""]
     if "triangles" in steps:
         t = steps["triangles"]
         out += [f"{heading} Time per ray against the object's triangle count ({t['threads']} threads)", "",
@@ -522,7 +614,7 @@ def compose(rawdir, out):
     lines = [f"# vff benchmarks: {machine['cpu']}, {machine['date']}", "",
              "Written by `bash benchmarks/run.sh`" + (" --quick (tiny sizes: the figures mean nothing)"
                                                        if machine.get("quick") == "1" else "") +
-             (f" --only {machine['only']} (a reduced run: that step alone)" if machine.get("only") else "") + ".", "",
+             (f" --only {machine['only']} (a reduced run: those steps alone)" if machine.get("only") else "") + ".", "",
              "| | |", "|---|---|"]
     for k in ("commit", "cpu", "cores", "kernel", "compiler", "build_type", "embree", "mesh", "field"):
         if k in machine:
@@ -553,7 +645,7 @@ def read_results(path):
     for k, v in re.findall(r"^\| (\w+) \| (.*) \|$", text, re.M):
         machine.setdefault(k, v)
     machine["quick"] = "1" if "--quick" in text.split("## Summary")[0] else "0"
-    only = re.search(r"--only (\w+) \(a reduced run", text.split("## Summary")[0])
+    only = re.search(r"--only ([\w,]+) \(a reduced run", text.split("## Summary")[0])
     if only:
         machine["only"] = only.group(1)
     steps = {}
@@ -725,7 +817,7 @@ def main(argv):
         return 0
     if len(argv) == 3 and argv[1] == "check":
         machine, steps = read_results(argv[2])
-        wanted = ONLY[machine["only"]] if machine.get("only") in ONLY else STEPS
+        wanted = [n for step in machine["only"].split(",") for n in ONLY.get(step, [])] if machine.get("only") else STEPS
         missing = [n for n in wanted if n not in OPTIONAL and n not in steps]
         if missing:
             raise ParseError(f"{argv[2]}: no output of " + ", ".join(missing))

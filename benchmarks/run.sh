@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
 # benchmarks/run.sh - runs every benchmark of vff and writes one results file.
 #
-#   bash benchmarks/run.sh [--build DIR] [--mesh FILE] [--out FILE] [--quick] [--only STEP]
+#   bash benchmarks/run.sh [--build DIR] [--mesh FILE] [--out FILE] [--quick] [--only STEP[,STEP...]]
 #                          [--sdf-memory "MiB ..."] [--sdf-rays N]
 #
 # Without --build it sets up and builds as scripts/main.sh does (Release preset, into build/).
 # With the bunny of Debian's glmark2-data (or --mesh) it runs:
 #   bake         vff-bake --benchmark: the whole bake against Embree alone on the bake's rays
 #   query        vff-experiments bench: field queries against Embree and against the memory floor
-#   accuracy     vff-experiments ao, intra-ao, shadows, reflections: fields against exact casts
+#   accuracy     vff-experiments ao (at AO ranges 0.25, 0.5, 1 and 2 R), intra-ao, shadows, reflections:
+#                fields against exact casts
 #   scene        vff-experiments scene-bench: 1 to 10000 moving instances, Embree instancing vs vff::Scene
 #   triangles    vff-experiments triangle-bench: time per ray from about 10k to 1M triangles
 #   compression  vff-compress --benchmark: the hits-med codec against zstd, xz and OpenEXR's
@@ -27,7 +28,7 @@
 # and writes benchmarks/results/<cpu>-<date>.md (or --out): the machine, the commit, a summary in
 # rounded tables (README.md and benchmarks/README.md copy it: python3 benchmarks/report.py readme) and the full output of
 # every command. --quick runs each at a tiny size: a check that the whole chain works, whose
-# figures mean nothing. --only STEP runs one step (bake, query, accuracy, scene, triangles,
+# figures mean nothing. --only STEP[,STEP...] runs those steps (bake, query, accuracy, scene, triangles,
 # compression, gpu, sdf, python, library): a reduced run, and its results file says so. Run it on
 # a quiet machine: the query figures move with the memory's load.
 # Exit codes: 0 written, 1 usage, 2 a file cannot be read or written, 4 a benchmark failed.
@@ -35,7 +36,7 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 prog="benchmarks/run.sh"
 build="" mesh="/usr/share/glmark2/models/bunny.obj" out="" quick=0 only="" sdfmemory="1 4 16 64" sdfrays=""
-usage() { echo "usage: $prog [--build DIR] [--mesh FILE] [--out FILE] [--quick] [--only STEP] [--sdf-memory \"MiB ...\"] [--sdf-rays N]" >&2; exit 1; }
+usage() { echo "usage: $prog [--build DIR] [--mesh FILE] [--out FILE] [--quick] [--only STEP[,STEP...]] [--sdf-memory \"MiB ...\"] [--sdf-rays N]" >&2; exit 1; }
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --build) [[ $# -ge 2 ]] || usage; build="$2"; shift 2 ;;
@@ -43,10 +44,10 @@ while [[ $# -gt 0 ]]; do
     --out) [[ $# -ge 2 ]] || usage; out="$2"; shift 2 ;;
     --quick) quick=1; shift ;;
     --only) [[ $# -ge 2 ]] || usage; only="$2"; shift 2
-      [[ $only =~ ^(bake|query|accuracy|scene|triangles|compression|gpu|sdf|python|library)$ ]] || usage ;;
+      [[ $only =~ ^((bake|query|accuracy|scene|triangles|compression|gpu|sdf|python|library)(,|$))+$ ]] || usage ;;
     --sdf-memory) [[ $# -ge 2 ]] || usage; sdfmemory="$2"; shift 2 ;;
     --sdf-rays) [[ $# -ge 2 ]] || usage; sdfrays="$2"; shift 2 ;;
-    -h|--help) echo "usage: $prog [--build DIR] [--mesh FILE] [--out FILE] [--quick] [--only STEP] [--sdf-memory \"MiB ...\"] [--sdf-rays N]"; exit 0 ;;
+    -h|--help) echo "usage: $prog [--build DIR] [--mesh FILE] [--out FILE] [--quick] [--only STEP[,STEP...]] [--sdf-memory \"MiB ...\"] [--sdf-rays N]"; exit 0 ;;
     *) usage ;;
   esac
 done
@@ -92,7 +93,7 @@ else
 fi
 [[ -z $sdfrays ]] || sdfargs+=(--bench-rays "$sdfrays")
 # want STEP: true when the run includes it (all of them without --only).
-want() { [[ -z $only || $only == "$1" ]]; }
+want() { [[ -z $only || ,$only, == *",$1,"* ]]; }
 
 # step NAME COMMAND...: runs COMMAND with its output in $raw/NAME.txt and its command line in
 # $raw/NAME.cmd (paths relative to the build folder, so that results files name no machine path).
@@ -128,7 +129,9 @@ want bake && step bake "$bake" "$mesh" --benchmark "${config[@]}" --repeat "$bak
 want query && step query "$experiments" bench --mesh "$mesh" "${benchargs[@]}"
 if want accuracy; then
   for e in ao intra-ao shadows reflections; do
-    step "accuracy-$e" "$experiments" "$e" --mesh "$mesh" "${expargs[@]}" -o "$raw/experiments"
+    # ao renders each AO range against its own exact image (the contact shadow at short ranges).
+    ranges=(); [[ $e != ao ]] || ranges=(--ao-ranges 0.25 0.5 1 2)
+    step "accuracy-$e" "$experiments" "$e" --mesh "$mesh" "${expargs[@]}" "${ranges[@]}" -o "$raw/experiments"
   done
 fi
 want scene && step scene "$experiments" scene-bench --mesh "$mesh" "${sceneargs[@]}"
@@ -188,7 +191,7 @@ commit="$(git -C "$root" rev-parse --short=12 HEAD 2>/dev/null || echo unknown)"
 } >"$raw/machine.txt"
 if [[ -z $out ]]; then
   # A reduced run (--only) never replaces the day's full results file.
-  out="$root/benchmarks/results/$(python3 "$root/benchmarks/report.py" slug "$raw/machine.txt")${only:+-$only}.md"
+  out="$root/benchmarks/results/$(python3 "$root/benchmarks/report.py" slug "$raw/machine.txt")${only:+-${only//,/-}}.md"
 fi
 python3 "$root/benchmarks/report.py" compose "$raw" "$out.tmp"
 mv "$out.tmp" "$out"

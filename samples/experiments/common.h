@@ -18,6 +18,8 @@
 #include <string>
 #include <vector>
 
+#include <embree3/rtcore.h>
+
 #include "vff/bake/baker.h"
 #include "vff/bake/mesh.h"
 #include "vff/query.h"
@@ -116,6 +118,8 @@ class ExactTracer {
   bool occluded(const vff::Ray& ray) const;  // rtcOccluded1
   ExactHit intersect(const vff::Ray& ray) const;  // rtcIntersect1
   uint64_t memoryBytes() const;  // Embree's peak allocation (BVH and buffers)
+  RTCDevice device() const;      // its Embree device and scene, for other forms of ray casts
+  RTCScene scene() const;
 
   struct Impl;
 
@@ -201,6 +205,7 @@ struct GSample {
   Vec3 normal;   // geometric, facing the camera
   Vec3 shadingNormal;  // interpolated when the mesh has normals, facing the camera
   Vec3 viewDir;  // unit, camera -> point
+  uint32_t instance = ~0u;  // the scene experiment's: the object hit (its instance id), ~0u for none
 };
 
 struct GBuffer {
@@ -256,6 +261,8 @@ struct Options {
   // AO range as a multiple of R. 2 R spans the whole bounding sphere, so for a plane point inside the
   // sphere the range never cuts the intra-object answer (whose hit is the LAST crossing, at most 2 R away).
   float aoDistance = 2.0f;
+  // ao: the ranges to render (multiples of R); empty: aoDistance alone.
+  std::vector<float> aoRanges;
   // bench
   uint32_t benchRays = 1u << 21;
   uint32_t benchBatch = 4096;  // rays per batch call in (b), (d) and (e)
@@ -292,8 +299,10 @@ struct TableRow {
   double memoryMiB = -1;  // < 0: not applicable
   double rms = 0, max = 0, seconds = 0;
   bool reference = false;
+  double rmsContact = -1, rmsOutside = -1;  // ImageExperiment::contactRegion (< 0: not measured)
 };
-std::string formatTable(const std::vector<TableRow>& rows);
+// The table; with contact, the RMS columns of the contact region and of the rest beside the whole's.
+std::string formatTable(const std::vector<TableRow>& rows, bool contact = false);
 
 // Every experiment returns an exit code (vff::cli::kExit*), after printing its diagnostics.
 int runAo(const Options& o);
@@ -333,9 +342,17 @@ struct ImageExperiment {
   std::vector<vff::Reconstruction> sdfRows{vff::Reconstruction::kNearest, vff::Reconstruction::kInterpolated};
   // Returns the shade function of one method: field and sdf null is the exact reference; else the
   // field, or the distance field, with reconstruction r.
+  // range: the AO range in multiples of R, one of `ranges` (experiments without ranges ignore it).
   std::function<std::function<Vec3(const GSample&, Rng&)>(const World&, const ExactTracer&, const BakedQuery* field,
-                                                            const SdfField* sdf, vff::Reconstruction r, int rays)>
+                                                            const SdfField* sdf, vff::Reconstruction r, int rays,
+                                                            float range)>
       makeShader;
+  // The AO ranges to render, each with its own reference (empty: one pass, range unused). The table
+  // then names the range in every row.
+  std::vector<float> ranges;
+  // Also report the error over the plane pixels inside the object's bounding sphere (the contact
+  // region, where rays start inside the sphere) and over the rest, beside the whole image's.
+  bool contactRegion = false;
 };
 int runImageExperiment(const Options& o, const ImageExperiment& e);
 

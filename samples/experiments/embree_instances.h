@@ -1,8 +1,11 @@
 // embree_instances.h - what the scene experiments share with Embree: placing an instance by a
-// vff::RigidTransform, and one exact occlusion ray.
+// vff::RigidTransform, one exact occlusion ray, packets of 16.
 #pragma once
 
 #include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <cstdint>
 
 #include "vff/query.h"
 
@@ -29,6 +32,29 @@ inline bool occluded1(RTCScene scene, const vff::Ray& r) {
   rtcInitIntersectContext(&ctx);
   rtcOccluded1(scene, &ctx, &ray);
   return ray.tfar < 0;
+}
+
+// Rays [lo, hi) in packets of 16 (rtcOccluded16; the last one part-filled), ray i's id ids[i]
+// (none: 0); out[i] = 1 where occluded.
+inline void occluded16(RTCScene scene, const vff::Ray* rays, const unsigned* ids, uint64_t lo, uint64_t hi,
+                       uint8_t* out) {
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  for (uint64_t b = lo; b < hi; b += 16) {
+    alignas(64) int valid[16];
+    RTCRay16 p;
+    for (unsigned k = 0; k < 16; ++k) {
+      const uint64_t i = std::min(b + k, hi - 1);  // (invalid lanes repeat the last ray)
+      const vff::Ray& r = rays[i];
+      valid[k] = b + k < hi ? -1 : 0;
+      p.org_x[k] = r.origin.x, p.org_y[k] = r.origin.y, p.org_z[k] = r.origin.z;
+      p.dir_x[k] = r.direction.x, p.dir_y[k] = r.direction.y, p.dir_z[k] = r.direction.z;
+      p.tnear[k] = r.tmin, p.tfar[k] = r.tmax, p.mask[k] = ~0u, p.id[k] = ids ? ids[i] : 0u, p.time[k] = 0,
+      p.flags[k] = 0;
+    }
+    rtcOccluded16(valid, scene, &ctx, &p);
+    for (unsigned k = 0; k < 16 && b + k < hi; ++k) out[b + k] = p.tfar[k] < 0;
+  }
 }
 
 }  // namespace vffx

@@ -108,4 +108,7 @@ ExactHit ExactTracer::intersect(const vff::Ray& r) const {
 
 uint64_t ExactTracer::memoryBytes() const { return uint64_t(std::max<int64_t>(0, impl_->peak.load())); }
 
+RTCDevice ExactTracer::device() const { return impl_->device; }
+RTCScene ExactTracer::scene() const { return impl_->scene; }
+
 }  // namespace vffx

@@ -37,8 +37,8 @@ bool writeImages(const Image& image, const std::string& base) {
 // the experiment's SDF rows: images, error maps, table rows. Returns an exit code, 0 on success.
 int renderSdfRows(const Options& o, const ImageExperiment& e, const World& world, const ExactTracer& exact,
                   const GBuffer& g, const std::vector<uint8_t>& mask, const Image& reference, const BakedQuery& c,
-                  int rays, unsigned threads, uint32_t stream, const std::string& base, std::vector<Image>* strip,
-                  std::vector<TableRow>* rows) {
+                  int rays, unsigned threads, uint32_t stream, const std::string& base, float range,
+                  std::vector<Image>* strip, std::vector<TableRow>* rows) {
   if (c.query.payloadBytes() < kSdfMinBudget) {  // a field this small has no distance field beside it
     std::fprintf(stderr, "%s: %s: note: no distance-field rows for %s: its %llu bytes are under the %llu a distance grid needs\n",
                  kProg, e.name.c_str(), c.name.c_str(), static_cast<unsigned long long>(c.query.payloadBytes()),
@@ -60,7 +60,7 @@ int renderSdfRows(const Options& o, const ImageExperiment& e, const World& world
   for (vff::Reconstruction r : e.sdfRows) {
     const char* mode = r == vff::Reconstruction::kNearest ? "sphere trace" : "cone";
     double seconds = 0;
-    const Image img = renderImage(g, threads, stream, e.makeShader(world, exact, nullptr, &sdf, r, rays), &seconds);
+    const Image img = renderImage(g, threads, stream, e.makeShader(world, exact, nullptr, &sdf, r, rays, range), &seconds);
     const ErrorStats st = compareImages(reference, img, mask);
     const std::string name = base + "-sdf-" + c.name + "-" + (r == vff::Reconstruction::kNearest ? "trace" : "cone");
     if (!writeImages(img, name)) return vff::cli::kExitIo;
@@ -76,15 +76,18 @@ int renderSdfRows(const Options& o, const ImageExperiment& e, const World& world
 
 }  // namespace
 
-std::string formatTable(const std::vector<TableRow>& rows) {
+std::string formatTable(const std::vector<TableRow>& rows, bool contact) {
   std::ostringstream s;
-  s << "| configuration | reconstruction | memory MiB | RMS (8-bit) | max | time s |\n";
-  s << "|---|---|---:|---:|---:|---:|\n";
+  s << "| configuration | reconstruction | memory MiB | RMS (8-bit) | " << (contact ? "RMS contact | RMS outside | " : "")
+    << "max | time s |\n";
+  s << "|---|---|---:|---:|" << (contact ? "---:|---:|" : "") << "---:|---:|\n";
+  auto rms = [](const TableRow& r, double v) { return r.reference ? std::string(v == r.rms ? "(reference)" : "-") : fixed(v, 2); };
   for (const TableRow& r : rows) {
     s << "| " << r.configuration << " | " << r.reconstruction << " | "
-      << (r.memoryMiB < 0 ? std::string("-") : fixed(r.memoryMiB, 2)) << " | "
-      << (r.reference ? std::string("(reference)") : fixed(r.rms, 2)) << " | "
-      << (r.reference ? std::string("-") : fixed(r.max, 0)) << " | " << fixed(r.seconds, 2) << " |\n";
+      << (r.memoryMiB < 0 ? std::string("-") : fixed(r.memoryMiB, 2)) << " | " << rms(r, r.rms) << " | ";
+    if (contact) s << (r.rmsContact < 0 ? std::string("-") : rms(r, r.rmsContact)) << " | "
+                   << (r.rmsOutside < 0 ? std::string("-") : rms(r, r.rmsOutside)) << " | ";
+    s << (r.reference ? std::string("-") : fixed(r.max, 0)) << " | " << fixed(r.seconds, 2) << " |\n";
   }
   return s.str();
 }
@@ -132,59 +135,85 @@ int runImageExperiment(const Options& o, const ImageExperiment& e) {
   for (size_t i = 0; i < mask.size(); ++i)
     mask[i] = (e.comparePlane && g.pixels[i].kind == PixelKind::kPlane) ||
               (e.compareObject && g.pixels[i].kind == PixelKind::kObject);
-  const std::string base = o.out + "/" + e.name;
+  // The contact region: plane pixels inside the bounding sphere (their rays start inside it).
+  std::vector<uint8_t> contact(mask.size()), outside(mask.size());
+  for (size_t i = 0; i < mask.size(); ++i) {
+    const Vec3 d = g.pixels[i].point - world->center;
+    const bool in = dot(d, d) <= world->radius * world->radius;
+    contact[i] = mask[i] && g.pixels[i].kind == PixelKind::kPlane && in;
+    outside[i] = mask[i] && !contact[i];
+  }
   const uint32_t stream = 0x76ff0000u ^ uint32_t(std::hash<std::string>{}(e.name) & 0xffffu);
+  auto measure = [&](const Image& reference, const Image& img, TableRow row) {
+    const ErrorStats st = compareImages(reference, img, mask);
+    row.rms = st.rms;
+    row.max = st.max;
+    if (e.contactRegion) {
+      row.rmsContact = compareImages(reference, img, contact).rms;
+      row.rmsOutside = compareImages(reference, img, outside).rms;
+    }
+    return row;
+  };
+
+  // The fields: the bakes of --config, then the files of --field.
+  std::vector<std::unique_ptr<BakedQuery>> fields;
+  for (const FieldConfig& fc : configs) {
+    auto baked = bakeQuery(*world, *scene, fc, e.normals, threads);
+    if (!baked) return vff::cli::reportError(kProg, o.mesh, baked.error());
+    std::fprintf(stderr, "%s: %s: baked %s in %.2f s (%.2f MiB)\n", kProg, e.name.c_str(), (*baked)->name.c_str(),
+                 (*baked)->bakeSeconds, (*baked)->payloadMiB());
+    fields.push_back(std::move(*baked));
+  }
+  for (std::unique_ptr<BakedQuery>& f : files) {
+    std::fprintf(stderr, "%s: %s: loaded %s (%.2f MiB)\n", kProg, e.name.c_str(), f->description.c_str(), f->payloadMiB());
+    fields.push_back(std::move(f));
+  }
 
   std::vector<TableRow> rows;
-  double seconds = 0;
-  const Image reference =
-      renderImage(g, threads, stream, e.makeShader(*world, *exact, nullptr, nullptr, vff::Reconstruction::kNearest, rays),
-                  &seconds);
-  if (!writeImages(reference, base + "-exact")) return vff::cli::kExitIo;
-  const double meshMiB = double(world->worldMesh.positions.size() * 4 + world->worldMesh.indices.size() * 4) / 1048576.0;
-  rows.push_back({"exact (Embree, " + std::to_string(world->worldMesh.triangleCount()) + " triangles)", "-",
-                  meshMiB + double(exact->memoryBytes()) / 1048576.0, 0, 0, seconds, true});
-  std::fprintf(stderr, "%s: %s: exact reference in %.2f s\n", kProg, e.name.c_str(), seconds);
-
-  std::vector<Image> strip{reference};  // exact | first configuration nearest | interpolated
-  // The bakes of --config, then the files of --field.
-  for (size_t source = 0; source < configs.size() + files.size(); ++source) {
-    const bool baking = source < configs.size();
-    std::unique_ptr<BakedQuery> field;
-    if (baking) {
-      auto baked = bakeQuery(*world, *scene, configs[source], e.normals, threads);
-      if (!baked) return vff::cli::reportError(kProg, o.mesh, baked.error());
-      field = std::move(*baked);
-    } else {
-      field = std::move(files[source - configs.size()]);
+  std::vector<Image> strip;  // exact | first configuration nearest | interpolated | distance field
+  const std::vector<float> ranges = e.ranges.empty() ? std::vector<float>{0.0f} : e.ranges;
+  for (float range : ranges) {
+    // With several ranges, every row and file names its range ("ao-r0.5-...", "4226x64x64 @ 0.5 R").
+    char tag[32] = "", label[32] = "";
+    if (e.ranges.size() > 1) {
+      std::snprintf(tag, sizeof tag, "-r%g", double(range));
+      std::snprintf(label, sizeof label, " @ %g R", double(range));
     }
-    const BakedQuery& c = *field;
-    if (baking)
-      std::fprintf(stderr, "%s: %s: baked %s in %.2f s (%.2f MiB)\n", kProg, e.name.c_str(), c.name.c_str(),
-                   c.bakeSeconds, c.payloadMiB());
-    else
-      std::fprintf(stderr, "%s: %s: loaded %s (%.2f MiB)\n", kProg, e.name.c_str(), c.description.c_str(),
-                   c.payloadMiB());
-    for (vff::Reconstruction r : {vff::Reconstruction::kNearest, vff::Reconstruction::kInterpolated}) {
-      const Image img =
-          renderImage(g, threads, stream, e.makeShader(*world, *exact, field.get(), nullptr, r, rays), &seconds);
-      const ErrorStats st = compareImages(reference, img, mask);
-      const std::string name = base + "-" + c.name + "-" + reconstructionName(r);
-      if (!writeImages(img, name)) return vff::cli::kExitIo;
-      if (strip.size() < 3) strip.push_back(img);
-      if (auto w = writeErrorMap(reference, img, mask, 8.0f, name + "-error.png"); !w)
-        return vff::cli::reportError(kProg, "", w.error());
-      rows.push_back({c.description, reconstructionName(r), c.payloadMiB(), st.rms, st.max, seconds, false});
-      std::fprintf(stderr, "%s: %s: %s %s in %.2f s, RMS %.2f\n", kProg, e.name.c_str(), c.name.c_str(),
-                   reconstructionName(r), seconds, st.rms);
-    }
-    if (o.sdf && !e.sdfRows.empty()) {
-      const bool first = strip.size() == 3;
-      if (const int rc = renderSdfRows(o, e, *world, *exact, g, mask, reference, c, rays, threads, stream, base,
-                                       first ? &strip : nullptr, &rows))
-        return rc;
+    const std::string base = o.out + "/" + e.name + tag;
+    double seconds = 0;
+    const Image reference = renderImage(
+        g, threads, stream, e.makeShader(*world, *exact, nullptr, nullptr, vff::Reconstruction::kNearest, rays, range),
+        &seconds);
+    if (!writeImages(reference, base + "-exact")) return vff::cli::kExitIo;
+    const double meshMiB = double(world->worldMesh.positions.size() * 4 + world->worldMesh.indices.size() * 4) / 1048576.0;
+    rows.push_back({"exact (Embree, " + std::to_string(world->worldMesh.triangleCount()) + " triangles)" + label, "-",
+                    meshMiB + double(exact->memoryBytes()) / 1048576.0, 0, 0, seconds, true});
+    std::fprintf(stderr, "%s: %s: exact reference%s in %.2f s\n", kProg, e.name.c_str(), label, seconds);
+    const bool firstRange = strip.empty();
+    if (firstRange) strip.push_back(reference);
+    for (const std::unique_ptr<BakedQuery>& field : fields) {
+      const BakedQuery& c = *field;
+      for (vff::Reconstruction r : {vff::Reconstruction::kNearest, vff::Reconstruction::kInterpolated}) {
+        const Image img =
+            renderImage(g, threads, stream, e.makeShader(*world, *exact, &c, nullptr, r, rays, range), &seconds);
+        const std::string name = base + "-" + c.name + "-" + reconstructionName(r);
+        if (!writeImages(img, name)) return vff::cli::kExitIo;
+        if (firstRange && strip.size() < 3) strip.push_back(img);
+        if (auto w = writeErrorMap(reference, img, mask, 8.0f, name + "-error.png"); !w)
+          return vff::cli::reportError(kProg, "", w.error());
+        rows.push_back(measure(reference, img, {c.description + label, reconstructionName(r), c.payloadMiB(), 0, 0, seconds, false}));
+        std::fprintf(stderr, "%s: %s: %s%s %s in %.2f s, RMS %.2f\n", kProg, e.name.c_str(), c.name.c_str(), label,
+                     reconstructionName(r), seconds, rows.back().rms);
+      }
+      if (o.sdf && !e.sdfRows.empty()) {
+        const bool first = strip.size() == 3;
+        if (const int rc = renderSdfRows(o, e, *world, *exact, g, mask, reference, c, rays, threads, stream, base,
+                                         range, first ? &strip : nullptr, &rows))
+          return rc;
+      }
     }
   }
+  const std::string base = o.out + "/" + e.name;
 
   // The side-by-side comparison: exact, the first configuration nearest and interpolated, its
   // distance field's first image.
@@ -197,8 +226,9 @@ int runImageExperiment(const Options& o, const ImageExperiment& e) {
      << " rays per pixel, " << threads << " threads; error over " << compared << " "
      << (e.comparePlane && e.compareObject ? "plane and object" : e.comparePlane ? "plane" : "object")
      << " pixels against the exact image; memory: field payload (exact: mesh + Embree BVH; distance field: the bricks of its "
-     << "narrow band and their indirection table, at most the field's payload); time: secondary rays only.\n\n"
-     << formatTable(rows);
+     << "narrow band and their indirection table, at most the field's payload); time: secondary rays only"
+     << (e.contactRegion ? "; contact: the plane pixels inside the bounding sphere, outside: the rest" : "") << ".\n\n"
+     << formatTable(rows, e.contactRegion);
   std::printf("%s", md.str().c_str());
   std::ofstream f(base + "-table.md");
   f << md.str();

@@ -19,7 +19,7 @@ int runIntraAo(const Options& o) {
   e.comparePlane = false;
   e.compareObject = true;
   e.makeShader = [](const World& w, const ExactTracer& exact, const BakedQuery* field, const SdfField* sdf,
-                    vff::Reconstruction r, int rays) -> std::function<Vec3(const GSample&, Rng&)> {
+                    vff::Reconstruction r, int rays, float) -> std::function<Vec3(const GSample&, Rng&)> {
     const float eps = 1e-3f * w.radius;
     const vff::QueryOptions qo{.reconstruction = r};
     const SdfTraceOptions so = sdfOptions(r == vff::Reconstruction::kInterpolated, true, hemisphereConeTan(rays));

@@ -59,6 +59,10 @@ int main(int argc, char** argv) {
   app.add_option("--ao-distance", o.aoDistance, "AO ray range in multiples of the bounding radius R")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  app.add_option("--ao-ranges", o.aoRanges,
+                 "ao: render each of these AO ranges (multiples of R, e.g. 0.25 0.5 1 2), each against its own "
+                 "exact image; default: --ao-distance")
+      ->check(CLI::PositiveNumber);
   app.add_option("--bench-rays", o.benchRays, "bench: rays per ray set")->capture_default_str()
       ->check(CLI::Range(1u, 1u << 26));
   app.add_option("--batch", o.benchBatch, "bench: rays per batch call in (b), (d) and (e) (a renderer's call: a tile, a pixel)")

@@ -39,7 +39,7 @@ int runReflections(const Options& o) {
   e.comparePlane = true;
   e.sdfRows = {vff::Reconstruction::kNearest};  // no cone for a hit's shading
   e.makeShader = [](const World& w, const ExactTracer& exact, const BakedQuery* field, const SdfField* sdf,
-                    vff::Reconstruction r, int rays) -> std::function<Vec3(const GSample&, Rng&)> {
+                    vff::Reconstruction r, int rays, float) -> std::function<Vec3(const GSample&, Rng&)> {
     const float eps = 1e-4f * w.radius;
     const vff::QueryOptions qo{.reconstruction = r};
     return [=, &exact](const GSample& s, Rng& rng) -> Vec3 {

@@ -33,11 +33,8 @@
 #include <embree3/rtcore.h>
 
 #include "cli.h"
-#include "common.h"
 #include "embree_instances.h"
-#include "surface_sampler.h"
-#include "vff/embree.h"
-#include "vff/scene.h"
+#include "scene_bench.h"
 
 namespace vffx {
 
@@ -52,6 +49,8 @@ double now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+}  // namespace
+
 vff::RigidTransform randomPlacement(std::mt19937_64& g, float side) {
   std::uniform_real_distribution<float> u(0, 1);
   const Vec3 axis = uniformSphere(u(g), u(g));
@@ -59,9 +58,7 @@ vff::RigidTransform randomPlacement(std::mt19937_64& g, float side) {
   return vff::RigidTransform::fromAxisAngle(axis, angle, {side * u(g), side * u(g), side * u(g)});
 }
 
-struct Side {
-  double commit = 0, rays = 0;  // seconds, summed over frames
-};
+namespace {
 
 // The object's mesh centred on its field's sphere s, alone in an Embree scene (what every
 // instance of (a) instances), so that a placement's translation is its sphere's centre.
@@ -83,50 +80,14 @@ RTCScene centredMeshScene(RTCDevice device, const vff::bake::Mesh& m, const vff:
   return mesh;
 }
 
-// The field's object space has its sphere's centre at s.center: the same shift.
+}  // namespace
+
 vff::RigidTransform fieldPlacement(const vff::RigidTransform& x, const vff::Sphere& s) {
   vff::RigidTransform f = x;
   f.translation = x.translation - x.toWorldVector(toVec(s.center));
   return f;
 }
 
-// What every count's frames share: the options, the field and its sphere, the query options and the
-// surface the rays start on.
-struct Bench {
-  const Options& o;
-  unsigned threads;
-  const vff::FieldQuery& q;
-  const vff::Sphere& s;  // the field's sphere
-  float R;
-  // The field's default intra bias: the rays start on the objects' surfaces.
-  vff::QueryOptions qo;
-  const SurfaceSampler& surface;
-};
-
-// One instance count's scenes and sums. Every count's scenes exist at once: the counts take turns
-// frame by frame (runSceneBench). A count owns its Embree objects, and releases them on every way
-// out.
-struct Count {
-  uint32_t n = 0;
-  std::mt19937_64 g;
-  float side = 0;
-  RTCScene exact = nullptr, hybrid = nullptr;
-  std::vector<RTCGeometry> inst;
-  std::vector<vff::embree::FieldGeometry> fields;
-  vff::Scene scene;
-  Side a, b, c;
-  double answers = 0;  // (b)'s floor, summed over frames
-  uint64_t agreeAB = 0, agreeBC = 0, agreeBD = 0, total = 0, pairs = 0;
-  ~Count() {
-    fields.clear();  // (each detaches from `hybrid`, which must still exist)
-    for (RTCGeometry gi : inst) rtcReleaseGeometry(gi);
-    if (hybrid) rtcReleaseScene(hybrid);
-    if (exact) rtcReleaseScene(exact);
-  }
-};
-
-// n instances at random in a cube whose volume grows with n: (a) instances of `mesh`, (b) the
-// field's vff::Scene, (c) the field's Embree geometries.
 std::unique_ptr<Count> makeCount(const Bench& b, uint32_t n, RTCDevice device, RTCScene mesh) {
   auto count = std::make_unique<Count>();
   Count& k = *count;
@@ -147,6 +108,8 @@ std::unique_ptr<Count> makeCount(const Bench& b, uint32_t n, RTCDevice device, R
   }
   return count;
 }
+
+namespace {
 
 // A frame's rays and answers, reused by every count and frame.
 struct FrameRays {
@@ -359,12 +322,13 @@ int runSceneBench(const Options& o) {
     for (auto& count : counts)
       if (int rc = measureFrame(b, *count, frame, f)) return rc;
   const std::vector<Summary> summary = printCounts(counts, o.frames);
+  printSummary(summary);
   std::fflush(stdout);
+  const int rc = runRayForms(b, counts, device, mesh);
   counts.clear();
   rtcReleaseScene(mesh);
   rtcReleaseDevice(device);
-  printSummary(summary);
-  return 0;
+  return rc;
 }
 
 }  // namespace vffx

@@ -9,8 +9,10 @@
 // primary hits:
 //   exact   Embree: the room's triangles and each object as an instance of its mesh's scene, the
 //           top level recommitted every frame;
-//   fields  the room in Embree (exact), the objects through a vff::Scene (kNearest), committed
-//           every frame; a pixel on an object answers with its intra-object test.
+//   fields  the two-pass hybrid (vff::embree::occluded): the objects through a vff::Scene
+//           (kNearest), committed every frame, then the room in Embree (exact); each ray's source
+//           is the pixel's object (its intra-object test, spec/geometry.md 7.3) or none (a room
+//           point: every object by 7.4).
 //   distance fields  the room exact, each object through its distance field (sdf_field.h) at its
 //           field's memory, sphere traced (rows "F, distance fields"; --no-sdf: none).
 // Writes OUT/scene-fF-exact.png, -fields.png, -comparison.png (the two side by side),
@@ -30,6 +32,7 @@
 #include "embree_instances.h"
 #include "vff/bake/procedural.h"
 #include "vff/bake/sphere.h"
+#include "vff/embree.h"
 #include "vff/scene.h"
 
 namespace vffx {
@@ -237,6 +240,7 @@ GBuffer primaryHits(RTCScene exact, const Camera& cam, int size, const std::vect
       if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
       const uint32_t id = rh.hit.instID[0];
       s.kind = id < count ? PixelKind::kObject : PixelKind::kPlane;
+      s.instance = id < count ? id : vff::kNoInstance;
       Vec3 n{rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
       if (id < count) n = xs[id].toWorldVector(n);  // Embree gives an instance's normal in its space
       n = normalize(n);
@@ -278,12 +282,13 @@ Image renderFields(const GBuffer& g, const vff::Scene& fields, RTCScene roomOnly
     if (s.kind == PixelKind::kBackground) return Vec3{};
     const std::span<vff::Ray> r = aoRays(s, rng, rays);
     thread_local std::vector<uint8_t> blocked;
+    thread_local std::vector<uint32_t> sources;
     blocked.resize(r.size());
-    vff::QueryOptions qo;
-    if (s.kind == PixelKind::kPlane) qo.intraBias = 0;  // a room point is on no object
-    (void)fields.occluded(r, blocked, qo);
+    sources.assign(r.size(), s.instance);  // each ray starts on the pixel's object, or on none (the room)
+    // The two-pass hybrid: the objects through vff::Scene, then the room in Embree packets.
+    (void)vff::embree::occluded(roomOnly, fields, r, sources, blocked);
     int open = 0;
-    for (size_t i = 0; i < r.size(); ++i) open += !blocked[i] && !occluded1(roomOnly, r[i]);
+    for (size_t i = 0; i < r.size(); ++i) open += !blocked[i];
     const float v = float(open) / float(rays);
     return Vec3{v, v, v};
   }, seconds);

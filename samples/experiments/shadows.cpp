@@ -36,7 +36,7 @@ int runShadows(const Options& o) {
   e.comparePlane = true;
   e.compareObject = true;
   e.makeShader = [](const World& w, const ExactTracer& exact, const BakedQuery* field, const SdfField* sdf,
-                    vff::Reconstruction r, int rays) -> std::function<Vec3(const GSample&, Rng&)> {
+                    vff::Reconstruction r, int rays, float) -> std::function<Vec3(const GSample&, Rng&)> {
     const float eps = 1e-3f * w.radius;
     return [=, &exact](const GSample& s, Rng& rng) -> Vec3 {
       if (s.kind == PixelKind::kBackground) return {};

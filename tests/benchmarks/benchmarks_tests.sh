@@ -57,7 +57,7 @@ test_only_runs_one_step() {
   run bash "$VFF_SOURCE_DIR/benchmarks/run.sh" --quick --only sdf --build "$VFF_BUILD_DIR" --mesh "$WORK/knot.obj" \
     --out "$WORK/s.md"
   expect_rc 0
-  grep -q -F -- "--only sdf (a reduced run: that step alone)" "$WORK/s.md" || fail "the results file does not say it is reduced"
+  grep -q -F -- "--only sdf (a reduced run: those steps alone)" "$WORK/s.md" || fail "the results file does not say it is reduced"
   ! grep -q -F "### Bake speed" "$WORK/s.md" || fail "--only sdf ran the bake"
   run "$PYTHON" "$report" check "$WORK/s.md"
   expect_rc 0

@@ -18,6 +18,12 @@ case "$case" in
     grep -q '1090x16x16 | nearest' stdout.txt || { cat stdout.txt; fail "table lacks the nearest row"; }
     grep -q '1090x16x16 | interpolated' stdout.txt || fail "table lacks the interpolated row"
     if command -v exrheader >/dev/null; then exrheader out/ao-exact.exr >/dev/null || fail "exrheader rejects the EXR"; fi
+    # The contact region's error beside the whole image's, and one pass per AO range.
+    grep -q '| RMS contact | RMS outside |' stdout.txt || { cat stdout.txt; fail "table lacks the contact columns"; }
+    "$exp" ao "${small[@]}" --rays 16 --ao-ranges 0.5 2 -o ranges >stdout.txt 2>stderr.txt || { cat stderr.txt; fail "ao --ao-ranges failed"; }
+    for f in ao-r0.5-exact.png ao-r2-exact.png ao-r0.5-1090x16x16-nearest.png; do [ -s "ranges/$f" ] || { ls ranges; fail "missing ranges/$f"; }; done
+    grep -q '1090x16x16 @ 0.5 R | nearest' stdout.txt || { cat stdout.txt; fail "table lacks the 0.5 R row"; }
+    grep -q 'exact (Embree, [0-9]* triangles) @ 2 R' stdout.txt || { cat stdout.txt; fail "table lacks the 2 R reference"; }
     ;;
   every_experiment_runs)
     for e in intra-ao shadows reflections; do
@@ -59,17 +65,27 @@ case "$case" in
     "$exp" scene-bench --mesh knot.obj --config 290x16x16 --instances 1 7 40 --scene-rays 3000 --frames 1 -j 2 \
       >stdout.txt 2>stderr.txt || { cat stderr.txt; fail "scene-bench failed"; }
     grep -q "^Scene benchmark: .* threads, " stdout.txt || { cat stdout.txt; fail "scene-bench header names no CPU"; }
-    [ "$(grep -cE '^\| [0-9]+ \|' stdout.txt)" -eq 3 ] || { cat stdout.txt; fail "scene-bench: not one row per count"; }
-    for n in 1 7 40; do grep -qE "^\| $n \|" stdout.txt || { cat stdout.txt; fail "scene-bench: no row for $n"; }; done
+    sed -n '/^| instances | (a)/,/^$/p' stdout.txt >first.txt  # the first table: time per frame
+    [ "$(grep -cE '^\| [0-9]+ \|' first.txt)" -eq 3 ] || { cat stdout.txt; fail "scene-bench: not one row per count"; }
+    for n in 1 7 40; do grep -qE "^\| $n \|" first.txt || { cat stdout.txt; fail "scene-bench: no row for $n"; }; done
     # The hybrid (c) answers every ray as vff::Scene (b) does: its column "(c) = (b)" is 1.
-    [ "$(awk -F'|' '/^\| [0-9]+ \|/ {print $12}' stdout.txt | tr -d ' ' | sort -u)" = "1.0000" ] \
+    [ "$(awk -F'|' '/^\| [0-9]+ \|/ {print $12}' first.txt | tr -d ' ' | sort -u)" = "1.0000" ] \
       || { cat stdout.txt; fail "scene-bench: the hybrid answers otherwise than vff::Scene"; }
     # (b)'s floor (the field's batch on (b)'s pairs, found beforehand) answers as (b) does, and
     # the summary says what finding the pairs costs.
-    [ "$(awk -F'|' '/^\| [0-9]+ \|/ {print $15}' stdout.txt | tr -d ' ' | sort -u)" = "1.0000" ] \
+    [ "$(awk -F'|' '/^\| [0-9]+ \|/ {print $15}' first.txt | tr -d ' ' | sort -u)" = "1.0000" ] \
       || { cat stdout.txt; fail "scene-bench: the pairs found beforehand answer otherwise than vff::Scene"; }
     grep -q "^1 instance: finding and preparing the pairs takes " stdout.txt \
       || { cat stdout.txt; fail "scene-bench: no line on what finding the pairs costs"; }
+    # The ray forms: per count and ray set, three forms and vff::Scene; the hybrid with ray sources
+    # answers every ray as vff::Scene's *From calls do, in every form.
+    sed -n '/^| instances | rays | form |/,/^$/p' stdout.txt >forms.txt
+    [ "$(grep -cE '^\| [0-9]+ \| (random|tiles) \|' forms.txt)" -eq 24 ] || { cat stdout.txt; fail "scene-bench: not 4 rows a count and set"; }
+    [ "$(awk -F'|' '/\| (single|packets of 16|stream) \|/ {print $9}' forms.txt | tr -d ' ' | sort -u)" = "1.0000" ] \
+      || { cat stdout.txt; fail "scene-bench: the hybrid with sources answers otherwise than vff::Scene"; }
+    awk -F'|' '/packets of 16/ {exit !($8 + 0 >= 1)}' forms.txt || { cat forms.txt; fail "scene-bench: no rays a callback"; }
+    sed -n '/^| instances | rays | vff::Scene speed-up/,/^$/p' stdout.txt >twopass.txt
+    [ "$(grep -cE '^\| [0-9]+ \| (random|tiles) \|' twopass.txt)" -eq 6 ] || { cat stdout.txt; fail "scene-bench: no two-pass rows"; }
     ;;
   scene_writes_frames_and_table)
     "$exp" scene --mesh knot.obj --config 290x16x16 --size 48 --rays 8 --frames 2 -j 2 -o out >stdout.txt 2>stderr.txt \
@@ -141,7 +157,7 @@ case "$case" in
     [ ! -e sc/scene-f0-sdf.png ] || fail "scene: a distance-field image for tiny fields"
     "$exp" scene-bench "${tiny[@]}" --instances 1 3 --scene-rays 300 --frames 1 >stdout.txt 2>stderr.txt \
       || { cat stderr.txt; fail "scene-bench on tiny fields failed"; }
-    [ "$(grep -cE '^\| [0-9]+ \|' stdout.txt)" -eq 2 ] || { cat stdout.txt; fail "scene-bench: not one row per count"; }
+    [ "$(sed -n '/^| instances | (a)/,/^$/p' stdout.txt | grep -cE '^\| [0-9]+ \|')" -eq 2 ] || { cat stdout.txt; fail "scene-bench: not one row per count"; }
     "$exp" sdf-bench "${tiny[@]}" --bench-rays 2000 --repeat 1 >stdout.txt 2>stderr.txt
     rc=$?
     [ "$rc" -eq 1 ] || { cat stderr.txt; fail "sdf-bench on a tiny field: exit $rc, expected 1 (usage)"; }
