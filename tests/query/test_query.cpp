@@ -11,6 +11,7 @@
 
 #include "common/baked_shape.h"
 #include "common/rng.h"
+#include "common/vec3.h"
 #include "platform/huge_pages.h"  // private: detail::adviseHugePages
 #include "vff/bake/embree_reference.h"
 #include "vff/vff.h"
@@ -22,13 +23,13 @@ using Reference = bake::EmbreeReference;
 using test::bakeShape;
 using test::BakedShape;
 using test::Rng;
+using test::add;
+using test::centerOf;
+using test::dot3;
+using test::mul;
+using test::sub;
+using test::unit;
 
-Vec3 add(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-Vec3 sub(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-Vec3 mul(Vec3 a, float s) { return {a.x * s, a.y * s, a.z * s}; }
-float dot3(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-Vec3 unit(Vec3 a) { return mul(a, 1.0f / std::sqrt(dot3(a, a))); }
-Vec3 centerOf(const FieldDesc& f) { return {f.sphere.center[0], f.sphere.center[1], f.sphere.center[2]}; }
 
 // ---- The lookup of spec/geometry.md 7.2, texel by texel -----------------------------------------
 

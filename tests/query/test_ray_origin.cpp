@@ -14,6 +14,7 @@
 
 #include "common/baked_shape.h"
 #include "common/rng.h"
+#include "common/vec3.h"
 #include "vff/bake/embree_reference.h"
 #include "vff/vff.h"
 
@@ -24,12 +25,12 @@ using Reference = bake::EmbreeReference;
 using test::bakeShape;
 using test::BakedShape;
 using test::Rng;
+using test::add;
+using test::centerOf;
+using test::dot3;
+using test::mul;
+using test::sub;
 
-Vec3 add(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-Vec3 sub(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-Vec3 mul(Vec3 a, float s) { return {a.x * s, a.y * s, a.z * s}; }
-float dot3(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-Vec3 centerOf(const FieldDesc& f) { return {f.sphere.center[0], f.sphere.center[1], f.sphere.center[2]}; }
 
 uint32_t bits(float f) {
   uint32_t u;
@@ -109,7 +110,9 @@ TEST(RayOrigin, GroundAoKeepsTheContactShadowAtEveryRange) {
       EXPECT_LE(near, 10.0) << name << " at " << reach << " R";
       EXPECT_LE(interp, near) << name << " at " << reach << " R";
       EXPECT_LT(near, old) << name << " at " << reach << " R";
-      if (std::strcmp(name, "box") == 0 && reach <= 0.5f) EXPECT_LT(near, old / 5) << name << " at " << reach << " R";
+      if (std::strcmp(name, "box") == 0 && reach <= 0.5f) {
+        EXPECT_LT(near, old / 5) << name << " at " << reach << " R";
+      }
     }
   }
 }
@@ -257,7 +260,9 @@ TEST(RayOrigin, BatchesAnswerLikeOneRays) {
         ASSERT_EQ(hits[r].inside, one.inside) << name << " ray " << r;
         ASSERT_EQ(blocked[r] != 0, b.query.occluded(rays[r], o)) << name << " ray " << r;
         ASSERT_EQ(bits(vis[r]), bits(b.query.visibility(rays[r], o))) << name << " ray " << r;
-        if (one.hit) ASSERT_GE(one.t * std::sqrt(dot3(rays[r].direction, rays[r].direction)), rays[r].tmin);
+        if (one.hit) {
+          ASSERT_GE(one.t * std::sqrt(dot3(rays[r].direction, rays[r].direction)), rays[r].tmin);
+        }
         const Vec3 dc = sub(rays[r].origin, c);
         if (dot3(dc, dc) > R * R * 1.0001f) {  // from outside: as under section 7.3
           QueryOptions on = o;

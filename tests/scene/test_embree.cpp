@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "common/baked_shape.h"
+#include "embree_test.h"
 #include "common/rng.h"
 #include "vff/embree.h"
 #include "vff/vff.h"
@@ -18,14 +19,11 @@ namespace {
 
 using test::Rng;
 
-// The two fields of every test, both with normals.
-const std::vector<std::unique_ptr<test::BakedShape>>& fields() { return test::knotAndBowl(true); }
+using test::addGround;
+using test::bits;
+using test::toEmbree;
 
-uint32_t bits(float f) {
-  uint32_t u;
-  std::memcpy(&u, &f, 4);
-  return u;
-}
+const std::vector<std::unique_ptr<test::BakedShape>>& fields() { return test::embreeFields(); }
 
 struct EmbreeWorld {
   RTCDevice device = rtcNewDevice(nullptr);
@@ -37,31 +35,6 @@ struct EmbreeWorld {
     rtcReleaseDevice(device);
   }
 };
-
-// A ground quad at y = -3 as two triangles, attached at geomID 100000.
-void addGround(RTCDevice device, RTCScene scene) {
-  RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 12, 4));
-  const float q[12] = {-50, -3, -50, 50, -3, -50, 50, -3, 50, -50, -3, 50};
-  std::memcpy(v, q, sizeof q);
-  auto* ix = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 12, 2));
-  const unsigned t[6] = {0, 2, 1, 0, 3, 2};
-  std::memcpy(ix, t, sizeof t);
-  rtcCommitGeometry(g);
-  rtcAttachGeometryByID(scene, g, 100000);
-  rtcReleaseGeometry(g);
-}
-
-RTCRayHit toEmbree(const Ray& r) {
-  RTCRayHit rh{};
-  rh.ray.org_x = r.origin.x, rh.ray.org_y = r.origin.y, rh.ray.org_z = r.origin.z;
-  rh.ray.dir_x = r.direction.x, rh.ray.dir_y = r.direction.y, rh.ray.dir_z = r.direction.z;
-  rh.ray.tnear = r.tmin;
-  rh.ray.tfar = r.tmax;
-  rh.ray.mask = ~0u;
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  return rh;
-}
 
 std::vector<Ray> randomRays(Rng& rng, size_t n, float e) {
   std::vector<Ray> rays;
@@ -162,9 +135,9 @@ TEST(SceneEmbree, MixedWithTrianglesGivesTheNearerOfBoth) {
   Rng rng(12);
   EmbreeWorld w;
   RTCScene ground = rtcNewScene(w.device);
-  addGround(w.device, ground);
+  addGround(w.device, ground, 100000);
   rtcCommitScene(ground);
-  addGround(w.device, w.scene);
+  addGround(w.device, w.scene, 100000);
   Scene scene;
   for (uint32_t i = 0; i < 20; ++i) {
     const RigidTransform x = rng.transform(3.0f, 0.4f, 1.4f);

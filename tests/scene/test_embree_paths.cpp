@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "common/baked_shape.h"
+#include "embree_test.h"
 #include "common/rng.h"
 #include "vff/embree.h"
 #include "vff/vff.h"
@@ -18,13 +19,10 @@ namespace {
 
 using test::Rng;
 
-const std::vector<std::unique_ptr<test::BakedShape>>& fields() { return test::knotAndBowl(true); }
+using test::bits;
+using test::toEmbree;
 
-uint32_t bits(float f) {
-  uint32_t u;
-  std::memcpy(&u, &f, 4);
-  return u;
-}
+const std::vector<std::unique_ptr<test::BakedShape>>& fields() { return test::embreeFields(); }
 
 // A scene of n instances twice: as a vff::Scene and as FieldGeometry (geomID = instance id) in an
 // RTCScene, optionally with a ground quad (geomID 100000) in a scene of its own and in the
@@ -44,9 +42,9 @@ struct World {
     }
     if (withGround) {
       ground = rtcNewScene(device);
-      addGround(ground);
+      test::addGround(device, ground, 100000);
       rtcCommitScene(ground);
-      addGround(embree);
+      test::addGround(device, embree, 100000);
     }
     EXPECT_TRUE(scene.commit().ok());
     rtcCommitScene(embree);
@@ -57,31 +55,7 @@ struct World {
     rtcReleaseScene(embree);
     rtcReleaseDevice(device);
   }
-  void addGround(RTCScene s) {
-    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 12, 4));
-    const float q[12] = {-50, -3, -50, 50, -3, -50, 50, -3, 50, -50, -3, 50};
-    std::memcpy(v, q, sizeof q);
-    auto* ix = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 12, 2));
-    const unsigned t[6] = {0, 2, 1, 0, 3, 2};
-    std::memcpy(ix, t, sizeof t);
-    rtcCommitGeometry(g);
-    rtcAttachGeometryByID(s, g, 100000);
-    rtcReleaseGeometry(g);
-  }
 };
-
-RTCRayHit toEmbree(const Ray& r, unsigned id = 0) {
-  RTCRayHit rh{};
-  rh.ray.org_x = r.origin.x, rh.ray.org_y = r.origin.y, rh.ray.org_z = r.origin.z;
-  rh.ray.dir_x = r.direction.x, rh.ray.dir_y = r.direction.y, rh.ray.dir_z = r.direction.z;
-  rh.ray.tnear = r.tmin;
-  rh.ray.tfar = r.tmax;
-  rh.ray.mask = ~0u;
-  rh.ray.id = id;
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  return rh;
-}
 
 // Rays from around the scene and from inside the instances' spheres, some with a short tmax; with
 // each ray's source: the instance whose sphere it starts in (every other one), or none.

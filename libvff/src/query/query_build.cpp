@@ -227,6 +227,7 @@ detail::GroupTables FieldQuery::Impl::groupTables(const QueryOptions& o, bool de
   t.bit1 = field.distanceEncoding == DistanceEncoding::kBit1;
   t.insideLo = (o.intraBias >= 0 ? o.intraBias : defaultBias) * radius;
   t.offObject = o.origin == RayOrigin::kOffObject;
+  t.offTolerance = offTolerance;
   t.gridGuard = detail::gridGuard(t.octaN);
   t.texelGuard = detail::texelGuard(m);
   t.maps = dist.data();
@@ -236,9 +237,7 @@ detail::GroupTables FieldQuery::Impl::groupTables(const QueryOptions& o, bool de
     t.texels = dist[0];
     t.mapBytes = int32_t(distMapBytes);
   }
-  // (Section 7.4's step 3 needs a second lookup: off-object rays are decoded by offHitsAt.)
-  t.decodeHits = decodeHits && byteTexels && field.distanceEncoding == DistanceEncoding::kUnorm8Diameter &&
-                 !t.offObject;
+  t.decodeHits = decodeHits && byteTexels && field.distanceEncoding == DistanceEncoding::kUnorm8Diameter;
   t.distanceScale = distanceStep;
   return t;
 }

@@ -112,43 +112,71 @@ void answerPairs(const Scene::Impl& m, const Pairs& p, std::vector<T>* answers, 
   }
 }
 
-// With sources (chunk-relative; null: none), answers again the pairs whose ray starts on their own
-// instance, with section 7.3's options (answerPairs gave every pair section 7.4's): once per
-// field, over the own pairs of all its instances.
+// With sources (chunk-relative): each field answers the pairs whose ray starts on their own
+// instance with `on` (section 7.3) and the rest with `off` (7.4): two calls over the pairs
+// gathered apart, or one in place where none of the field's pairs starts on its instance.
 template <class T, class Answer>
-void answerOwnPairs(const Scene::Impl& m, const Pairs& p, const uint32_t* sources, const QueryOptions& on,
-                    std::vector<T>* answers, Answer&& answer) {
-  if (!sources) return;
+void answerSourcedPairs(const Scene::Impl& m, const Pairs& p, const uint32_t* sources, const QueryOptions& on,
+                        const QueryOptions& off, std::vector<T>* answers, Answer&& answer) {
+  answers->resize(p.rays.size());
+  const std::span<const Ray> all(p.rays);
+  const std::span<T> out(*answers);
+  std::vector<uint8_t> own;
   std::vector<Ray> rays;
   std::vector<uint32_t> at;
+  std::vector<T> part;
   for (size_t g = 0; g + 1 < m.fieldStart.size(); ++g) {
-    rays.clear();
-    at.clear();
+    const uint32_t lo = m.byField[m.fieldStart[g]], hi = m.byField[m.fieldStart[g + 1] - 1];
+    const uint32_t a = p.first[lo], b = p.first[hi] + p.count[hi];
+    if (a == b) continue;
+    const FieldQuery& field = *m.instances[lo].field;
+    own.assign(b - a, 0);
+    bool any = false;
     for (uint32_t f = m.fieldStart[g]; f < m.fieldStart[g + 1]; ++f) {
       const uint32_t id = m.byField[f];
       for (uint32_t k = p.first[id]; k < p.first[id] + p.count[id]; ++k)
-        if (sources[p.ray[k]] == id) {
-          rays.push_back(p.rays[k]);
-          at.push_back(k);
-        }
+        if (sources[p.ray[k]] == id) own[k - a] = 1, any = true;
     }
-    if (at.empty()) continue;
-    std::vector<T> own(at.size());
-    answer(*m.instances[m.byField[m.fieldStart[g]]].field, std::span<const Ray>(rays), std::span<T>(own), on);
-    for (size_t q = 0; q < at.size(); ++q) (*answers)[at[q]] = own[q];
+    if (!any) {
+      answer(field, all.subspan(a, b - a), out.subspan(a, b - a), off);
+      continue;
+    }
+    for (const uint8_t which : {uint8_t(0), uint8_t(1)}) {
+      rays.clear();
+      at.clear();
+      for (uint32_t k = a; k < b; ++k)
+        if (own[k - a] == which) rays.push_back(p.rays[k]), at.push_back(k);
+      if (at.empty()) continue;
+      part.resize(at.size());
+      answer(field, std::span<const Ray>(rays), std::span<T>(part), which ? on : off);
+      for (size_t q = 0; q < at.size(); ++q) out[at[q]] = part[q];
+    }
   }
 }
 
-// The options of a call's first pass over all pairs, and of answerOwnPairs.
+// A call's options: `all` for a call without sources; with sources, `own` for the pairs whose ray
+// starts on their instance and `others` for the rest.
 struct PassOptions {
-  QueryOptions all, own;
-  PassOptions(const QueryOptions& o, bool sources) : all(o), own(o) {
-    if (sources) {
-      all.origin = RayOrigin::kOffObject;
-      own.origin = RayOrigin::kOnObject;
-    }
+  QueryOptions all, own, others;
+  explicit PassOptions(const QueryOptions& o) : all(o), own(o), others(o) {
+    own.origin = RayOrigin::kOnObject;
+    others.origin = RayOrigin::kOffObject;
   }
 };
+
+// The pairs of a chunk answered (answer(field, rays, out, options)), with the chunk's sources or
+// without (null).
+template <class T, class Answer>
+void answerChunk(const Scene::Impl& m, const Pairs& p, const uint32_t* sources, const PassOptions& pass,
+                 std::vector<T>* answers, Answer&& answer) {
+  if (sources) {
+    answerSourcedPairs(m, p, sources, pass.own, pass.others, answers, answer);
+  } else {
+    answerPairs(m, p, answers, [&](const FieldQuery& f, std::span<const Ray> r, std::span<T> o) {
+      answer(f, r, o, pass.all);
+    });
+  }
+}
 
 Status checkSources(const Scene::Impl* m, size_t rays, std::span<const uint32_t> sources) {
   if (sources.size() != rays)
@@ -172,7 +200,7 @@ Status intersectBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::s
   std::fill(out.begin(), out.end(), SceneHit{});
   if (!impl) return {};
   const Scene::Impl& m = *impl;
-  const PassOptions pass(options, sources.data() != nullptr);
+  const PassOptions pass(options);
   const ScratchLease lease(m);
   Scratch& s = *lease;
   const Pairs& p = s.pairs;
@@ -183,10 +211,7 @@ Status intersectBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::s
   for (size_t c = 0; c < rays.size(); c += kChunk) {
     const std::span<const Ray> chunk = rays.subspan(c, std::min(kChunk, rays.size() - c));
     pairUp(m, chunk, &s);
-    answerPairs(m, p, &hits, [&](const FieldQuery& f, std::span<const Ray> r, std::span<QueryHit> h) {
-      answer(f, r, h, pass.all);
-    });
-    answerOwnPairs(m, p, sources.data() ? sources.data() + c : nullptr, pass.own, &hits, answer);
+    answerChunk(m, p, sources.data() ? sources.data() + c : nullptr, pass, &hits, answer);
     for (uint32_t i = 0; i < m.instances.size(); ++i)
       for (uint32_t k = p.first[i]; k < p.first[i] + p.count[i]; ++k) {
         SceneHit& best = out[c + p.ray[k]];
@@ -208,7 +233,7 @@ Status occludedBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::sp
   std::fill(out.begin(), out.end(), uint8_t(0));
   if (!impl) return {};
   const Scene::Impl& m = *impl;
-  const PassOptions pass(options, sources.data() != nullptr);
+  const PassOptions pass(options);
   const ScratchLease lease(m);
   Scratch& s = *lease;
   const Pairs& p = s.pairs;
@@ -219,10 +244,7 @@ Status occludedBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::sp
   for (size_t c = 0; c < rays.size(); c += kChunk) {
     const std::span<const Ray> chunk = rays.subspan(c, std::min(kChunk, rays.size() - c));
     pairUp(m, chunk, &s);
-    answerPairs(m, p, &blocked, [&](const FieldQuery& f, std::span<const Ray> r, std::span<uint8_t> o) {
-      answer(f, r, o, pass.all);
-    });
-    answerOwnPairs(m, p, sources.data() ? sources.data() + c : nullptr, pass.own, &blocked, answer);
+    answerChunk(m, p, sources.data() ? sources.data() + c : nullptr, pass, &blocked, answer);
     for (size_t k = 0; k < p.ray.size(); ++k) out[c + p.ray[k]] |= blocked[k];
   }
   return {};
@@ -235,7 +257,7 @@ Status visibilityBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::
   std::fill(out.begin(), out.end(), 1.0f);
   if (!impl) return {};
   const Scene::Impl& m = *impl;
-  const PassOptions pass(options, sources.data() != nullptr);
+  const PassOptions pass(options);
   const ScratchLease lease(m);
   Scratch& s = *lease;
   const Pairs& p = s.pairs;
@@ -246,10 +268,7 @@ Status visibilityBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::
   for (size_t c = 0; c < rays.size(); c += kChunk) {
     const std::span<const Ray> chunk = rays.subspan(c, std::min(kChunk, rays.size() - c));
     pairUp(m, chunk, &s);
-    answerPairs(m, p, &vis, [&](const FieldQuery& f, std::span<const Ray> r, std::span<float> o) {
-      answer(f, r, o, pass.all);
-    });
-    answerOwnPairs(m, p, sources.data() ? sources.data() + c : nullptr, pass.own, &vis, answer);
+    answerChunk(m, p, sources.data() ? sources.data() + c : nullptr, pass, &vis, answer);
     for (uint32_t i = 0; i < m.instances.size(); ++i)  // the product in id order
       for (uint32_t k = p.first[i]; k < p.first[i] + p.count[i]; ++k) out[c + p.ray[k]] *= vis[k];
   }

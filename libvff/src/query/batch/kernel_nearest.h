@@ -78,7 +78,8 @@ void sphereStep(const GroupTables& tb, const Ray* rays, Group* g, size_t r0, Loo
   const size_t at = g->count;
   if (tb.decodeHits) {
     compress(g->pt0 + at, t0, bits);
-    compress(g->plo + at, lo, bits);
+    // (Section 7.4's rays, t0 < 0, count a surface within the tolerance behind lo: decodeStep.)
+    compress(g->plo + at, tb.offObject ? sel(lt(t0, zero), lo - F(tb.offTolerance), lo) : lo, bits);
     compress(g->phi + at, tmaxL, bits);
     compress(g->pinside + at, maskValue(inside), bits);
   }
@@ -221,10 +222,12 @@ void lookupStep(const GroupTables& tb, size_t p, LookupQueue* q) {
 }
 
 // GroupKernel::decode (query_group.h) for packed rays p .. p + kLanes - 1, those of `keep` only:
-// whether each texel holds a hit within the ray's range, as FieldQuery::Impl::hitsAt decodes a
-// kUnorm8Diameter texel: bit l of the answer for packed ray p + l.
+// whether each texel holds a hit within the ray's range, as FieldQuery::Impl::hitsAt (and, for
+// section 7.4's rays, offHitsAt) decodes a kUnorm8Diameter texel: bit l of the answer for packed
+// ray p + l. *behind: the section 7.4 rays whose surface lies behind the origin (step 3: the
+// caller's reference path answers them).
 template <class F>
-unsigned decodeStep(const GroupTables& tb, size_t p, const Group* g) {
+unsigned decodeStep(const GroupTables& tb, size_t p, const Group* g, unsigned* behind) {
   F c;
   if (tb.texels) {
     c = F::gatherBytes(tb.texels, g->t + p);
@@ -237,7 +240,10 @@ unsigned decodeStep(const GroupTables& tb, size_t p, const Group* g) {
   const F t0 = F::load(g->pt0 + p);
   const F th = sel(valueMask(F::load(g->pinside + p)), t0 - d, t0 + d);
   // texel(): a hit unless the code is 255; hitsAt(): !(th < lo || th > hi).
-  const auto hit = band(bnot(eq(c, F(255.0f))), band(nlt(th, F::load(g->plo + p)), ngt(th, F::load(g->phi + p))));
+  const auto coded = bnot(eq(c, F(255.0f)));
+  const F lo = F::load(g->plo + p);
+  const auto hit = band(coded, band(nlt(th, lo), ngt(th, F::load(g->phi + p))));
+  *behind = tb.offObject ? movemask(band(coded, band(lt(th, lo), lt(t0, F(0.0f))))) : 0u;
   return movemask(hit);
 }
 
@@ -258,9 +264,14 @@ void decodeGroupWith(const GroupTables& tb, Group* g) {
     void* const tails[] = {g->k + count, g->t + count, g->pt0 + count, g->plo + count, g->phi + count, g->pinside + count};
     for (void* a : tails) std::memset(a, 0, L * 4);  // (4-byte entries)
   }
-  uint64_t hits = 0;  // by packed ray
-  for (size_t p = 0; p < count; p += L) hits |= uint64_t(decodeStep<F>(tb, p, g)) << p;
-  g->hits = F::hitsByRay(*g, hits & keep);
+  uint64_t hits = 0, behind = 0;  // by packed ray
+  for (size_t p = 0; p < count; p += L) {
+    unsigned b = 0;
+    hits |= uint64_t(decodeStep<F>(tb, p, g, &b)) << p;
+    behind |= uint64_t(b) << p;
+  }
+  g->hits = F::hitsByRay(*g, hits & keep & ~behind);
+  g->redo |= behind & keep;  // (section 7.4's step 3: left to the reference, as the kernel's redone rays)
 }
 
 // GroupKernel::sphere (query_group.h) with lanes F.

@@ -52,6 +52,7 @@ struct GroupTables {
   bool bit1 = false;                // the distance encoding has no distances (rays from inside miss)
   float insideLo = 0;               // intra-object bias times the radius (QueryOptions::intraBias)
   bool offObject = false;           // RayOrigin::kOffObject: rays from inside look up forward from a t0 < 0
+  float offTolerance = 0;           // section 7.4's tolerance near the origin (object units)
   float gridGuard = 0, texelGuard = 0;  // fast_lookup.h's gridGuard(octaN) and texelGuard(m)
   // The distance maps, to prefetch the texels while the group is being looked up (null: none).
   const uint8_t* const* maps = nullptr;
