@@ -355,13 +355,14 @@ def accuracy_table(steps, only=None):
             sdf = re.match(r"distance field, (\S+)'s memory", c)
             by = {r["reconstruction"]: r for r in rows if r["config"] == c}
             first_row = next(iter(by.values()))
-            if only and (first_row["base"] != only or first_row["range"] not in (None, 2.0)) and \
-                    not (sdf and sdf.group(1) == only):
+            if only and (first_row["range"] not in (None, 2.0) or
+                         (first_row["base"] != only and not (sdf and sdf.group(1) == only))):
                 continue
             near, interp = by.get("nearest"), by.get("interpolated")
             if sdf:  # the distance field at that field's memory: sphere tracing, and its cone estimate
                 near, interp = by.get("sphere trace"), by.get("cone")
-                c = f"distance field at {sdf.group(1)}'s memory"
+                c = f"distance field at {sdf.group(1)}'s memory" + \
+                    (f" @ {first_row['range']:g} R" if first_row["range"] is not None else "")
             first = near or interp
             exact = exacts.get(first["range"], rows[0])
             lines.append(f"| {name[len('accuracy-'):]} | {c} | {first['mib']:.1f} | "

@@ -80,8 +80,8 @@ inline double renderAo(const AoScene& s, const AoBuffers& b, int spp, int mode, 
 inline std::string sceneAoShaderSource() {
   return "#version 430\n#define VFF_SCENE_INSTANCES_BINDING 10\n#define VFF_SCENE_NODES_BINDING 11\n" +
          gl::sceneShaderSource(readGlsl("vff_scene.glsl"), readGlsl("vff_query.glsl")) +
-         "#define AO_VISIBILITY(o, d) vffSceneVisibility(o, d, 0.0, aoTmax, 0.0, true)\n"
-         "#define AO_OCCLUDED(o, d) vffSceneOccluded(o, d, 0.0, aoTmax, 0.0, false)\n" +
+         "#define AO_VISIBILITY(o, d) vffSceneVisibility(o, d, 0.0, aoTmax, VFF_OFF_OBJECT, true)\n"
+         "#define AO_OCCLUDED(o, d) vffSceneOccluded(o, d, 0.0, aoTmax, VFF_OFF_OBJECT, false)\n" +
          kAoShader;
 }
 inline void useSceneAo(const gl::GpuScene& scene, const AoBuffers& buffers, GLuint program) {

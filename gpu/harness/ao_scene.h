@@ -95,7 +95,8 @@ inline Ray aoRay(const AoScene& s, uint32_t p, int i) {
 template <class Query>
 std::vector<float> cpuAo(const Query& q, const AoScene& s, int rays, Reconstruction r, unsigned threads = 1) {
   std::vector<float> out(size_t(s.size) * s.size);
-  const QueryOptions qo{.reconstruction = r, .intraBias = 0.0f};
+  // Ground points are on no object: section 7.4 (spec/geometry.md), as the GLSL below.
+  const QueryOptions qo{.reconstruction = r, .origin = RayOrigin::kOffObject};
   struct Buffers {
     std::vector<Ray> batch;
     std::vector<float> vis;  // kNearest: 0 or 1, as !occluded()
@@ -125,8 +126,8 @@ std::vector<float> cpuAo(const Query& q, const AoScene& s, int rays, Reconstruct
 // as vffSceneVisibility and vffSceneOccluded before this text.
 inline constexpr const char* kAoShader = R"(
 #ifndef AO_VISIBILITY
-#define AO_VISIBILITY(o, d) vffVisibility(o, d, 0.0, aoTmax, 0.0)
-#define AO_OCCLUDED(o, d) vffOccluded(o, d, 0.0, aoTmax, 0.0)
+#define AO_VISIBILITY(o, d) vffVisibility(o, d, 0.0, aoTmax, VFF_OFF_OBJECT)
+#define AO_OCCLUDED(o, d) vffOccluded(o, d, 0.0, aoTmax, VFF_OFF_OBJECT)
 #endif
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std430, binding = 5) readonly buffer AoGBuffer { vec4 aoGBuffer[]; };

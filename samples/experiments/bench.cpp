@@ -127,9 +127,10 @@ int runBench(const Options& o) {
     const size_t n = set.world.size();
     std::vector<uint8_t> ref(n), nearest(n), single(n);
     std::vector<float> vis(n);
-    // Both ray sets start off the object (on the plane, or outside the sphere): intra bias 0.
-    const vff::QueryOptions qn{.reconstruction = vff::Reconstruction::kNearest, .intraBias = 0.0f};
-    const vff::QueryOptions qi{.reconstruction = vff::Reconstruction::kInterpolated, .intraBias = 0.0f};
+    // Both ray sets start off the object (on the plane, or outside the sphere): spec/geometry.md 7.4.
+    const vff::QueryOptions qn{.reconstruction = vff::Reconstruction::kNearest, .origin = vff::RayOrigin::kOffObject};
+    const vff::QueryOptions qi{.reconstruction = vff::Reconstruction::kInterpolated,
+                               .origin = vff::RayOrigin::kOffObject};
     const std::span<const vff::Ray> rays(set.object);
     // (m): a random byte of the maps per ray.
     const std::span<const uint8_t> maps((*field)->baked.distance);

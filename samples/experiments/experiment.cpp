@@ -38,7 +38,7 @@ bool writeImages(const Image& image, const std::string& base) {
 int renderSdfRows(const Options& o, const ImageExperiment& e, const World& world, const ExactTracer& exact,
                   const GBuffer& g, const std::vector<uint8_t>& mask, const Image& reference, const BakedQuery& c,
                   int rays, unsigned threads, uint32_t stream, const std::string& base, float range,
-                  std::vector<Image>* strip, std::vector<TableRow>* rows) {
+                  const std::string& label, std::vector<Image>* strip, std::vector<TableRow>* rows) {
   if (c.query.payloadBytes() < kSdfMinBudget) {  // a field this small has no distance field beside it
     std::fprintf(stderr, "%s: %s: note: no distance-field rows for %s: its %llu bytes are under the %llu a distance grid needs\n",
                  kProg, e.name.c_str(), c.name.c_str(), static_cast<unsigned long long>(c.query.payloadBytes()),
@@ -67,7 +67,7 @@ int renderSdfRows(const Options& o, const ImageExperiment& e, const World& world
     if (auto w = writeErrorMap(reference, img, mask, 8.0f, name + "-error.png"); !w)
       return vff::cli::reportError(kProg, "", w.error());
     if (strip) strip->push_back(img), strip = nullptr;
-    rows->push_back({what, mode, double(sdf.bytes()) * mib, st.rms, st.max, seconds, false});
+    rows->push_back({std::string(what) + label, mode, double(sdf.bytes()) * mib, st.rms, st.max, seconds, false});
     std::fprintf(stderr, "%s: %s: distance field at %s, %s in %.2f s, RMS %.2f\n", kProg, e.name.c_str(), c.name.c_str(),
                  mode, seconds, st.rms);
   }
@@ -208,7 +208,7 @@ int runImageExperiment(const Options& o, const ImageExperiment& e) {
       if (o.sdf && !e.sdfRows.empty()) {
         const bool first = strip.size() == 3;
         if (const int rc = renderSdfRows(o, e, *world, *exact, g, mask, reference, c, rays, threads, stream, base,
-                                         range, first ? &strip : nullptr, &rows))
+                                         range, label, first ? &strip : nullptr, &rows))
           return rc;
       }
     }

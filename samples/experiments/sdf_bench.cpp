@@ -102,7 +102,8 @@ int runSdfBench(const Options& o) {
         const size_t n = set.world.size();
         const std::span<const vff::Ray> rays(set.world);
         std::vector<uint8_t> ref(n), byField(n), bySdf(n);
-        const vff::QueryOptions qn{.reconstruction = vff::Reconstruction::kNearest, .intraBias = 0.0f};
+        // (The rays start on the plane or outside the sphere: off the object, spec/geometry.md 7.4.)
+        const vff::QueryOptions qn{.reconstruction = vff::Reconstruction::kNearest, .origin = vff::RayOrigin::kOffObject};
         auto batched = [&](auto&& call) {
           return timedParallelFor(n, kChunk, threads, [&](uint64_t b, uint64_t e) {
             for (uint64_t x = b; x < e; x += o.benchBatch) call(x, std::min<uint64_t>(e, x + o.benchBatch) - x);

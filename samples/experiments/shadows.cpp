@@ -5,7 +5,8 @@
 // to a uniform point on the light's sphere, with direction = target - origin and tmax = 1. The
 // shading is Lambert toward the light's centre times the unoccluded fraction, on the plane and on
 // the object; both are compared. Rays from the object start inside the bounding sphere (the
-// field's intra-object path); most rays from the plane start outside (inter-object path). The
+// field's intra-object path, spec/geometry.md 7.3); most rays from the plane start outside
+// (inter-object path), those near the object inside it but off it (section 7.4). The
 // distance field traces the same rays (hit or miss), or takes the cone estimate of each: a cone
 // from the shaded point that covers the light's disc (distance-field shadows).
 #include <algorithm>
@@ -40,8 +41,10 @@ int runShadows(const Options& o) {
     const float eps = 1e-3f * w.radius;
     return [=, &exact](const GSample& s, Rng& rng) -> Vec3 {
       if (s.kind == PixelKind::kBackground) return {};
-      // Plane points have no surface of their own to skip (bias 0); object points use the default.
-      const vff::QueryOptions qo{.reconstruction = r, .intraBias = s.kind == PixelKind::kPlane ? 0.0f : -1.0f};
+      // Plane points are on no object (spec/geometry.md 7.4); object points on it (7.3, default bias).
+      const vff::QueryOptions qo{.reconstruction = r,
+                                 .origin = s.kind == PixelKind::kPlane ? vff::RayOrigin::kOffObject
+                                                                       : vff::RayOrigin::kOnObject};
       const SdfTraceOptions so = sdfOptions(r == vff::Reconstruction::kInterpolated, s.kind == PixelKind::kObject, 0.0f,
                                             kLightRadius * w.radius);
       const Vec3 albedo = s.kind == PixelKind::kPlane ? Vec3{0.85f, 0.85f, 0.85f} : Vec3{0.9f, 0.85f, 0.75f};

@@ -160,7 +160,7 @@ def main():
     images, seconds = {}, {}
     for name, interpolated in (("nearest", False), ("interpolated", True)):
         t0 = time.perf_counter()
-        vis = q.visibility(o, d, None, tmax, interpolated=interpolated, intra_bias=0.0)
+        vis = q.visibility(o, d, None, tmax, interpolated=interpolated, ray_origin="off-object")
         seconds[name] = time.perf_counter() - t0
         images[name] = vis.reshape(a.size, a.size, a.rays).mean(-1)
     t0 = time.perf_counter()

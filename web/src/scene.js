@@ -39,8 +39,9 @@ float openShare(vec3 o, vec3 d, float tmax) {
   vec3 c = vffField.sphereCenter;
   vec3 oo = c + transpose(uObject) * (o - c);
   vec3 od = transpose(uObject) * d;
-  if (uInterpolated != 0) return vffVisibility(oo, od, 0.0, tmax, 0.0);
-  return vffOccluded(oo, od, 0.0, tmax, 0.0) ? 0.0 : 1.0;
+  // (A ground point is on no object: section 7.4.)
+  if (uInterpolated != 0) return vffVisibility(oo, od, 0.0, tmax, VFF_OFF_OBJECT);
+  return vffOccluded(oo, od, 0.0, tmax, VFF_OFF_OBJECT) ? 0.0 : 1.0;
 }
 
 float groundAo(vec3 p, int count) {
