@@ -227,7 +227,9 @@ def parse_scene(text):
                              "hybrid": number(r[4]), "ratio": number(r[5]), "per_call": r[6]} for r in t[1:]]
         elif t and t[0][:3] == ["instances", "rays", "vff::Scene speed-up"]:
             out["twopass"] = [{"instances": int(r[0]), "rays": r[1], "scene": number(r[2]), "twopass": number(r[3]),
-                               "kept": number(r[4])} for r in t[1:]]
+                               "kept": number(r[4]),
+                               "ground": number(r[8]) if len(r) >= 9 else None,
+                               "total": number(r[7]) if len(r) >= 9 else None} for r in t[1:]]
     return out
 
 
@@ -480,9 +482,10 @@ def forms_table(sc):
 
 def twopass_table(sc):
     lines = ["| moving instances | AO rays | vff::Scene over Embree instancing | two-pass hybrid over Embree + ground | "
-             "kept (target 0.8) |", "|---:|---|---:|---:|---:|"]
+             "kept (target 0.8) | two-pass, ns/ray | of it the ground pass |", "|---:|---|---:|---:|---:|---:|---:|"]
     for r in sc.get("twopass", []):
-        lines.append(f"| {r['instances']} | {r['rays']} | {r['scene']:.2f}x | {r['twopass']:.2f}x | {r['kept']:.2f} |")
+        lines.append(f"| {r['instances']} | {r['rays']} | {r['scene']:.2f}x | {r['twopass']:.2f}x | {r['kept']:.2f} | " +
+                     (f"{r['total']:.1f} | {r['ground']:.1f} |" if r.get("total") is not None else "- | - |"))
     return lines
 
 
