@@ -66,7 +66,7 @@ bake="$build/tools/vff-bake/vff-bake"
 compress="$build/tools/vff-compress/vff-compress"
 experiments="$build/samples/experiments/vff-experiments"
 meshgen="$build/samples/vff-procedural-mesh"
-gpubench="$build/gpu/vff-gpu-bench"
+gpubench="$build/samples/gpu-bench/vff-gpu-bench"
 for t in "$bake" "$compress" "$experiments" "$meshgen"; do
   [[ -x $t ]] || { echo "$prog: error: $t: not built" >&2; exit 2; }
 done

@@ -47,12 +47,12 @@ inline uint32_t aoPixelOffset(uint32_t pixel) {
   return ((h >> 22u) ^ h) % kAoTableSize;
 }
 
-inline AoScene makeAoScene(const FieldDesc& field, float groundY, int size) {
+inline AoScene makeAoScene(const FieldDesc& field, float groundY, int size, float aoDistance = 2.0f) {
   AoScene s;
   s.size = size;
   const float R = field.sphere.radius;
   s.eps = 1e-4f * R;
-  s.tmax = 2.0f * R;
+  s.tmax = aoDistance * R;
   const float step = 4.0f * R / float(size);
   const float x0 = field.sphere.center[0] - 2.0f * R, z0 = field.sphere.center[2] - 2.0f * R;
   s.gbuffer.assign(size_t(size) * size * 8, 0.0f);

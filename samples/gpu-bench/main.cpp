@@ -74,9 +74,9 @@ void main() {
 
 int usage() {
 #ifdef VFF_GPU_BENCH_SDF
-  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--threads N] [--scene N] [--sdf [--sdf-size N] [--sdf-spp N]]\n");
+  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--ao-distance R] [--threads N] [--scene N] [--sdf [--sdf-size N] [--sdf-spp N]]\n");
 #else
-  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--threads N] [--scene N]\n");
+  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--ao-distance R] [--threads N] [--scene N]\n");
 #endif
   return 1;
 }
@@ -86,6 +86,7 @@ int usage() {
 struct BenchOptions {
   std::string fieldPath, meshPath = "/usr/share/glmark2/models/bunny.obj";
   int size = 512, spp = 256;
+  float aoDistance = 2.0f;  // --ao-distance: the AO range of the ground renders, multiples of R
   int sceneInstances = 0;  // --scene N: also the scene benchmark with N instances
   bool sdf = false;        // --sdf: also the distance-field peer at equal memory
   int sdfSize = 0, sdfSpp = 0;  // its image and rays per pixel (0: --size and --spp)
@@ -111,6 +112,12 @@ int parseOptions(int argc, char** argv, BenchOptions* o) {
       o->size = std::atoi(v);
     } else if (a == "--spp" && (v = next())) {
       o->spp = std::atoi(v);
+    } else if (a == "--ao-distance" && (v = next())) {
+      o->aoDistance = float(std::atof(v));
+      if (!(o->aoDistance > 0)) {
+        std::fprintf(stderr, "vff-gpu-bench: --ao-distance takes a positive number (multiples of R)\n");
+        return 1;
+      }
     } else if (a == "--scene" && (v = next())) {
       o->sceneInstances = std::atoi(v);
     } else if (a == "--sdf") {
@@ -314,12 +321,12 @@ void benchAo(const vff::FieldDesc& f, float groundY, const vff::gl::GpuField& gp
              GLuint aoProg, const BenchOptions& o) {
   using namespace vff;
   const int size = o.size, spp = o.spp;
-  const harness::AoScene s = harness::makeAoScene(f, groundY, size);
+  const harness::AoScene s = harness::makeAoScene(f, groundY, size, o.aoDistance);
   const harness::AoBuffers aoBuffers(s);
   gpu.bind();
   glUseProgram(aoProg);
-  std::printf("\nground AO %dx%d, %d rays/px (%.3g rays), tmax 2 R; GPU vs CPU image on the 8-bit scale\n", size, size,
-              spp, double(size) * size * spp);
+  std::printf("\nground AO %dx%d, %d rays/px (%.3g rays), tmax %g R; GPU vs CPU image on the 8-bit scale\n", size,
+              size, spp, double(size) * size * spp, double(o.aoDistance));
   std::printf("| query | GPU s | CPU s | GPU/CPU | max | RMS |\n|---|---|---|---|---|---|\n");
   for (int interp = 0; interp < 2; ++interp) {
     std::vector<float> g;
@@ -375,12 +382,14 @@ int main(int argc, char** argv) {
   benchQueries(f, *gpu, *cpu, rayProg, o.threads);
   benchAo(f, groundY, *gpu, *cpu, aoProg, o);
   if (o.sceneInstances > 0) {
-    const harness::SceneBenchOptions so{.instances = o.sceneInstances, .size = o.size, .spp = o.spp, .threads = o.threads};
+    const harness::SceneBenchOptions so{.instances = o.sceneInstances, .size = o.size, .spp = o.spp,
+                                        .threads = o.threads, .aoDistance = o.aoDistance};
     if (const int code = harness::benchScene(*file, *cpu, groundY, so); code != 0) return code;
   }
 #ifdef VFF_GPU_BENCH_SDF
   if (o.sdf) {
-    const harness::SdfBenchOptions so{.size = o.sdfSize, .spp = o.sdfSpp, .threads = o.threads};
+    const harness::SdfBenchOptions so{.size = o.sdfSize, .spp = o.sdfSpp, .threads = o.threads,
+                                      .aoDistance = o.aoDistance};
     if (const int code = harness::benchSdf(*file, *cpu, mesh, groundY, *gpu, aoProg, so); code != 0) return code;
   }
 #endif

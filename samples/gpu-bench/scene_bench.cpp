@@ -77,7 +77,7 @@ int benchScene(const File& file, const FieldQuery& cpu, float groundY, const Sce
   bounds.sphere.center[0] = bounds.sphere.center[2] = 0;
   AoScene ao = makeAoScene(bounds, groundY, o.size);
   ao.eps = 1e-4f * f.sphere.radius;  // the rays of the single-field render: eps and tmax of one R
-  ao.tmax = 2.0f * f.sphere.radius;
+  ao.tmax = o.aoDistance * f.sphere.radius;
 
   std::string log;
   const GLuint prog = harness::buildProgram(sceneAoShaderSource(), &log);
@@ -90,8 +90,8 @@ int benchScene(const File& file, const FieldQuery& cpu, float groundY, const Sce
   std::printf("\nscene: %d instances of the field on a %dx%d grid; a frame moves all of them: CPU commit %.3g ms, "
               "GPU update %.3g ms (mean of %d)\n",
               o.instances, side, side, 1e3 * commitS / kFrames, 1e3 * updateS / kFrames, kFrames);
-  std::printf("scene ground AO %dx%d, %d rays/px, tmax 2 R; GPU (vff_scene.glsl) vs CPU vff::Scene on %u thread(s)\n",
-              o.size, o.size, o.spp, o.threads);
+  std::printf("scene ground AO %dx%d, %d rays/px, tmax %g R; GPU (vff_scene.glsl) vs CPU vff::Scene on %u thread(s)\n",
+              o.size, o.size, o.spp, double(o.aoDistance), o.threads);
   std::printf("| query | GPU s | CPU s | GPU/CPU | mean AO | max | RMS |\n|---|---|---|---|---|---|---|\n");
   for (int interp = 0; interp < 2; ++interp) {
     std::vector<float> g;

@@ -16,6 +16,7 @@ struct SceneBenchOptions {
   int instances = 16;
   int size = 512, spp = 256;
   unsigned threads = 1;
+  float aoDistance = 2.0f;  // AO range, multiples of the field's R
 };
 
 // Prints the scene's table; returns an exit code (0, or 4 for a GL or shader failure).

@@ -72,7 +72,7 @@ int benchSdf(const File& file, const FieldQuery& cpu, const bake::Mesh& mesh, fl
   }
 
   const int size = o.size, spp = o.spp;
-  const AoScene s = makeAoScene(f, groundY, size);
+  const AoScene s = makeAoScene(f, groundY, size, o.aoDistance);
   const AoBuffers aoBuffers(s);
   gpuField.bind();
   gpuSdf->bind();
@@ -83,9 +83,9 @@ int benchSdf(const File& file, const FieldQuery& cpu, const bake::Mesh& mesh, fl
   const double exactS = secondsSince(c0);
 
   std::printf(
-      "\nground AO %dx%d, %d rays/px, tmax 2 R, at equal memory; max and RMS against the exact image (Embree) on "
+      "\nground AO %dx%d, %d rays/px, tmax %g R, at equal memory; max and RMS against the exact image (Embree) on "
       "the 8-bit scale; CPU: the same image by the same method on %u thread(s)\n",
-      size, size, spp, o.threads);
+      size, size, spp, double(o.aoDistance), o.threads);
   std::printf("| AO by | memory | GPU frame s | CPU s | max | RMS |\n|---|---|---|---|---|---|\n");
   std::printf("| exact (Embree) | mesh, %zu triangles | - | %.3f | 0 | 0 |\n", mesh.triangleCount(), exactS);
   glUseProgram(fieldProgram);

@@ -23,6 +23,7 @@ struct SdfBenchOptions {
   int size = 512, spp = 256;
   unsigned threads = 1;
   float bandVoxels = 8.0f;  // vffx::SdfBuildOptions::bandVoxels
+  float aoDistance = 2.0f;  // AO range, multiples of R
 };
 
 // `gpu` is the field's upload (vff::gl::GpuField), `fieldProgram` the field's AO program (kAoShader
