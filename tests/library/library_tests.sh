@@ -51,7 +51,9 @@ test_all_good_exits_zero_and_reports() {
   expect_err "2 entries: 2 baked, 0 up to date, 0 failed"
   [[ $(json 'r["rays"]') == $((2 * 82 * 64)) ]] || fail "rays: $(json 'r["rays"]')"
   [[ $(json 'len(r["tasks"])') == 2 ]] || fail "a time per task"
-  [[ $(find "$WORK/cache" -name '*.vff' -not -path '*/tmp/*' | wc -l) == 2 ]] || fail "two fields in the cache"
+  # (The cache's own tmp/ holds work in progress: matched from the cache, not as any folder named
+  # tmp above it, which a checkout under the system's temporary folder has.)
+  [[ $(find "$WORK/cache" -name '*.vff' -not -path "$WORK/cache/tmp/*" | wc -l) == 2 ]] || fail "two fields in the cache"
   # The same geometry under another name is another field (its name is in the file's metadata).
   cp "$WORK/lib/a.obj" "$WORK/lib/c.obj"
   lib_bake "$WORK/lib" --cache "$WORK/cache" -- -n 4 -m 8
