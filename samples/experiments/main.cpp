@@ -73,10 +73,12 @@ int main(int argc, char** argv) {
   app.add_flag("--sdf,!--no-sdf", o.sdf,
                "image experiments: also render the signed distance field (OpenVDB level set, NanoVDB, sphere "
                "tracing) at each field's memory (default: on)");
-  app.add_option("--sdf-values", o.sdfValues, "the distance field's values: fp8 (one byte a voxel) or float")
-      ->transform(CLI::CheckedTransformer(std::map<std::string, SdfValues>{{"fp8", SdfValues::kFp8},
-                                                                           {"float", SdfValues::kFloat}}))
-      ->capture_default_str();
+  // (A string option: CLI11's help cannot print an enum's map.)
+  app.add_option_function<std::string>(
+         "--sdf-values", [&o](const std::string& v) { o.sdfValues = v == "float" ? SdfValues::kFloat : SdfValues::kFp8; },
+         "the distance field's values: fp8 (one byte a voxel) or float")
+      ->check(CLI::IsMember({"fp8", "float"}))
+      ->default_str("fp8");
   app.add_option("--sdf-band", o.sdfBand, "the distance field's narrow band: half-width in voxels")
       ->capture_default_str()
       ->check(CLI::Range(1.0f, 64.0f));
