@@ -258,8 +258,8 @@ struct Options {
   unsigned threads = 0;
   std::vector<std::string> configs;  // empty: the experiment's default field configurations (none with fields)
   std::vector<std::string> fields;   // .vff files of the same mesh to evaluate besides (or instead of) bakes
-  // AO range as a multiple of R. 2 R spans the whole bounding sphere, so for a plane point inside the
-  // sphere the range never cuts the intra-object answer (whose hit is the LAST crossing, at most 2 R away).
+  // AO range as a multiple of R (2 R: the whole bounding sphere). Rays from the plane start off the
+  // object (spec/geometry.md 7.4), so shorter ranges keep the contact shadow.
   float aoDistance = 2.0f;
   // ao: the ranges to render (multiples of R); empty: aoDistance alone.
   std::vector<float> aoRanges;
