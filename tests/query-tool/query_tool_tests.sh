@@ -292,6 +292,35 @@ test_bad_lines_name_line_and_column() {
   expect_err_re '<stdin>:1:[0-9]+: invalid JSON'
 }
 
+# Text input that is not quite text: a UTF-8 byte order mark is skipped (the rays answer as
+# without it); a NUL byte is named by line and column; bytes outside printable ASCII are shown as
+# \xHH, never raw; a JSON ray with an unknown key is refused.
+test_text_input_edges() {
+  local f="$VECTORS/u8d-zstd-normals-meta.vff"
+  printf '0.5,-1,5,0,0,-1\n9,9,9,1,0,0\n' >"$WORK/plain.csv"
+  printf '\xEF\xBB\xBF0.5,-1,5,0,0,-1\n9,9,9,1,0,0\n' >"$WORK/bom.csv"
+  query "$f" -i "$WORK/plain.csv" -o "$WORK/plain.out"
+  expect_rc 0
+  query "$f" -i "$WORK/bom.csv" -o "$WORK/bom.out"
+  expect_rc 0
+  same "$WORK/plain.out" "$WORK/bom.out"
+  printf '0.5,-1,5,0,0,-1\n1,2\0003,4,5,6\n' >"$WORK/nul.csv"
+  query "$f" -i "$WORK/nul.csv" -o "$WORK/nul.out"
+  expect_rc 3
+  expect_err "$WORK/nul.csv:2:4: a NUL byte: the input is not text"
+  # (as for every bad text line, the rays before it are answered: README "Errors")
+  [[ $(wc -l <"$WORK/nul.out") -eq 2 ]] || fail "the ray before the NUL line is not answered"
+  printf '0,0,\x01\xff,0,0,-1\n' >"$WORK/in"
+  query "$f" <"$WORK/in"
+  expect_rc 3
+  expect_err 'expected a number, found "\x01\xFF"'
+  LC_ALL=C grep -q $'\xff' "$WORK/err" && fail "a raw byte 0xFF in the message"
+  printf '{"origin":[0,0,5],"direction":[0,0,-1],"tmaxx":3}\n' >"$WORK/in"
+  query "$f" <"$WORK/in"
+  expect_rc 3
+  expect_err '<stdin>:1:1: unknown key "tmaxx"'
+}
+
 test_bad_npy_names_expected() {
   has_numpy || { echo "SKIP: python3 with numpy is not installed"; return 0; }
   local f="$VECTORS/u8d-zstd-normals-meta.vff"

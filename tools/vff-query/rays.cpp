@@ -27,6 +27,24 @@ void assign(Ray* ray, const float* v, size_t n) {
   }
 }
 
+// Bytes of the input as a message may show them: printable ASCII as is, every other byte as \xHH
+// (a terminal must not receive raw binary), cut after `limit` bytes.
+std::string shown(std::string_view bytes, size_t limit = 40) {
+  std::string out;
+  for (size_t k = 0; k < bytes.size() && k < limit; ++k) {
+    const unsigned char c = static_cast<unsigned char>(bytes[k]);
+    if (c >= 0x20 && c < 0x7f && c != '"' && c != '\\') {
+      out.push_back(char(c));
+    } else {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02X", unsigned(c));
+      out += buf;
+    }
+  }
+  if (bytes.size() > limit) out += "...";
+  return out;
+}
+
 // A CSV line. columns[i]: the 1-based column where number i starts.
 std::optional<LineError> parseCsv(std::string_view line, Ray* ray) {
   float v[8];
@@ -45,7 +63,7 @@ std::optional<LineError> parseCsv(std::string_view line, Ray* ray) {
     if (ec != std::errc() || (end < line.size() && !isBlank(line[end]) && line[end] != ',')) {
       size_t e = i;
       while (e < line.size() && !isBlank(line[e]) && line[e] != ',') ++e;
-      return LineError{0, i + 1, "expected a number, found \"" + std::string(line.substr(i, e - i)) + "\""};
+      return LineError{0, i + 1, "expected a number, found \"" + shown(line.substr(i, e - i)) + "\""};
     }
     columns[n++] = i + 1;
     i = end;
@@ -72,7 +90,8 @@ std::optional<LineError> parseJson(std::string_view line, Ray* ray) {
   } catch (const nlohmann::json::parse_error& e) {
     std::string what = e.what();
     const size_t colon = what.find("syntax error");
-    return LineError{0, e.byte ? e.byte : 1, "invalid JSON: " + (colon == std::string::npos ? what : what.substr(colon))};
+    return LineError{0, e.byte ? e.byte : 1,
+                     "invalid JSON: " + shown(colon == std::string::npos ? what : what.substr(colon), 200)};
   }
   auto numbers = [](const nlohmann::json& a, size_t count, const char* name, float* v) -> std::optional<std::string> {
     if (!a.is_array() || a.size() != count) return std::string(name) + " must be an array of " + std::to_string(count) + " numbers";
@@ -91,6 +110,9 @@ std::optional<LineError> parseJson(std::string_view line, Ray* ray) {
   } else if (j.is_object()) {
     if (!j.contains("origin") || !j.contains("direction"))
       return LineError{0, 1, "a ray object needs \"origin\" and \"direction\""};
+    for (const auto& item : j.items())
+      if (item.key() != "origin" && item.key() != "direction" && item.key() != "tmin" && item.key() != "tmax")
+        return LineError{0, 1, "unknown key \"" + shown(item.key()) + "\" (a ray has origin, direction, tmin, tmax)"};
     if (auto e = numbers(j["origin"], 3, "origin", v)) return LineError{0, 1, *e};
     if (auto e = numbers(j["direction"], 3, "direction", v + 3)) return LineError{0, 1, *e};
     assign(ray, v, 6);
@@ -137,6 +159,8 @@ ParsedRays parseRayLines(std::string_view text, float tmin, float tmax) {
   uint64_t lineNo = 0;
   bool firstContent = true;
   size_t pos = 0;
+  // A UTF-8 byte order mark (what some editors write first) is not part of the first line.
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") pos = 3;
   while (pos < text.size()) {
     size_t end = text.find('\n', pos);
     if (end == std::string_view::npos) end = text.size();
@@ -144,6 +168,10 @@ ParsedRays parseRayLines(std::string_view text, float tmin, float tmax) {
     pos = end + 1;
     ++lineNo;
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    if (const size_t nul = line.find('\0'); nul != std::string_view::npos) {
+      out.error = LineError{lineNo, nul + 1, "a NUL byte: the input is not text (a .npy file must be named *.npy)"};
+      return out;
+    }
     size_t s = 0;
     while (s < line.size() && isBlank(line[s])) ++s;
     if (s == line.size() || line[s] == '#') continue;

@@ -5,7 +5,10 @@
 //   JSON lines: {"origin":[ox,oy,oz],"direction":[dx,dy,dz],"tmin":0,"tmax":10}   (tmin, tmax optional)
 //               or [ox,oy,oz,dx,dy,dz] / [ox,oy,oz,dx,dy,dz,tmin,tmax]
 // Blank lines and lines starting with '#' are skipped, and so is a first line of column names
-// "ox,oy,oz,dx,dy,dz[,tmin,tmax]". Rays without their own tmin/tmax take the command line's.
+// "ox,oy,oz,dx,dy,dz[,tmin,tmax]". Rays without their own tmin/tmax take the command line's. A
+// UTF-8 byte order mark before the first line is skipped; a NUL byte, and a JSON ray with a key
+// other than origin, direction, tmin and tmax, are errors. Messages show the input's bytes outside
+// printable ASCII as \xHH.
 #pragma once
 
 #include <cmath>
