@@ -321,6 +321,35 @@ test_text_input_edges() {
   expect_err '<stdin>:1:1: unknown key "tmaxx"'
 }
 
+# A .npy header must be the dict numpy writes: a syntax error or another key is refused.
+test_npy_header_is_strict() {
+  has_numpy || { echo "SKIP: python3 with numpy is not installed"; return 0; }
+  local f="$VECTORS/u8d-zstd-normals-meta.vff"
+  /usr/bin/python3 - "$WORK" <<'PY'
+import struct, sys
+import numpy as np
+work = sys.argv[1]
+np.save(work + "/ok.npy", np.array([[0.5, -1, 5, 0, 0, -1]], np.float32))
+raw = open(work + "/ok.npy", "rb").read()
+n = struct.unpack("<H", raw[8:10])[0]
+for name, text in [("nobrace", "{'descr': '<f4', 'fortran_order': False, 'shape': (1, 6) "),
+                   ("extra", "{'descr': '<f4', 'fortran_order': False, 'shape': (1, 6), 'x': 1}"),
+                   ("twice", "{'descr': '<f4', 'descr': '<f4', 'fortran_order': False, 'shape': (1, 6)}")]:
+    open(work + "/" + name + ".npy", "wb").write(raw[:10] + (text.ljust(n - 1) + "\n").encode() + raw[10 + n:])
+PY
+  query "$f" -i "$WORK/ok.npy"
+  expect_rc 0
+  query "$f" -i "$WORK/nobrace.npy"
+  expect_rc 3
+  expect_err "$WORK/nobrace.npy: the .npy header is not a dict literal"
+  query "$f" -i "$WORK/extra.npy"
+  expect_rc 3
+  expect_err "has a key other than 'descr', 'fortran_order' and 'shape'"
+  query "$f" -i "$WORK/twice.npy"
+  expect_rc 3
+  expect_err "names 'descr' twice"
+}
+
 test_bad_npy_names_expected() {
   has_numpy || { echo "SKIP: python3 with numpy is not installed"; return 0; }
   local f="$VECTORS/u8d-zstd-normals-meta.vff"

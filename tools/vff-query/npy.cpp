@@ -58,6 +58,46 @@ std::optional<std::pair<uint64_t, uint64_t>> parseShape(std::string_view t) {
   return std::pair{dims[0], dims[1]};
 }
 
+// Whether the header is the dict literal numpy writes: '{', items 'key': value separated by commas
+// (a comma inside a tuple belongs to it; one may trail), '}', then blanks and a newline; each of the
+// keys descr, fortran_order and shape exactly once and no other. The values are checked apart.
+std::optional<std::string> checkDict(std::string_view h) {
+  while (!h.empty() && (h.back() == ' ' || h.back() == '\n')) h.remove_suffix(1);
+  if (h.size() < 2 || h.front() != '{' || h.back() != '}') return "is not a dict literal {...}";
+  const std::string_view inner = h.substr(1, h.size() - 2);
+  bool seen[3] = {};
+  const std::string_view keys[3] = {"'descr'", "'fortran_order'", "'shape'"};
+  size_t start = 0;
+  int depth = 0;
+  for (size_t i = 0; i <= inner.size(); ++i) {
+    const char c = i < inner.size() ? inner[i] : ',';
+    if (c == '(') ++depth;
+    if (c == ')' && --depth < 0) return "has an unbalanced ')'";
+    if (c != ',' || depth > 0) continue;
+    std::string_view item = inner.substr(start, i - start);
+    start = i + 1;
+    while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
+    while (!item.empty() && item.back() == ' ') item.remove_suffix(1);
+    if (item.empty()) {
+      if (i >= inner.size() - 1 || inner.substr(i + 1).find_first_not_of(' ') == std::string_view::npos) continue;
+      return "has an empty item";  // (only the last, a trailing comma, may be empty)
+    }
+    const size_t colon = item.find(':');
+    if (colon == std::string_view::npos) return "has an item without ':'";
+    std::string_view key = item.substr(0, colon);
+    while (!key.empty() && key.back() == ' ') key.remove_suffix(1);
+    int which = -1;
+    for (int k = 0; k < 3; ++k)
+      if (key == keys[k]) which = k;
+    if (which < 0) return "has a key other than 'descr', 'fortran_order' and 'shape'";
+    if (seen[which]) return "names " + std::string(key) + " twice";
+    seen[which] = true;
+  }
+  if (depth != 0) return "has an unbalanced '('";
+  if (!seen[0] || !seen[1] || !seen[2]) return "lacks descr, fortran_order or shape";
+  return std::nullopt;
+}
+
 }  // namespace
 
 std::optional<std::string> readNpyMatrix(std::span<const uint8_t> bytes, NpyMatrix* out) {
@@ -76,6 +116,7 @@ std::optional<std::string> readNpyMatrix(std::span<const uint8_t> bytes, NpyMatr
   }
   if (headerLen > bytes.size() - start) return "the .npy header is truncated";
   const std::string_view header(reinterpret_cast<const char*>(bytes.data() + start), headerLen);
+  if (auto bad = checkDict(header)) return "the .npy header " + *bad;
   const auto descr = dictValue(header, "'descr'");
   const auto order = dictValue(header, "'fortran_order'");
   const auto shapeText = dictValue(header, "'shape'");
