@@ -13,7 +13,8 @@
 // two-pass hybrid (vff::embree::occluded) answers the instances and the ground together, against
 // Embree's instancing with the ground in its scene. The mean number of active rays an Embree
 // callback gets in each form is counted by a geometry that only counts (the same boxes, never
-// occluding). Times are the best of --repeat passes on --threads workers; rates in Mrays/s.
+// occluding). Each side's time is its best of --repeat passes on --threads workers, so that a busy
+// moment of the machine does not fall on one side alone.
 #include <atomic>
 #include <cmath>
 #include <cstdio>

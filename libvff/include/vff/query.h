@@ -127,9 +127,8 @@ struct QueryOptions {
 // The default intra-object bias (fraction of R): two quantisation steps at normal incidence plus
 // one mean angular spacing of the positional samples, sqrt(4 pi / mapCount): snapping the exit
 // point to its nearest sample moves the reversed ray sideways by up to about that much, and the
-// origin's own surface must not count as an occluder. (Measured with vff-experiments intra-ao on
-// the bunny: half a spacing gives RMS 8.9, one spacing 5.3, 1.5 spacings 3.9 but larger misses at
-// contacts.)
+// origin's own surface must not count as an occluder. (vff-experiments intra-ao compares the
+// spacings: less lets the origin's surface occlude it, more hides surfaces near contacts.)
 VFF_API float defaultIntraBias(const FieldDesc& field) noexcept;
 
 // The kernel the batch functions use for kNearest on this CPU: "avx512", "avx2", "sse2" or

@@ -1,9 +1,9 @@
 // filter.cpp - filter 1 `hits-med`: a hit mask, then the hits' residuals against the median edge
 // detector (MED, LOCO-I / JPEG-LS) of their left, upper and upper-left hit neighbours.
 //
-// Why this filter (measured on the bunny at 4226 x 64 x 64, tools/vff-compress --benchmark): three
-// quarters of the texels are misses, which a mask holds in a few bits each, and the hits are a
-// smooth function of the texel position, which MED predicts to within a code or two. Predicting
+// Why this filter (tools/vff-compress --benchmark compares it with the others): most texels are
+// misses, which a mask holds in a few bits each, and the hits are a smooth function of the texel
+// position, which MED predicts closely. Predicting
 // the raw bytes instead (misses included) gains little over zstd alone, because every hit/miss edge
 // becomes a large residual.
 #include "codec/filter.h"

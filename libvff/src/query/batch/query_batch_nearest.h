@@ -21,8 +21,8 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
   // A batch of one ray (an Embree callback for rtcIntersect1 or rtcOccluded1) takes the reference
   // path: a group's fixed cost is larger than the ray's own, and there are no other texel reads
   // for its read to overlap. (batchInterpolated does the same.) From two rays on, the group
-  // kernel's lanes win: vff-experiments bench --batch 16 measured it against the reference steps
-  // with the texels requested together.
+  // kernel's SIMD lanes answer each ray for less than the reference steps do, even for an Embree
+  // packet of 16 (vff-experiments bench --batch 16 compares them).
   const detail::GroupKernel* kernel = rays.size() > 1 ? detail::groupKernel() : nullptr;
   if (!kernel) {
     for (size_t base = 0; base < rays.size(); base += detail::kGroupRays) {
