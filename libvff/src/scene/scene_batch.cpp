@@ -191,88 +191,70 @@ Status checkSources(const Scene::Impl* m, size_t rays, std::span<const uint32_t>
   return {};
 }
 
-// The batches, with sources (one per ray) or without (sources.data() null; with rays, checkSources
-// has made sure that a call with sources has them).
-Status intersectBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::span<const uint32_t> sources,
-                      std::span<SceneHit> out, const QueryOptions& options) {
+// The frame the three batches share, with sources (one per ray) or without (sources.data() null;
+// with rays, checkSources has made sure that a call with sources has them): the checks, `out`
+// filled with `none`, then chunk by chunk the pairs found, answered into the scratch's `answers` by
+// answer(field, rays, answers, options), and combine(first ray of the chunk, chunk, pairs, answers)
+// folding them into `out`.
+template <class Out, class T, class Answer, class Combine>
+Status runBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::span<const uint32_t> sources,
+                std::span<Out> out, const Out& none, const QueryOptions& options, std::vector<T> Scratch::*answers,
+                Answer&& answer, Combine&& combine) {
   if (Status s = Scene::Impl::ready(impl); !s) return s;
   if (Status s = sizes(rays.size(), out.size()); !s) return s;
-  std::fill(out.begin(), out.end(), SceneHit{});
+  std::fill(out.begin(), out.end(), none);
   if (!impl) return {};
   const Scene::Impl& m = *impl;
   const PassOptions pass(options);
   const ScratchLease lease(m);
   Scratch& s = *lease;
-  const Pairs& p = s.pairs;
-  std::vector<QueryHit>& hits = s.hits;
-  auto answer = [](const FieldQuery& f, std::span<const Ray> r, std::span<QueryHit> h, const QueryOptions& o) {
-    f.intersect(r, h, o);
-  };
   for (size_t c = 0; c < rays.size(); c += kChunk) {
     const std::span<const Ray> chunk = rays.subspan(c, std::min(kChunk, rays.size() - c));
     pairUp(m, chunk, &s);
-    answerChunk(m, p, sources.data() ? sources.data() + c : nullptr, pass, &hits, answer);
-    for (uint32_t i = 0; i < m.instances.size(); ++i)
-      for (uint32_t k = p.first[i]; k < p.first[i] + p.count[i]; ++k) {
-        SceneHit& best = out[c + p.ray[k]];
-        if (hits[k].hit && hits[k].t < best.t) {
-          QueryHit h = hits[k];
-          detail::toWorld(m.instances[i].transform, chunk[p.ray[k]], &h);
-          static_cast<QueryHit&>(best) = h;
-          best.instance = i;
-        }
-      }
+    answerChunk(m, s.pairs, sources.data() ? sources.data() + c : nullptr, pass, &(s.*answers), answer);
+    combine(c, chunk, s.pairs, s.*answers);
   }
   return {};
+}
+
+Status intersectBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::span<const uint32_t> sources,
+                      std::span<SceneHit> out, const QueryOptions& options) {
+  return runBatch(
+      impl, rays, sources, out, SceneHit{}, options, &Scratch::hits,
+      [](const FieldQuery& f, std::span<const Ray> r, std::span<QueryHit> h, const QueryOptions& o) { f.intersect(r, h, o); },
+      [&](size_t c, std::span<const Ray> chunk, const Pairs& p, const std::vector<QueryHit>& hits) {
+        for (uint32_t i = 0; i < impl->instances.size(); ++i)
+          for (uint32_t k = p.first[i]; k < p.first[i] + p.count[i]; ++k) {
+            SceneHit& best = out[c + p.ray[k]];
+            if (hits[k].hit && hits[k].t < best.t) {
+              QueryHit h = hits[k];
+              detail::toWorld(impl->instances[i].transform, chunk[p.ray[k]], &h);
+              static_cast<QueryHit&>(best) = h;
+              best.instance = i;
+            }
+          }
+      });
 }
 
 Status occludedBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::span<const uint32_t> sources,
                      std::span<uint8_t> out, const QueryOptions& options) {
-  if (Status s = Scene::Impl::ready(impl); !s) return s;
-  if (Status s = sizes(rays.size(), out.size()); !s) return s;
-  std::fill(out.begin(), out.end(), uint8_t(0));
-  if (!impl) return {};
-  const Scene::Impl& m = *impl;
-  const PassOptions pass(options);
-  const ScratchLease lease(m);
-  Scratch& s = *lease;
-  const Pairs& p = s.pairs;
-  std::vector<uint8_t>& blocked = s.blocked;
-  auto answer = [](const FieldQuery& f, std::span<const Ray> r, std::span<uint8_t> o, const QueryOptions& q) {
-    f.occluded(r, o, q);
-  };
-  for (size_t c = 0; c < rays.size(); c += kChunk) {
-    const std::span<const Ray> chunk = rays.subspan(c, std::min(kChunk, rays.size() - c));
-    pairUp(m, chunk, &s);
-    answerChunk(m, p, sources.data() ? sources.data() + c : nullptr, pass, &blocked, answer);
-    for (size_t k = 0; k < p.ray.size(); ++k) out[c + p.ray[k]] |= blocked[k];
-  }
-  return {};
+  return runBatch(
+      impl, rays, sources, out, uint8_t(0), options, &Scratch::blocked,
+      [](const FieldQuery& f, std::span<const Ray> r, std::span<uint8_t> o, const QueryOptions& q) { f.occluded(r, o, q); },
+      [&](size_t c, std::span<const Ray>, const Pairs& p, const std::vector<uint8_t>& blocked) {
+        for (size_t k = 0; k < p.ray.size(); ++k) out[c + p.ray[k]] |= blocked[k];
+      });
 }
 
 Status visibilityBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::span<const uint32_t> sources,
                        std::span<float> out, const QueryOptions& options) {
-  if (Status s = Scene::Impl::ready(impl); !s) return s;
-  if (Status s = sizes(rays.size(), out.size()); !s) return s;
-  std::fill(out.begin(), out.end(), 1.0f);
-  if (!impl) return {};
-  const Scene::Impl& m = *impl;
-  const PassOptions pass(options);
-  const ScratchLease lease(m);
-  Scratch& s = *lease;
-  const Pairs& p = s.pairs;
-  std::vector<float>& vis = s.vis;
-  auto answer = [](const FieldQuery& f, std::span<const Ray> r, std::span<float> o, const QueryOptions& q) {
-    f.visibility(r, o, q);
-  };
-  for (size_t c = 0; c < rays.size(); c += kChunk) {
-    const std::span<const Ray> chunk = rays.subspan(c, std::min(kChunk, rays.size() - c));
-    pairUp(m, chunk, &s);
-    answerChunk(m, p, sources.data() ? sources.data() + c : nullptr, pass, &vis, answer);
-    for (uint32_t i = 0; i < m.instances.size(); ++i)  // the product in id order
-      for (uint32_t k = p.first[i]; k < p.first[i] + p.count[i]; ++k) out[c + p.ray[k]] *= vis[k];
-  }
-  return {};
+  return runBatch(
+      impl, rays, sources, out, 1.0f, options, &Scratch::vis,
+      [](const FieldQuery& f, std::span<const Ray> r, std::span<float> o, const QueryOptions& q) { f.visibility(r, o, q); },
+      [&](size_t c, std::span<const Ray>, const Pairs& p, const std::vector<float>& vis) {
+        for (uint32_t i = 0; i < impl->instances.size(); ++i)  // the product in id order
+          for (uint32_t k = p.first[i]; k < p.first[i] + p.count[i]; ++k) out[c + p.ray[k]] *= vis[k];
+      });
 }
 
 }  // namespace
