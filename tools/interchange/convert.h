@@ -23,6 +23,22 @@ struct FieldData {
   std::vector<uint8_t> normals;   // mapCount * normalMapBytes, empty without a normal field
 };
 
+// What the EXR and OpenVDB writers read of a field's packed layout: the map size, the gutter,
+// whether there is a normal plane, the bytes of a map of each plane and the maps of a slice.
+struct PackedPlanes {
+  uint32_t mapResolution;
+  int64_t gutter;
+  bool normals;
+  uint64_t distanceMapBytes, normalMapBytes;
+  uint32_t mapsPerSlice;
+};
+inline PackedPlanes packedPlanes(const FieldData& d) {
+  const FieldDesc& f = d.field;
+  return {f.mapResolution, d.layout.gutter, f.normalEncoding != NormalEncoding::kNone,
+          distanceMapBytes(f.distanceEncoding, f.mapResolution), normalMapBytes(f.normalEncoding, f.mapResolution),
+          d.layout.tilesPerRow * d.layout.tilesPerColumn};
+}
+
 enum class ExrCompression { kNone, kZip, kPiz, kDwaa };  // DWAA is lossy
 
 struct ExrWriteOptions {

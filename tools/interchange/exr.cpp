@@ -135,12 +135,7 @@ bool looksLikeExr(const std::string& path) {
 Status writeExr(const std::string& path, const FieldData& d, const ExrWriteOptions& options) {
   const FieldDesc& f = d.field;
   const LayoutDesc& l = d.layout;
-  const uint32_t m = f.mapResolution;
-  const int64_t g = l.gutter;
-  const bool normals = f.normalEncoding != NormalEncoding::kNone;
-  const uint64_t dBytes = distanceMapBytes(f.distanceEncoding, m);
-  const uint64_t nBytes = normalMapBytes(f.normalEncoding, m);
-  const uint32_t perSlice = l.tilesPerRow * l.tilesPerColumn;
+  const auto [m, g, normals, dBytes, nBytes, perSlice] = packedPlanes(d);
   const Imf::PixelType type = options.half ? Imf::HALF : Imf::FLOAT;
   const int w = static_cast<int>(l.sliceWidth), h = static_cast<int>(l.sliceHeight);
   const std::vector<float> cosines = texelCosines(f);

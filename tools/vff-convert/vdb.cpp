@@ -127,12 +127,7 @@ Status writeVdb(const std::string& path, const FieldData& d, const VdbWriteOptio
                 VdbWriteReport* report) {
   const FieldDesc& f = d.field;
   const LayoutDesc& l = d.layout;
-  const uint32_t m = f.mapResolution;
-  const int64_t g = l.gutter;
-  const bool normals = f.normalEncoding != NormalEncoding::kNone;
-  const uint64_t dBytes = distanceMapBytes(f.distanceEncoding, m);
-  const uint64_t nBytes = normalMapBytes(f.normalEncoding, m);
-  const uint32_t perSlice = l.tilesPerRow * l.tilesPerColumn;
+  const auto [m, g, normals, dBytes, nBytes, perSlice] = packedPlanes(d);
   const std::vector<float> cosines = texelCosines(f);
   auto provenance = provenanceJson(d, options);
   if (!provenance) return std::move(provenance).error();
