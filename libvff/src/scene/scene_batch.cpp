@@ -115,16 +115,18 @@ void answerPairs(const Scene::Impl& m, const Pairs& p, std::vector<T>* answers, 
 // With sources (chunk-relative): each field answers the pairs whose ray starts on their own
 // instance with `on` (section 7.3) and the rest with `off` (7.4): two calls over the pairs
 // gathered apart, or one in place where none of the field's pairs starts on its instance.
+// The gathered halves live in the scratch (part: its vector for T), kept from call to call.
 template <class T, class Answer>
 void answerSourcedPairs(const Scene::Impl& m, const Pairs& p, const uint32_t* sources, const QueryOptions& on,
-                        const QueryOptions& off, std::vector<T>* answers, Answer&& answer) {
+                        const QueryOptions& off, Scratch* s, std::vector<T>* answers, std::vector<T>* partOf,
+                        Answer&& answer) {
   answers->resize(p.rays.size());
   const std::span<const Ray> all(p.rays);
   const std::span<T> out(*answers);
-  std::vector<uint8_t> own;
-  std::vector<Ray> rays;
-  std::vector<uint32_t> at;
-  std::vector<T> part;
+  std::vector<uint8_t>& own = s->own;
+  std::vector<Ray>& rays = s->sourcedRays;
+  std::vector<uint32_t>& at = s->sourcedAt;
+  std::vector<T>& part = *partOf;
   for (size_t g = 0; g + 1 < m.fieldStart.size(); ++g) {
     const uint32_t lo = m.byField[m.fieldStart[g]], hi = m.byField[m.fieldStart[g + 1] - 1];
     const uint32_t a = p.first[lo], b = p.first[hi] + p.count[hi];
@@ -167,10 +169,10 @@ struct PassOptions {
 // The pairs of a chunk answered (answer(field, rays, out, options)), with the chunk's sources or
 // without (null).
 template <class T, class Answer>
-void answerChunk(const Scene::Impl& m, const Pairs& p, const uint32_t* sources, const PassOptions& pass,
-                 std::vector<T>* answers, Answer&& answer) {
+void answerChunk(const Scene::Impl& m, const Pairs& p, const uint32_t* sources, const PassOptions& pass, Scratch* s,
+                 std::vector<T>* answers, std::vector<T>* part, Answer&& answer) {
   if (sources) {
-    answerSourcedPairs(m, p, sources, pass.own, pass.others, answers, answer);
+    answerSourcedPairs(m, p, sources, pass.own, pass.others, s, answers, part, answer);
   } else {
     answerPairs(m, p, answers, [&](const FieldQuery& f, std::span<const Ray> r, std::span<T> o) {
       answer(f, r, o, pass.all);
@@ -199,7 +201,7 @@ Status checkSources(const Scene::Impl* m, size_t rays, std::span<const uint32_t>
 template <class Out, class T, class Answer, class Combine>
 Status runBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::span<const uint32_t> sources,
                 std::span<Out> out, const Out& none, const QueryOptions& options, std::vector<T> Scratch::*answers,
-                Answer&& answer, Combine&& combine) {
+                std::vector<T> Scratch::*part, Answer&& answer, Combine&& combine) {
   if (Status s = Scene::Impl::ready(impl); !s) return s;
   if (Status s = sizes(rays.size(), out.size()); !s) return s;
   std::fill(out.begin(), out.end(), none);
@@ -211,7 +213,7 @@ Status runBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::span<co
   for (size_t c = 0; c < rays.size(); c += kChunk) {
     const std::span<const Ray> chunk = rays.subspan(c, std::min(kChunk, rays.size() - c));
     pairUp(m, chunk, &s);
-    answerChunk(m, s.pairs, sources.data() ? sources.data() + c : nullptr, pass, &(s.*answers), answer);
+    answerChunk(m, s.pairs, sources.data() ? sources.data() + c : nullptr, pass, &s, &(s.*answers), &(s.*part), answer);
     combine(c, chunk, s.pairs, s.*answers);
   }
   return {};
@@ -220,7 +222,7 @@ Status runBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::span<co
 Status intersectBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::span<const uint32_t> sources,
                       std::span<SceneHit> out, const QueryOptions& options) {
   return runBatch(
-      impl, rays, sources, out, SceneHit{}, options, &Scratch::hits,
+      impl, rays, sources, out, SceneHit{}, options, &Scratch::hits, &Scratch::partHits,
       [](const FieldQuery& f, std::span<const Ray> r, std::span<QueryHit> h, const QueryOptions& o) { f.intersect(r, h, o); },
       [&](size_t c, std::span<const Ray> chunk, const Pairs& p, const std::vector<QueryHit>& hits) {
         for (uint32_t i = 0; i < impl->instances.size(); ++i)
@@ -239,7 +241,7 @@ Status intersectBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::s
 Status occludedBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::span<const uint32_t> sources,
                      std::span<uint8_t> out, const QueryOptions& options) {
   return runBatch(
-      impl, rays, sources, out, uint8_t(0), options, &Scratch::blocked,
+      impl, rays, sources, out, uint8_t(0), options, &Scratch::blocked, &Scratch::partBlocked,
       [](const FieldQuery& f, std::span<const Ray> r, std::span<uint8_t> o, const QueryOptions& q) { f.occluded(r, o, q); },
       [&](size_t c, std::span<const Ray>, const Pairs& p, const std::vector<uint8_t>& blocked) {
         for (size_t k = 0; k < p.ray.size(); ++k) out[c + p.ray[k]] |= blocked[k];
@@ -249,7 +251,7 @@ Status occludedBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::sp
 Status visibilityBatch(const Scene::Impl* impl, std::span<const Ray> rays, std::span<const uint32_t> sources,
                        std::span<float> out, const QueryOptions& options) {
   return runBatch(
-      impl, rays, sources, out, 1.0f, options, &Scratch::vis,
+      impl, rays, sources, out, 1.0f, options, &Scratch::vis, &Scratch::partVis,
       [](const FieldQuery& f, std::span<const Ray> r, std::span<float> o, const QueryOptions& q) { f.visibility(r, o, q); },
       [&](size_t c, std::span<const Ray>, const Pairs& p, const std::vector<float>& vis) {
         for (uint32_t i = 0; i < impl->instances.size(); ++i)  // the product in id order

@@ -32,6 +32,13 @@ struct SceneScratch {
   std::vector<QueryHit> hits;
   std::vector<uint8_t> blocked;
   std::vector<float> vis;
+  // With sources: which pairs start on their own instance, and each half gathered with its answers.
+  std::vector<uint8_t> own;
+  std::vector<Ray> sourcedRays;
+  std::vector<uint32_t> sourcedAt;
+  std::vector<QueryHit> partHits;
+  std::vector<uint8_t> partBlocked;
+  std::vector<float> partVis;
 };
 
 }  // namespace detail
