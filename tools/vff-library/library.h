@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace vff::library {
@@ -40,6 +41,10 @@ struct Entry {
 // manifest itself (not JSON, a wrong field) is returned as a message; its exit code in *rc.
 std::optional<std::string> readManifest(const std::string& path, const std::string& outDir,
                                         std::vector<Entry>* entries, int* rc);
+// The same, of a manifest's text: `path` names it in messages and its folder is the base of relative
+// mesh paths (the file need not exist). Never throws, for any text.
+std::optional<std::string> parseManifest(std::string_view text, const std::string& path,
+                                         const std::string& outDir, std::vector<Entry>* entries, int* rc);
 // Every file under `folder` (recursively, sorted) whose path relative to it matches one of the
 // comma-separated `globs`, each baked with `args`, to OUT/RELATIVE-PATH-WITHOUT-EXTENSION.vff.
 std::optional<std::string> readFolder(const std::string& folder, const std::string& globs,

@@ -77,14 +77,19 @@ std::string expandPattern(const std::string& pattern, const fs::path& relative) 
 std::optional<std::string> readManifest(const std::string& path, const std::string& outDir,
                                         std::vector<Entry>* entries, int* rc) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) {
+  std::stringstream text;
+  if (in) text << in.rdbuf();
+  if (!in || in.bad()) {
     *rc = cli::kExitIo;
     return path + ": cannot be read";
   }
+  return parseManifest(text.str(), path, outDir, entries, rc);
+}
+
+std::optional<std::string> parseManifest(std::string_view text, const std::string& path, const std::string& outDir,
+                                         std::vector<Entry>* entries, int* rc) {
   *rc = cli::kExitInvalidFile;
-  std::stringstream text;
-  text << in.rdbuf();
-  nlohmann::json m = nlohmann::json::parse(text.str(), nullptr, false);
+  nlohmann::json m = nlohmann::json::parse(text, nullptr, false);
   if (m.is_discarded()) return path + ": not JSON";
   if (!m.is_object() || m.value("vffLibrary", 0) != 1)
     return path + ": not a vff library manifest (\"vffLibrary\": 1 is missing)";
