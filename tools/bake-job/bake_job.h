@@ -1,6 +1,6 @@
 // bake_job.h - one bake as vff-bake's command line states it, shared by vff-bake and vff-library:
 // the command line (options.cpp), the checks and output every bake makes (common.cpp), and partial
-// results of a map range (partial.cpp; spec/partial.md).
+// results of a map range (partial.cpp) and their merge (merge.cpp; spec/partial.md).
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -113,5 +114,16 @@ std::string partialMetadata(const std::string& wholeMetadata, const WriteOptions
 // the normals likewise; finishes the file. Returns the exit code of a failure.
 std::optional<int> writePartial(const Options& o, Writer& writer, const FieldDesc& field, const MapRange& r,
                                 const bake::BakedField& baked, double* seconds, uint64_t* fileBytes);
+
+// What a merge leaves to its caller around the output's Writer (vff-bake: its temporaries on a
+// signal); either may be empty, as in a fuzz target.
+struct MergeHooks {
+  std::function<void(const std::string& output)> beforeWrite;    // before the Writer of `output` exists
+  std::function<void(const std::string& output)> writerCreated;  // once it exists
+};
+// --merge: checks the parts o.merge against each other (spec/partial.md, in its order) and writes
+// the whole field to o.output through the same Writer and options as a whole bake; prints the
+// refusal or the summary. Returns the exit code. Uses o.merge, o.output, o.threads, o.json, o.quiet.
+int mergeParts(const Options& o, const MergeHooks& hooks = {});
 
 }  // namespace vff::bake_tool

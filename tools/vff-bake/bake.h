@@ -1,5 +1,5 @@
 // bake.h - what vff-bake's parts share beyond one bake's options and output (tools/bake-job,
-// bake_job.h): --merge (merge.cpp), the temporary files on a signal (interrupt.cpp), and the bakes,
+// bake_job.h, which also holds --merge): the temporary files on a signal (interrupt.cpp), and the bakes,
 // from a mesh (mesh_bake.cpp), from an OpenVDB level set (levelset_bake.cpp) and per glTF mesh or
 // node (split_bake.cpp).
 #pragma once
@@ -12,10 +12,6 @@
 #include "bake_job.h"
 
 namespace vff::bake_tool {
-
-// --merge: checks the parts o.merge against each other and writes the whole field to o.output
-// through the same Writer and options as a whole bake. Returns the exit code.
-int mergeParts(const Options& o);
 
 // ---- The temporary file (interrupt.cpp) ---------------------------------------------------------
 // Removes the temporaries of `output` (.NAME.tmp-PID-N beside it) left by processes that no longer

@@ -9,7 +9,7 @@
 //   vff-bake --merge p1.vff p0.vff -o field.vff         the partial results assembled (spec/partial.md)
 //
 // options.cpp reads the command line, mesh_bake.cpp, split_bake.cpp and levelset_bake.cpp bake, common.cpp holds
-// what the two bakes share, partial.cpp and merge.cpp the partial results (bake.h).
+// what the two bakes share, partial.cpp and merge.cpp the partial results (bake_job.h, bake.h).
 #include "bake.h"
 #include "cli.h"
 
@@ -32,7 +32,7 @@ int main(int argc, char** argv) {
       vff::cli::usageError(kProg, *problem);
       return vff::cli::kExitUsage;
     }
-    return mergeParts(o);
+    return mergeParts(o, MergeHooks{removeStaleTemporaries, [](const std::string& out) { removeTemporaryOnSignal(out); }});
   }
   if (auto problem = checkOptions(o)) {
     vff::cli::usageError(kProg, *problem);

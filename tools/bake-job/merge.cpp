@@ -1,11 +1,12 @@
 // merge.cpp - vff-bake --merge: partial results (spec/partial.md) checked against each other and
 // assembled into the whole field. The maps go through the same Writer with the same field, options
-// and META as the whole bake, so the bytes are the whole bake's by construction.
+// and META as the whole bake, so the bytes are the whole bake's by construction. In the library, not
+// the tool, so that a fuzz target runs the very checks vff-bake runs.
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
 
-#include "bake.h"
+#include "bake_job.h"
 #include "cli.h"
 
 namespace vff::bake_tool {
@@ -177,7 +178,7 @@ Status copyMaps(const Part& p, Plane plane, Writer& w) {
 
 }  // namespace
 
-int mergeParts(const Options& o) {
+int mergeParts(const Options& o, const MergeHooks& hooks) {
   std::error_code ec;
   for (const std::string& path : o.merge)
     if (path == o.output || std::filesystem::equivalent(path, o.output, ec)) {
@@ -205,10 +206,10 @@ int mergeParts(const Options& o) {
   wo.threads = o.threads;
 
   const auto t0 = std::chrono::steady_clock::now();
-  removeStaleTemporaries(o.output);
+  if (hooks.beforeWrite) hooks.beforeWrite(o.output);
   auto w = Writer::create(o.output, first.file.field(), wo);
   if (!w) return cli::reportError(kProg, o.output, w.error());
-  removeTemporaryOnSignal(o.output);
+  if (hooks.writerCreated) hooks.writerCreated(o.output);
   for (Plane plane : {Plane::kDistance, Plane::kNormal}) {
     if (!first.file.plane(plane).present) continue;
     for (const Part& p : parts)
