@@ -160,7 +160,7 @@ test_bad_ranges_are_usage_errors() {
   cp "$WORK/a.vff" "$WORK/a.copy"
   bake --merge "$WORK/a.vff" -o "$WORK/a.vff"
   expect_rc 1
-  expect_err "is also a part to merge"
+  expect_err "merge-output-is-part (12001): -o $WORK/a.vff is also a part to merge"
   bake --merge "$WORK/a.vff" -o "$WORK/../$(basename "$WORK")/a.vff"
   expect_rc 1
   cmp "$WORK/a.vff" "$WORK/a.copy" || fail "the part was changed"
@@ -196,11 +196,11 @@ test_merge_refuses_gaps_and_overlaps() {
   part b 50:82
   part c 40:82
   part d 41:82
-  refused 3 "b.vff: gap: maps 41:50 are in no part" "$WORK/b.vff" "$WORK/a.vff"
-  refused 3 "a.vff: gap: maps 41:82 of the field's 82 are in no part" "$WORK/a.vff"
-  refused 3 "d.vff: gap: maps 0:41 are in no part" "$WORK/d.vff"
-  refused 3 "c.vff: overlap: its maps 40:82 overlap" "$WORK/a.vff" "$WORK/c.vff"
-  refused 3 "overlap" "$WORK/a.vff" "$WORK/d.vff" "$WORK/d.vff"
+  refused 3 "b.vff: merge-gap (12017): gap: maps 41:50 are in no part" "$WORK/b.vff" "$WORK/a.vff"
+  refused 3 "a.vff: merge-gap (12017): gap: maps 41:82 of the field's 82 are in no part" "$WORK/a.vff"
+  refused 3 "d.vff: merge-gap (12017): gap: maps 0:41 are in no part" "$WORK/d.vff"
+  refused 3 "c.vff: merge-overlap (12018): overlap: its maps 40:82 overlap" "$WORK/a.vff" "$WORK/c.vff"
+  refused 3 "d.vff: merge-overlap (12018): overlap: its maps 41:82 overlap" "$WORK/a.vff" "$WORK/d.vff" "$WORK/d.vff"
   bake --merge "$WORK/d.vff" "$WORK/a.vff" -o "$WORK/ok.vff" -q
   expect_rc 0
 }
@@ -211,24 +211,24 @@ test_merge_refuses_other_geometry_and_options() {
   part a 0:41
   bake "$WORK/sphere.obj" -o "$WORK/sphere.vff" "${small[@]}" --map-range 41:82
   expect_rc 0
-  refused 3 "sphere.vff: different geometry: vff.source.geometryHash" "$WORK/a.vff" "$WORK/sphere.vff"
+  refused 3 "sphere.vff: merge-geometry (12012): different geometry: vff.source.geometryHash" "$WORK/a.vff" "$WORK/sphere.vff"
   part zstd 41:82 --codec zstd
-  refused 3 "zstd.vff: different options: codec" "$WORK/a.vff" "$WORK/zstd.vff"
+  refused 3 "zstd.vff: merge-block-options (12015): different options: codec" "$WORK/a.vff" "$WORK/zstd.vff"
   part normals 41:82 --normals
-  refused 3 "normals.vff: different options:" "$WORK/a.vff" "$WORK/normals.vff"
+  refused 3 "normals.vff: merge-options (12014): different options:" "$WORK/a.vff" "$WORK/normals.vff"
   part u16 41:82 --encoding unorm16-diameter
-  refused 3 "u16.vff: different options:" "$WORK/a.vff" "$WORK/u16.vff"
+  refused 3 "u16.vff: merge-options (12014): different options: encoding" "$WORK/a.vff" "$WORK/u16.vff"
   bake "$WORK/knot.obj" -o "$WORK/fib.vff" -q -m 16 --positions fibonacci -n 82 --map-range 41:82
-  refused 3 "fib.vff: different options:" "$WORK/a.vff" "$WORK/fib.vff"
+  refused 3 "fib.vff: merge-options (12014): different options:" "$WORK/a.vff" "$WORK/fib.vff"
   part g 41:82 --maps-per-block 4
-  refused 3 "g.vff: different options: mapsPerBlock" "$WORK/a.vff" "$WORK/g.vff"
+  refused 3 "g.vff: merge-block-options (12015): different options: mapsPerBlock" "$WORK/a.vff" "$WORK/g.vff"
   part layers 41:82 --gutter 2
-  refused 3 "layers.vff: different options:" "$WORK/a.vff" "$WORK/layers.vff"
+  refused 3 "layers.vff: merge-options (12014): different options: gutter" "$WORK/a.vff" "$WORK/layers.vff"
   part sphere 41:82 --center 0 0 0 --radius 2
-  refused 3 "different options:" "$WORK/a.vff" "$WORK/sphere.vff"
+  refused 3 "sphere.vff: merge-options (12014): different options: sphere" "$WORK/a.vff" "$WORK/sphere.vff"
   cp "$WORK/knot.obj" "$WORK/renamed.obj"
   bake "$WORK/renamed.obj" -o "$WORK/renamed.vff" "${small[@]}" --map-range 41:82
-  refused 3 "renamed.vff: different bake: META vff.source.name" "$WORK/a.vff" "$WORK/renamed.vff"
+  refused 3 "renamed.vff: merge-meta (12016): different bake: META vff.source.name" "$WORK/a.vff" "$WORK/renamed.vff"
 }
 
 test_merge_refuses_other_versions_and_bad_parts() {
@@ -236,20 +236,37 @@ test_merge_refuses_other_versions_and_bad_parts() {
   part a 0:41
   part b 41:82
   "$EDIT" "$WORK/b.vff" "$WORK/old.vff" /vff.generatorVersion '"0.0.1"' || fail "edit"
-  refused 3 "old.vff: different versions: baked by vff-bake \"0.0.1\"" "$WORK/a.vff" "$WORK/old.vff"
+  refused 3 "old.vff: merge-version (12013): different versions: baked by vff-bake \"0.0.1\"" "$WORK/a.vff" "$WORK/old.vff"
   "$EDIT" "$WORK/b.vff" "$WORK/v2.vff" /vff.partial/version 2 || fail "edit"
-  refused 5 "v2.vff: partial result version 2; this vff-bake reads version 1" "$WORK/a.vff" "$WORK/v2.vff"
+  refused 5 "v2.vff: partial-version (12004): partial result version 2; this vff-bake reads version 1" "$WORK/a.vff" "$WORK/v2.vff"
   "$EDIT" "$WORK/b.vff" "$WORK/count.vff" /vff.partial/mapCount 90 || fail "edit"
-  refused 3 "count.vff: \"vff.partial\" says 90 maps, the field has 82" "$WORK/a.vff" "$WORK/count.vff"
+  refused 3 "count.vff: partial-map-count (12008): \"vff.partial\" says 90 maps, the field has 82" "$WORK/a.vff" "$WORK/count.vff"
   "$EDIT" "$WORK/b.vff" "$WORK/end.vff" /vff.partial/mapEnd 83 || fail "edit"
-  refused 3 "end.vff: map range 41:83 is empty or outside the field's 82 maps" "$WORK/a.vff" "$WORK/end.vff"
+  refused 3 "end.vff: partial-range (12009): map range 41:83 is empty or outside the field's 82 maps" "$WORK/a.vff" "$WORK/end.vff"
   "$EDIT" "$WORK/b.vff" "$WORK/codec.vff" /vff.partial/codec '"lz4"' || fail "edit"
-  refused 5 "codec.vff: \"vff.partial\" names an unknown codec 'lz4'" "$WORK/a.vff" "$WORK/codec.vff"
+  refused 5 "codec.vff: partial-codec (12010): \"vff.partial\" names an unknown codec 'lz4'" "$WORK/a.vff" "$WORK/codec.vff"
   "$EDIT" "$WORK/b.vff" "$WORK/nolevel.vff" /vff.partial/zstdLevel '"high"' || fail "edit"
-  refused 3 "nolevel.vff: \"vff.partial\" lacks one of" "$WORK/a.vff" "$WORK/nolevel.vff"
+  refused 3 "nolevel.vff: partial-key-type (12006): \"vff.partial\" zstdLevel is \"high\", not an integer 0..22" "$WORK/a.vff" "$WORK/nolevel.vff"
+  # a value of another type is a malformed partial (3), even where its right type would be unsupported
+  "$EDIT" "$WORK/b.vff" "$WORK/codec7.vff" /vff.partial/codec 7 || fail "edit"
+  refused 3 "codec7.vff: partial-key-type (12006): \"vff.partial\" codec is 7, not a string" "$WORK/a.vff" "$WORK/codec7.vff"
+  "$EDIT" "$WORK/b.vff" "$WORK/negative.vff" /vff.partial/mapBegin -1 || fail "edit"
+  refused 3 "negative.vff: partial-key-type (12006): \"vff.partial\" mapBegin is -1" "$WORK/a.vff" "$WORK/negative.vff"
+  "$EDIT" "$WORK/b.vff" "$WORK/object.vff" /vff.partial '"0:41"' || fail "edit"
+  refused 3 "object.vff: partial-object (12003)" "$WORK/a.vff" "$WORK/object.vff"
+  "$EDIT" "$WORK/b.vff" "$WORK/lacks.vff" /vff.partial '{"version":1,"mapBegin":41,"mapEnd":82}' || fail "edit"
+  refused 3 "lacks.vff: partial-key-missing (12005): \"vff.partial\" lacks \"mapCount\"" "$WORK/a.vff" "$WORK/lacks.vff"
+  # a key version 1 does not define is refused: the merge would drop what it does not understand
+  "$EDIT" "$WORK/b.vff" "$WORK/extra.vff" /vff.partial/filter '"shuffle"' || fail "edit"
+  refused 3 "extra.vff: partial-key-unknown (12007): \"vff.partial\" has the key \"filter\"" "$WORK/a.vff" "$WORK/extra.vff"
+  "$EDIT" "$WORK/b.vff" "$WORK/level0.vff" /vff.partial '{"version":1,"mapBegin":41,"mapEnd":82,"mapCount":82,"codec":"zstd","zstdLevel":0,"mapsPerBlock":0}' || fail "edit"
+  refused 3 "level0.vff: partial-zstd-level (12011)" "$WORK/a.vff" "$WORK/level0.vff"
+  # the first part in argument order that breaks a rule is the one reported
+  refused 3 "count.vff: partial-map-count (12008)" "$WORK/count.vff" "$WORK/codec7.vff"
+  refused 3 "codec7.vff: partial-key-type (12006)" "$WORK/codec7.vff" "$WORK/count.vff"
   # a whole field is not a partial result
   bake "$WORK/knot.obj" -o "$WORK/whole.vff" "${small[@]}"
-  refused 3 "whole.vff: not a partial result" "$WORK/a.vff" "$WORK/whole.vff"
+  refused 3 "whole.vff: partial-missing (12002): not a partial result" "$WORK/a.vff" "$WORK/whole.vff"
   # a corrupt part: one byte of its distance plane changed
   cp "$WORK/b.vff" "$WORK/corrupt.vff"
   local size

@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <string_view>
 
 #include "bake_job.h"
 #include "cli.h"
+#include "partial_rules.h"
 
 namespace vff::bake_tool {
 
@@ -21,50 +23,78 @@ struct Part {
   MapRange range;
 };
 
-// A refusal naming the part: "vff-bake: error: PATH: MESSAGE"; returns `code`.
-int refuse(const std::string& path, const std::string& message, int code = cli::kExitInvalidFile) {
-  cli::printError(kProg, path + ": " + message);
-  return code;
+// A refusal of rule `r` naming the part: "vff-bake: error: PATH: NAME (ID): MESSAGE"; returns the
+// rule's exit code.
+int refuse(const std::string& path, PartialRule r, const std::string& message) {
+  cli::printError(kProg, path + ": " + partialRuleTag(r) + ": " + message);
+  return partialRuleInfo(r).exitCode;
 }
 
-std::string rangeText(const MapRange& r) { return std::to_string(r.begin) + ":" + std::to_string(r.end); }
-
-bool isUnsigned(const nlohmann::json& j, const char* key, uint64_t max) {
-  return j.contains(key) && j[key].is_number_unsigned() && j[key].get<uint64_t>() <= max;
+std::string rangeText(const MapRange& r) {
+  return std::to_string(r.begin) + ":" + std::to_string(r.end);
 }
 
-// Reads `path` as a partial result; returns the exit code of a refusal.
+// The keys of "vff.partial" version 1 after "version" (spec/partial.md section 2), in the order they
+// are checked, with the largest value each may take.
+constexpr std::pair<const char*, uint64_t> kPartialKeys[] = {{"mapBegin", UINT32_MAX}, {"mapEnd", UINT32_MAX},
+                                                             {"mapCount", UINT32_MAX}, {"codec", 0},
+                                                             {"zstdLevel", 22},        {"mapsPerBlock", UINT32_MAX}};
+
+// The keys of `p` ("vff.partial" with an integer version 1): rules 12005, 12006, 12007 in order.
+std::optional<int> checkPartialKeys(const std::string& path, const nlohmann::json& p) {
+  for (const auto& [key, max] : kPartialKeys)
+    if (!p.contains(key))
+      return refuse(path, PartialRule::kKeyMissing, std::string("\"vff.partial\" lacks \"") + key + "\"");
+  for (const auto& [key, max] : kPartialKeys) {
+    const nlohmann::json& v = p[key];
+    const bool codec = std::string_view(key) == "codec";
+    // A negative or fractional number, a string of digits: the writer makes none of these.
+    const bool ok = codec ? v.is_string() : v.is_number_unsigned() && v.get<uint64_t>() <= max;
+    if (!ok)
+      return refuse(path, PartialRule::kKeyType,
+                    std::string("\"vff.partial\" ") + key + " is " + v.dump() + ", not " +
+                        (codec ? std::string("a string") : "an integer 0.." + std::to_string(max)));
+  }
+  for (auto it = p.begin(); it != p.end(); ++it)
+    if (it.key() != "version" && std::none_of(std::begin(kPartialKeys), std::end(kPartialKeys),
+                                              [&](const auto& k) { return it.key() == k.first; }))
+      return refuse(path, PartialRule::kKeyUnknown,
+                    "\"vff.partial\" has the key \"" + it.key() + "\", which version " +
+                        std::to_string(kPartialVersion) + " does not define (merge with the vff-bake that baked it)");
+  return std::nullopt;
+}
+
+// Reads `path` as a partial result (rules 12002 to 12011, after the reader's own); returns the exit
+// code of a refusal.
 std::optional<int> openPart(const std::string& path, std::vector<Part>* parts) {
   auto f = File::open(path);
   if (!f) return cli::reportError(kProg, path, f.error());
   nlohmann::json meta = nlohmann::json::parse(f->metadata(), nullptr, false);
   if (meta.is_discarded() || !meta.is_object() || !meta.contains("vff.partial"))
-    return refuse(path, "not a partial result (its META has no \"vff.partial\"): bake parts with --map-range");
+    return refuse(path, PartialRule::kNotPartial,
+                  "not a partial result (its META has no \"vff.partial\"): bake parts with --map-range");
   nlohmann::json p = meta["vff.partial"];
   meta.erase("vff.partial");
   if (!p.is_object() || !p.contains("version") || !p["version"].is_number_integer())
-    return refuse(path, "\"vff.partial\" is not an object with an integer \"version\"");
+    return refuse(path, PartialRule::kNotObject, "\"vff.partial\" is not an object with an integer \"version\"");
   if (p["version"] != kPartialVersion)
-    return refuse(path,
+    return refuse(path, PartialRule::kVersion,
                   "partial result version " + p["version"].dump() + "; this vff-bake reads version " +
-                      std::to_string(kPartialVersion) + " (merge with the vff-bake that baked it)",
-                  cli::kExitUnsupported);
+                      std::to_string(kPartialVersion) + " (merge with the vff-bake that baked it)");
+  if (auto rc = checkPartialKeys(path, p)) return rc;
   const uint32_t count = f->field().mapCount;
-  if (!isUnsigned(p, "mapBegin", UINT32_MAX) || !isUnsigned(p, "mapEnd", UINT32_MAX) ||
-      !isUnsigned(p, "mapCount", UINT32_MAX) || !isUnsigned(p, "zstdLevel", 22) ||
-      !isUnsigned(p, "mapsPerBlock", UINT32_MAX) || !p.contains("codec") || !p["codec"].is_string())
-    return refuse(path, "\"vff.partial\" lacks one of mapBegin, mapEnd, mapCount, codec, zstdLevel, mapsPerBlock, "
-                        "or one is not a number in range: " + p.dump());
   const MapRange r{p["mapBegin"].get<uint32_t>(), p["mapEnd"].get<uint32_t>()};
   if (p["mapCount"].get<uint32_t>() != count)
-    return refuse(path, "\"vff.partial\" says " + p["mapCount"].dump() + " maps, the field has " + std::to_string(count));
+    return refuse(path, PartialRule::kMapCount,
+                  "\"vff.partial\" says " + p["mapCount"].dump() + " maps, the field has " + std::to_string(count));
   if (r.begin >= r.end || r.end > count)
-    return refuse(path, "map range " + rangeText(r) + " is empty or outside the field's " + std::to_string(count) + " maps");
+    return refuse(path, PartialRule::kRange,
+                  "map range " + rangeText(r) + " is empty or outside the field's " + std::to_string(count) + " maps");
   const std::string codec = p["codec"];
   if (codec != codecName(Codec::kStored) && codec != codecName(Codec::kZstd))
-    return refuse(path, "\"vff.partial\" names an unknown codec '" + codec + "'", cli::kExitUnsupported);
+    return refuse(path, PartialRule::kCodec, "\"vff.partial\" names an unknown codec '" + codec + "'");
   if (codec == codecName(Codec::kZstd) && p["zstdLevel"].get<int>() < 1)
-    return refuse(path, "\"vff.partial\" has zstdLevel 0; zstd levels are 1 to 22");
+    return refuse(path, PartialRule::kZstdLevel, "\"vff.partial\" has zstdLevel 0; zstd levels are 1 to 22");
   parts->push_back(Part{path, std::move(*f), std::move(meta), std::move(p), r});
   return std::nullopt;
 }
@@ -107,7 +137,8 @@ std::string firstDifference(const nlohmann::json& a, const nlohmann::json& b) {
 
 std::string metaValue(const nlohmann::json& meta, const std::string& key) {
   const size_t dot = key.find('.', 4);  // past "vff."
-  const nlohmann::json::json_pointer ptr("/" + (dot == std::string::npos ? key : key.substr(0, dot) + "/" + key.substr(dot + 1)));
+  const nlohmann::json::json_pointer ptr(
+      "/" + (dot == std::string::npos ? key : key.substr(0, dot) + "/" + key.substr(dot + 1)));
   return meta.contains(ptr) ? meta[ptr].dump() : "(absent)";
 }
 
@@ -118,23 +149,27 @@ std::optional<int> checkSameBake(const Part& p, const Part& q) {
     return j.contains(ptr) ? j[ptr].dump() : std::string("(absent)");
   };
   if (at(p.meta, geometry) != at(q.meta, geometry))
-    return refuse(p.path, "different geometry: vff.source.geometryHash " + at(p.meta, geometry) + ", but " + q.path +
-                              " has " + at(q.meta, geometry));
+    return refuse(p.path, PartialRule::kGeometry,
+                  "different geometry: vff.source.geometryHash " + at(p.meta, geometry) + ", but " + q.path + " has " +
+                      at(q.meta, geometry));
   if (at(p.meta, version) != at(q.meta, version))
-    return refuse(p.path, "different versions: baked by vff-bake " + at(p.meta, version) + ", but " + q.path +
-                              " by " + at(q.meta, version));
+    return refuse(p.path, PartialRule::kVersionOfBake,
+                  "different versions: baked by vff-bake " + at(p.meta, version) + ", but " + q.path + " by " +
+                      at(q.meta, version));
   const auto a = describe(p.file.field(), p.file.layout()), b = describe(q.file.field(), q.file.layout());
   for (size_t i = 0; i < a.size(); ++i)
     if (a[i].second != b[i].second)
-      return refuse(p.path, "different options: " + a[i].first + " " + a[i].second + ", but " + q.path + " has " +
-                                b[i].second);
+      return refuse(p.path, PartialRule::kFieldOptions,
+                    "different options: " + a[i].first + " " + a[i].second + ", but " + q.path + " has " + b[i].second);
   for (const char* k : {"codec", "zstdLevel", "mapsPerBlock"})
     if (p.partial[k] != q.partial[k])
-      return refuse(p.path, std::string("different options: ") + k + " " + p.partial[k].dump() + ", but " + q.path +
-                                " has " + q.partial[k].dump());
+      return refuse(p.path, PartialRule::kBlockOptions,
+                    std::string("different options: ") + k + " " + p.partial[k].dump() + ", but " + q.path + " has " +
+                        q.partial[k].dump());
   if (const std::string k = firstDifference(p.meta, q.meta); !k.empty())
-    return refuse(p.path, "different bake: META " + k + " is " + metaValue(p.meta, k) + ", but " + q.path + " has " +
-                              metaValue(q.meta, k));
+    return refuse(p.path, PartialRule::kMeta,
+                  "different bake: META " + k + " is " + metaValue(p.meta, k) + ", but " + q.path + " has " +
+                      metaValue(q.meta, k));
   return std::nullopt;
 }
 
@@ -145,17 +180,20 @@ std::optional<int> checkCoverage(const std::vector<Part>& parts) {
   const Part* previous = nullptr;
   for (const Part& p : parts) {
     if (p.range.begin > next)
-      return refuse(p.path, "gap: maps " + std::to_string(next) + ":" + std::to_string(p.range.begin) +
-                                " are in no part (this part holds " + rangeText(p.range) + ")");
+      return refuse(p.path, PartialRule::kGap,
+                    "gap: maps " + std::to_string(next) + ":" + std::to_string(p.range.begin) +
+                        " are in no part (this part holds " + rangeText(p.range) + ")");
     if (p.range.begin < next)
-      return refuse(p.path, "overlap: its maps " + rangeText(p.range) + " overlap " + previous->path + "'s " +
-                                rangeText(previous->range));
+      return refuse(p.path, PartialRule::kOverlap,
+                    "overlap: its maps " + rangeText(p.range) + " overlap " + previous->path + "'s " +
+                        rangeText(previous->range));
     next = p.range.end;
     previous = &p;
   }
   if (next != count)
-    return refuse(parts.back().path, "gap: maps " + std::to_string(next) + ":" + std::to_string(count) +
-                                         " of the field's " + std::to_string(count) + " are in no part");
+    return refuse(parts.back().path, PartialRule::kGap,
+                  "gap: maps " + std::to_string(next) + ":" + std::to_string(count) + " of the field's " +
+                      std::to_string(count) + " are in no part");
   return std::nullopt;
 }
 
@@ -170,7 +208,7 @@ Status copyMaps(const Part& p, Plane plane, Writer& w) {
     if (Status st = p.file.decodeBlock(plane, b, block); !st) return st;
     const uint32_t from = std::max(bi.firstMap, p.range.begin), to = std::min(bi.firstMap + bi.mapCount, p.range.end);
     const auto bytes = std::span<const uint8_t>(block).subspan(size_t(from - bi.firstMap) * info.mapBytes,
-                                                                size_t(to - from) * info.mapBytes);
+                                                               size_t(to - from) * info.mapBytes);
     if (Status st = w.writeMaps(plane, bytes); !st) return st;
   }
   return {};
@@ -182,15 +220,17 @@ int mergeParts(const Options& o, const MergeHooks& hooks) {
   std::error_code ec;
   for (const std::string& path : o.merge)
     if (path == o.output || std::filesystem::equivalent(path, o.output, ec)) {
-      cli::usageError(kProg, "-o " + o.output + " is also a part to merge: write the whole field elsewhere");
-      return cli::kExitUsage;
+      cli::usageError(kProg, partialRuleTag(PartialRule::kOutputIsPart) + ": -o " + o.output +
+                                 " is also a part to merge: write the whole field elsewhere");
+      return partialRuleInfo(PartialRule::kOutputIsPart).exitCode;
     }
   std::vector<Part> parts;
   for (const std::string& path : o.merge)
     if (auto rc = openPart(path, &parts)) return *rc;
   for (size_t i = 1; i < parts.size(); ++i)
     if (auto rc = checkSameBake(parts[i], parts[0])) return *rc;
-  std::stable_sort(parts.begin(), parts.end(), [](const Part& a, const Part& b) { return a.range.begin < b.range.begin; });
+  std::stable_sort(parts.begin(), parts.end(),
+                   [](const Part& a, const Part& b) { return a.range.begin < b.range.begin; });
   if (auto rc = checkCoverage(parts)) return *rc;
 
   // The whole bake's options: its block codec from "vff.partial", its layout limits from LAYT (the
@@ -217,8 +257,10 @@ int mergeParts(const Options& o, const MergeHooks& hooks) {
   }
   if (Status st = w->finish(); !st) return cli::reportError(kProg, o.output, st.error());
   if (o.json) {
-    nlohmann::json summary = {{"output", o.output}, {"maps", first.file.field().mapCount},
-                              {"parts", parts.size()}, {"seconds", secondsSince(t0)}};
+    nlohmann::json summary = {{"output", o.output},
+                              {"maps", first.file.field().mapCount},
+                              {"parts", parts.size()},
+                              {"seconds", secondsSince(t0)}};
     std::printf("%s\n", summary.dump(2).c_str());
   } else if (!o.quiet) {
     std::fprintf(stderr, "%s: merged %zu parts, %u maps -> %s\n", kProg, parts.size(), first.file.field().mapCount,
