@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "vff/scene_description.h"
+#include "vff/strict_json.h"
 
 namespace vff {
 namespace {
@@ -110,7 +111,7 @@ struct Bad {
 TEST(SceneDescription, EveryRuleHasItsError) {
   const std::string head = R"({"asset":{"format":"vff-scene","version":1},"fields":[{"uri":"a.vff"}],"instances":[)";
   const Bad bad[] = {
-      {"not json", Code::kSceneJson, "not valid JSON"},
+      {"not json", Code::kSceneJson, "bad.json:1:"},
       {"[1]", Code::kSceneJson, "not an object"},
       {R"({"fields":[],"instances":[]})", Code::kSceneVersion, "asset"},
       {R"({"asset":{"format":"gltf","version":1},"fields":[],"instances":[]})", Code::kSceneVersion, "\"gltf\""},
@@ -165,6 +166,71 @@ TEST(SceneDescription, FilesAndUris) {
   for (const auto& e : std::filesystem::directory_iterator(dir)) files += e.is_regular_file();
   EXPECT_EQ(files, 1u);
   std::filesystem::remove_all(dir);
+}
+
+// The JSON text rules (vff/strict_json.h, spec/scene.md section 1), one case each.
+TEST(StrictJson, AcceptsABomAndWhitespaceAround) {
+  EXPECT_FALSE(checkStrictJson("\xEF\xBB\xBF {\"a\": [1, 2.5e-3, true, null, \"x\"]}\r\n\t "));
+  EXPECT_FALSE(checkStrictJson("[1e308, -1e308, 1e-400, 18446744073709551616]"));
+}
+
+std::string where(std::string_view text) {
+  const auto p = checkStrictJson(text);
+  if (!p) return "accepted";
+  return describeJsonProblem(*p, "f.json");
+}
+
+TEST(StrictJson, RefusesTrailingBytesNulAndAHalfBom) {
+  using namespace std::string_literals;
+  EXPECT_EQ(where("{\"a\":1}\0"s), "f.json:1:8: a NUL byte after the JSON value (only whitespace may follow it)");
+  EXPECT_EQ(where("{\"a\":\n 1}\n x"), "f.json:3:2: a byte after the JSON value (only whitespace may follow it)");
+  EXPECT_EQ(where("{\"a\":[1,\0]}"s), "f.json:1:9: a[1]: a NUL byte (JSON allows none outside strings, and in a string only as \\u0000)");
+  EXPECT_EQ(where("[]{}"), "f.json:1:3: a byte after the JSON value (only whitespace may follow it)");
+  EXPECT_NE(where("\xEF\xBB{}"), "accepted");
+  EXPECT_NE(where("\xEF\xBB\xBF\xEF\xBB\xBF{}"), "accepted");
+}
+
+TEST(StrictJson, RefusesNumbersBeyondBinary64AndPlacesThem) {
+  EXPECT_EQ(where("{\"extras\": {\"k\": [0,\n  1e400]}}"),
+            "f.json:2:3: extras.k[1]: the number 1e400 is not representable as a finite binary64");
+  EXPECT_EQ(where("[-1e309]"), "f.json:1:2: [0]: the number -1e309 is not representable as a finite binary64");
+}
+
+TEST(StrictJson, RefusesRepeatedNamesAtTheSecondOne) {
+  EXPECT_EQ(where("{\"a\": {\"b\": 1,\n \"b\": 2}}"), "f.json:2:2: a.b: the member name \"b\" is repeated in one object");
+  EXPECT_EQ(where("{\"a b\": 1, \"a b\": 1}"), "f.json:1:12: [\"a b\"]: the member name \"a b\" is repeated in one object");
+  EXPECT_EQ(where("[{\"a\": 1}, {\"a\": 1}]"), "accepted");  // one name per object
+}
+
+TEST(StrictJson, NestsAtMost64Deep) {
+  const std::string ok = std::string(64, '[') + std::string(64, ']');
+  EXPECT_EQ(where(ok), "accepted");
+  const std::string deep = std::string(65, '[') + std::string(65, ']');
+  const auto p = checkStrictJson(deep);
+  ASSERT_TRUE(p);
+  EXPECT_EQ(p->byte, 64u);
+  EXPECT_EQ(p->column, 65u);
+  EXPECT_EQ(p->message, "objects and arrays nest deeper than 64 (a reader limit)");
+  // Far deeper than any stack would hold: refused all the same, at the same place.
+  const auto far = checkStrictJson(std::string(1000000, '['));
+  ASSERT_TRUE(far);
+  EXPECT_EQ(far->byte, 64u);
+}
+
+TEST(StrictJson, RefusesBadUtf8AndLoneSurrogates) {
+  EXPECT_NE(where("{\"a\": \"\xC3\x28\"}"), "accepted");
+  EXPECT_NE(where(R"({"a": "\ud800"})"), "accepted");
+  EXPECT_EQ(where(R"({"a": "\ud83d\ude00"})"), "accepted");
+}
+
+TEST(StrictJson, PathsQuoteNamesThatAreNotIdentifiers) {
+  std::string p = "instances[3]";
+  appendJsonPathKey(p, "rotation");
+  EXPECT_EQ(p, "instances[3].rotation");
+  std::string q;
+  appendJsonPathKey(q, "fields");
+  appendJsonPathKey(q, "1x");
+  EXPECT_EQ(q, "fields[\"1x\"]");
 }
 
 }  // namespace

@@ -11,6 +11,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "scene/strict_json_dom.h"
+
 namespace vff {
 namespace {
 
@@ -163,8 +165,9 @@ std::array<float, 4> quaternionFromRotation(const float r[3][3]) noexcept {
 }
 
 Result<SceneDescription> parseSceneDescription(std::string_view text, const std::string& name) {
-  const json doc = json::parse(text.begin(), text.end(), nullptr, false);
-  if (doc.is_discarded()) return makeError(Code::kSceneJson, name + ": not valid JSON");
+  json doc;
+  if (auto problem = detail::parseStrictJson(text, doc))
+    return makeError(Code::kSceneJson, describeJsonProblem(*problem, name));
   if (!doc.is_object()) return makeError(Code::kSceneJson, name + ": the JSON value is not an object");
   if (!doc.contains("asset") || !doc["asset"].is_object())
     return makeError(Code::kSceneVersion, name + ": asset: an object with format \"vff-scene\" is required");
