@@ -73,14 +73,18 @@ test_changed_mesh_rebakes_only_it() {
   [[ $(json 'len(r["baked"])') == 0 ]] || fail "--rehash re-baked an unchanged mesh"
 }
 
+# A dry run lists what it would bake and the entries that would fail, with their problem, and exits
+# as the bake would (the broken mesh: 3).
 test_dry_run_bakes_nothing() {
   make_library "$WORK/lib"
   run "$VFF_LIBRARY" bake "$WORK/lib" --out "$WORK/fields" --dry-run -- -m 8
-  expect_rc 0
+  expect_rc 3
   expect_out "box.obj -m 8 -o"
+  expect_out "# 6 entries: 5 to bake, 0 up to date, 1 failing"
+  expect_err "vff-library: error: broken.obj: mesh-parse (10002): line 3: face index 7"
   run "$VFF_LIBRARY" bake "$WORK/lib" --out "$WORK/fields" --dry-run --slurm --partition gpu --time 10:00 \
-    --max-running 3 --sbatch-arg=--account=vff -- -m 8
-  expect_rc 0
+    --max-running 3 --tasks 5 --sbatch-arg=--account=vff -- -m 8
+  expect_rc 3
   expect_out "'--array=0-4%3'"  # five good meshes
   expect_out "#SBATCH --partition=gpu"
   expect_out "#SBATCH --time=10:00"
@@ -103,18 +107,18 @@ test_manifest_errors() {
   echo '{"vffLibrary": 1, "entries": [{"mesh": "a.obj", "options": {"threads": 4}}]}' >"$WORK/lib/m.json"
   run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields"
   expect_rc 3
-  expect_err "vff-library: error: $WORK/lib/m.json: entries[0].options: \"threads\" is not a vff-bake option"
+  expect_err "vff-library: error: $WORK/lib/m.json: unknown-option (13008): entries[0].options.threads: not a vff-bake option"
   echo '{"entries": []}' >"$WORK/lib/m.json"
   run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields"
   expect_rc 3
-  expect_err "not a vff library manifest"
+  expect_err "$WORK/lib/m.json: manifest-object (13002): not a vff library manifest"
   run "$VFF_LIBRARY" bake "$WORK/lib/none.json" --out "$WORK/fields"
   expect_rc 2
   echo '{"vffLibrary": 1, "entries": [{"mesh": "a.obj", "options": {"map-size": 0}}]}' >"$WORK/lib/m.json"
   "$MESHGEN" box "$WORK/lib/a.obj"
   run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields"
   expect_rc 1
-  expect_err "a.obj: options: --map-size"
+  expect_err "vff-library: error: a.obj: bake-option (13015): entries[0].options: --map-size: Value 0 not in range 1 to 4096 (exit 1)"
   run "$VFF_LIBRARY" bake "$WORK/lib" --out "$WORK/fields" --no-such-option
   expect_rc 1
 }
@@ -205,18 +209,18 @@ test_split_entry_errors() {
   echo '{"vffLibrary": 1, "entries": [{"mesh": "s.gltf", "split": "triangles"}]}' >"$WORK/lib/m.json"
   run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields"
   expect_rc 3
-  expect_err "entries[0].split: must be \"mesh\" or \"node\""
+  expect_err "split-value (13011): entries[0].split: must be \"mesh\" or \"node\""
   echo '{"vffLibrary": 1, "entries": [{"mesh": "s.gltf", "split": "mesh", "output": "s.vff"}]}' >"$WORK/lib/m.json"
   run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields"
   expect_rc 3
-  expect_err "output \"s.vff\" of a split entry must name its scene description (.json)"
+  expect_err "split-output (13013): entries[0].output: must name the split entry's scene description (.json), not \"s.vff\""
   # vff-bake refuses --split for a mesh that is not glTF: that entry fails (usage), the other bakes.
   echo '{"vffLibrary": 1, "defaults": {"count": 2, "map-size": 8},
          "entries": [{"mesh": "a.obj", "split": "mesh"}, {"mesh": "s.gltf", "split": "node", "options": {"scene": 5}, "output": "five.json"},
                      {"mesh": "s.gltf", "split": "mesh"}]}' >"$WORK/lib/m.json"
   run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields" --json "$WORK/report.json"
   expect_rc 1
-  expect_err "a.obj: options: --split applies to a glTF input"
+  expect_err "a.obj: bake-option (13015): entries[0].options: --split applies to a glTF input"
   expect_err "there is no scene 5"
   [[ $(json '[f["exitCode"] for f in r["failed"]]') == "[1, 1]" ]] || { show; fail "both refusals: exit 1"; }
   [[ -s $WORK/fields/s.vffscene.json && ! -e $WORK/fields/a.vffscene.json ]] || fail "outputs: $(ls "$WORK/fields")"

@@ -54,6 +54,17 @@ std::optional<std::string> fileHash(const std::string& path) {
 
 namespace {
 
+// CLI11's message of a number out of a range without an upper bound prints binary64's largest value
+// in 309 digits ("--count: Value 0 not in range 0.000000 to 1797..."): said as the bound instead.
+std::string readableRange(std::string message) {
+  const size_t at = message.find(" not in range ");
+  const size_t to = at == std::string::npos ? at : message.find(" to ", at);
+  if (to == std::string::npos || message.size() - to < 4 + 40) return message;
+  // The options vff-bake checks so (CLI11's PositiveNumber and NonNegativeNumber, both shown as 0).
+  const char* bound = message.starts_with("--count:") ? "> 0" : ">= 0";
+  return message.substr(0, at) + " is not " + bound;
+}
+
 // The options as vff-bake resolves them (its own parser), one canonical line: two spellings of
 // the same bake (a default given or left out, -m or --map-size) share a key.
 std::optional<std::string> canonicalOptions(const Entry& e, bake_tool::Options* o, std::string* error) {
@@ -66,11 +77,11 @@ std::optional<std::string> canonicalOptions(const Entry& e, bake_tool::Options* 
   try {
     app.parse(rev);
   } catch (const CLI::ParseError& pe) {
-    *error = std::string("options: ") + pe.what();
+    *error = readableRange(pe.what());
     return std::nullopt;
   }
   if (auto problem = bake_tool::checkOptions(*o)) {
-    *error = "options: " + *problem;
+    *error = *problem;
     return std::nullopt;
   }
   const bake::BakeOptions bo = bake_tool::bakeOptions(*o);
@@ -201,15 +212,26 @@ std::optional<std::string> meshGeometry(const Entry& e, const bake_tool::Options
   return geometry;
 }
 
-// The key of one entry, or its error.
-void computeKey(Entry& e, const CacheOptions& c) {
+}  // namespace
+
+std::optional<std::string> checkBakeArgs(const Entry& e) {
+  bake_tool::Options o;
+  std::string error;
+  if (canonicalOptions(e, &o, &error)) return std::nullopt;
+  return error;
+}
+
+std::string keyHash(const std::string& text) { return hex128(XXH3_128bits(text.data(), text.size())); }
+
+std::optional<std::string> keyText(Entry& e, const CacheOptions& c) {
   bake_tool::Options o;
   std::string error;
   auto options = canonicalOptions(e, &o, &error);
   if (!options) {
-    e.error = error;
-    e.exitCode = cli::kExitUsage;
-    return;
+    // Named once: the report names the entry's mesh; the rule and the options' place follow.
+    e.error = ruleLabel(kRuleBakeOption) + ": " + (e.where.empty() ? "" : e.where + ".options: ") + error;
+    e.exitCode = kRuleBakeOption.exitCode;
+    return std::nullopt;
   }
   // What the bake reads and what it records of it: the output's META names the source file and
   // format and holds both of its hashes (vff.source), so each is part of the key.
@@ -217,18 +239,21 @@ void computeKey(Entry& e, const CacheOptions& c) {
   if (bake_tool::isVdbPath(e.mesh)) {
     auto h = fileHash(e.mesh);
     if (!h) {
-      e.error = e.mesh + ": cannot be read";
+      e.error = "io-open (1001): cannot be read";
       e.exitCode = cli::kExitIo;
-      return;
+      return std::nullopt;
     }
     geometry = "vdb " + *h;
   } else if (Error err; auto g = meshGeometry(e, o, c, &err)) {
     geometry = *g;
   } else {
-    e.error = cli::formatDiagnostic("vff-bake", "error", e.mesh, err);
+    // The report names the mesh: the message keeps the rule and the problem, without the path again.
+    std::string message = err.message;
+    for (size_t at; (at = message.find(e.mesh + ": ")) != std::string::npos;) message.erase(at, e.mesh.size() + 2);
+    e.error = std::string(codeName(err.code)) + " (" + std::to_string(static_cast<uint32_t>(err.code)) + "): " + message;
     // As vff-bake: a --scene the file does not have is a usage error.
     e.exitCode = err.code == Code::kInvalidArgument ? cli::kExitUsage : cli::exitCodeFor(err.code);
-    return;
+    return std::nullopt;
   }
   const bake::BakeOptions bo = bake_tool::bakeOptions(o);
   if (auto maps = positionCount(bo.positionScheme, bo.positionParam)) {
@@ -241,7 +266,14 @@ void computeKey(Entry& e, const CacheOptions& c) {
                            "\ngeometry " + geometry + "\noptions " + *options + "\n" +
                            // The description names its fields after its own file name.
                            (e.split.empty() ? "" : "output " + fs::path(e.output).filename().string() + "\n");
-  e.key = hex128(XXH3_128bits(text.data(), text.size()));
+  return text;
+}
+
+namespace {
+
+// The key of one entry, or its error.
+void computeKey(Entry& e, const CacheOptions& c) {
+  if (auto text = keyText(e, c)) e.key = keyHash(*text);
 }
 
 std::string hostName() {

@@ -9,6 +9,7 @@
 #include "vff/error.h"
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -17,6 +18,11 @@
 namespace vff::library {
 
 inline constexpr const char* kProg = "vff-library";
+
+// "1 entry", "2 entries": a count and its noun.
+inline std::string counted(uint64_t n, const char* one, const char* many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
 
 // ---- Entries (manifest.cpp) ---------------------------------------------------------------------
 // One field to bake: a mesh, the vff-bake options that shape its bytes, and where it goes. A split
@@ -27,6 +33,8 @@ struct Entry {
   std::string name;               // how the report names it (the path as the manifest or folder gives it)
   std::vector<std::string> args;  // vff-bake options, as vff-bake spells them (no -o, -j, --json)
   std::string output;             // the output file, absolute (a split entry's: its scene description)
+  std::string outputName;         // the output relative to the output folder, as spec/library.md section 5 makes it
+  std::string where;              // a manifest entry's JSON path ("entries[3]"); "" for a folder's
   std::string split;              // "mesh" or "node": vff-bake --split (also in args); "": one field
   uint64_t shardMaps = 0;         // above this many maps, bake in map ranges (0: never)
   // Filled by computeKeys (cache.cpp):
@@ -37,8 +45,33 @@ struct Entry {
   uint64_t maps = 0;  // of one field
 };
 
+// The checks of a manifest (spec/library.md section 8): a numeric ID, a name, the exit code.
+struct ManifestRule {
+  int id;
+  const char* name;
+  int exitCode;
+};
+inline constexpr ManifestRule kRuleManifestJson{13001, "manifest-json", 3};
+inline constexpr ManifestRule kRuleManifestObject{13002, "manifest-object", 3};
+inline constexpr ManifestRule kRuleVersionType{13003, "library-version-type", 3};
+inline constexpr ManifestRule kRuleVersion{13004, "library-version", 5};
+inline constexpr ManifestRule kRuleUnknownMember{13005, "unknown-member", 3};
+inline constexpr ManifestRule kRuleMissingMember{13006, "missing-member", 3};
+inline constexpr ManifestRule kRuleMemberType{13007, "member-type", 3};
+inline constexpr ManifestRule kRuleUnknownOption{13008, "unknown-option", 3};
+inline constexpr ManifestRule kRuleOptionType{13009, "option-type", 3};
+inline constexpr ManifestRule kRuleMeshPath{13010, "mesh-path", 3};
+inline constexpr ManifestRule kRuleSplitValue{13011, "split-value", 3};
+inline constexpr ManifestRule kRuleOutputPath{13012, "output-path", 3};
+inline constexpr ManifestRule kRuleSplitOutput{13013, "split-output", 3};
+inline constexpr ManifestRule kRuleDuplicateOutput{13014, "duplicate-output", 3};
+inline constexpr ManifestRule kRuleBakeOption{13015, "bake-option", 1};
+// "name (ID)", as messages print a rule.
+std::string ruleLabel(const ManifestRule& rule);
+
 // Reads a manifest (spec/library.md) into entries; outputs under `outDir`. A problem of the
-// manifest itself (not JSON, a wrong field) is returned as a message; its exit code in *rc.
+// manifest itself (not JSON, a wrong field) is returned as "FILE: name (ID): PATH: problem"; its
+// exit code in *rc. Entries are added only when the whole manifest is valid.
 std::optional<std::string> readManifest(const std::string& path, const std::string& outDir,
                                         std::vector<Entry>* entries, int* rc);
 // The same, of a manifest's text: `path` names it in messages and its folder is the base of relative
@@ -61,6 +94,14 @@ struct CacheOptions {
 // XXH3-128 of a file's bytes, as hex (level sets and glTF scenes: what vff-bake reads of them);
 // nothing when it cannot be read.
 std::optional<std::string> fileHash(const std::string& path);
+// The text whose XXH3-128 is the entry's key (spec/library.md section 6); nothing, with the entry's
+// error and exit code set, when its options or its mesh cannot be read. Sets its rays and maps.
+std::optional<std::string> keyText(Entry& e, const CacheOptions& o);
+// XXH3-128 of a key's text, as 32 lower-case hex digits.
+std::string keyHash(const std::string& text);
+// What vff-bake's parser and checks say against the entry's options (its mesh only by its kind:
+// a .gltf, a .vdb or another mesh); nothing when they take them.
+std::optional<std::string> checkBakeArgs(const Entry& e);
 // Reads every entry's mesh and options and sets its key (or its error), in parallel.
 void computeKeys(std::vector<Entry>& entries, const CacheOptions& o);
 // CACHE/ab/KEY.vff
@@ -136,6 +177,13 @@ BakeResult mergeParts(const Entry& e, const std::vector<Unit>& parts, const Work
 // killed if this thread ends first; its exit code (128 + N when killed by signal N, -1 when it
 // could not be started).
 int runProcess(const std::vector<std::string>& args, const std::string& out, const std::string& err);
+// j[key] when j is an object whose `key` is an integer >= 0, else 0: for JSON this tool wrote
+// (vff-bake's summary, a task's report), read without trusting its types.
+inline uint64_t jsonCount(const nlohmann::json& j, const char* key) {
+  if (!j.is_object()) return 0;
+  const auto it = j.find(key);
+  return it != j.end() && it->is_number_unsigned() ? it->get<uint64_t>() : 0;
+}
 // A file's bytes as text ("" when unreadable).
 std::string readText(const std::string& path);
 // The vff-bake beside this program (or $VFF_BAKE).
@@ -174,10 +222,18 @@ struct PoolOptions {
 std::vector<EntryOutcome> runPool(const std::vector<Entry>& entries, const std::vector<Unit>& todo,
                                   const WorkerOptions& wo, const PoolOptions& po);
 
+// The least work an array task gets by default (spec/library.md section 7): a task waits in the
+// scheduler and starts a process, so a small bake alone in a task spends more time there than baking.
+inline constexpr uint64_t kRaysPerTask = uint64_t{1} << 30;
+// The array tasks for `rays` of work in `units` bakes: `tasks` when given (at most one per bake),
+// else one per raysPerTask rays begun; at least 1 and at most 1000.
+unsigned arrayTasks(uint64_t rays, size_t units, unsigned tasks, uint64_t raysPerTask);
+
 struct SlurmOptions {
   std::string partition, time;
   unsigned maxRunning = 0;             // the array's %N (0: no cap)
-  unsigned tasks = 0;                  // array size (0: one task per entry, at most 1000)
+  unsigned tasks = 0;                  // array size (0: by the work, raysPerTask each, at most 1000)
+  uint64_t raysPerTask = kRaysPerTask;
   unsigned cpusPerTask = 0;            // --cpus-per-task (0: Slurm's default) and vff-bake -j
   std::vector<std::string> sbatchArgs; // passed through
   std::string stateDir;                // where the plan, script, logs and reports go

@@ -33,6 +33,7 @@ struct Options {
   unsigned workers = 0, threads = 0;
   uint64_t shardMaps = 0;
   bool slurm = false, dryRun = false, quiet = false, rehash = false;
+  cli::OutputFormat format = cli::OutputFormat::kText;
   SlurmOptions slurmOptions;
   std::string planPath;
   unsigned task = 0;
@@ -57,7 +58,11 @@ void addBakeOptions(CLI::App& bake, Options& o) {
   bake.add_option("--partition", s.partition, "slurm: the partition");
   bake.add_option("--time", s.time, "slurm: each task's time limit");
   bake.add_option("--max-running", s.maxRunning, "slurm: the most array tasks at once (%N)");
-  bake.add_option("--tasks", s.tasks, "slurm: array tasks (0: one per bake, at most 1000); fewer tasks spend less time in the scheduler");
+  bake.add_option("--tasks", s.tasks,
+                  "slurm: array tasks (0: as many as the work fills, --rays-per-task each, at most one per bake and 1000)");
+  bake.add_option("--rays-per-task", s.raysPerTask,
+                  "slurm: with --tasks 0, the rays of work an array task gets at least (a task waits in the scheduler)")
+      ->capture_default_str();
   bake.add_option("--cpus-per-task", s.cpusPerTask, "slurm: CPUs of each task, and vff-bake's threads");
   bake.add_option("--sbatch-arg", s.sbatchArgs, "slurm: another sbatch option (repeatable), e.g. --sbatch-arg=--account=A")
       ->allow_extra_args(false);
@@ -66,7 +71,10 @@ void addBakeOptions(CLI::App& bake, Options& o) {
   bake.add_option("--poll", s.pollSeconds, "slurm: seconds between squeue polls")->capture_default_str();
   bake.add_flag("--rehash", o.rehash,
                 "read every mesh again, even those whose path, size and time are unchanged since a run noted them");
-  bake.add_flag("--dry-run", o.dryRun, "print what would be baked (with --slurm: the batch script) and bake nothing");
+  bake.add_flag("--dry-run", o.dryRun,
+                "print what would be baked (with --slurm: the batch script) and the entries that would fail, bake "
+                "nothing, and exit as the bake would");
+  cli::addFormatOption(bake, o.format);
   bake.add_option("--json", o.json, "also write the report as JSON to this file (- for stdout)");
   bake.add_flag("-q,--quiet", o.quiet, "no progress line, no report on stderr (errors still)");
 }
@@ -78,6 +86,44 @@ int failureExitCode(const std::vector<Entry>& entries, const Report& r) {
   for (const auto& f : j["failed"]) codes.insert(f["exitCode"].get<int>());
   if (codes.size() == 1 && *codes.begin() > 0 && *codes.begin() < 6) return *codes.begin();
   return cli::kExitRuntime;
+}
+
+// The kind of input an option may apply to (vff-bake's checks differ for glTF and OpenVDB files).
+std::string inputKind(const std::string& mesh) {
+  const std::string ext = fs::path(mesh).extension().string();
+  return ext == ".vdb" ? ".vdb" : (ext == ".gltf" || ext == ".glb") ? "glTF" : "mesh";
+}
+
+// A folder's options after --, checked once for each kind of input the folder has (the same options
+// for every entry: one usage error, not one per entry).
+std::optional<std::string> checkFolderArgs(const std::vector<Entry>& entries) {
+  std::set<std::string> kinds;
+  for (const Entry& e : entries)
+    if (kinds.insert(inputKind(e.mesh)).second)
+      if (auto p = checkBakeArgs(e))
+        return ruleLabel(kRuleBakeOption) + ": the options after --: " + *p + " (for " + e.name + ", a " +
+               inputKind(e.mesh) + " input)";
+  return std::nullopt;
+}
+
+// The dry run's listing as JSON: every entry with its state, and the bakes.
+nlohmann::json dryRunJson(const std::vector<Entry>& entries, const Report& r, const std::vector<Unit>& units,
+                          const std::vector<size_t>& todo) {
+  nlohmann::json j = {{"vffLibraryDryRun", 1}, {"entries", nlohmann::json::array()}, {"bakes", nlohmann::json::array()}};
+  std::vector<std::string> state(entries.size());
+  for (size_t i : r.upToDate) state[i] = "upToDate";
+  for (size_t i : todo) state[i] = "bake";
+  for (size_t i : r.failed) state[i] = "failed";
+  for (size_t i = 0; i < entries.size(); ++i) {
+    const Entry& e = entries[i];
+    nlohmann::json x = {{"mesh", e.name}, {"output", e.outputName}, {"args", e.args}, {"shardMaps", e.shardMaps},
+                        {"split", e.split}, {"state", state[i]}, {"key", e.key}, {"maps", e.maps}, {"rays", e.rays}};
+    if (!e.error.empty()) x["error"] = e.error, x["exitCode"] = e.exitCode;
+    j["entries"].push_back(x);
+  }
+  for (const Unit& u : units)
+    j["bakes"].push_back({{"entry", u.entry}, {"maps", u.part() ? nlohmann::json::array({u.begin, u.end}) : nlohmann::json("all")}});
+  return j;
 }
 
 int bakeLibrary(const Options& o) {
@@ -93,6 +139,10 @@ int bakeLibrary(const Options& o) {
       cli::printError(kProg, *p);
       return cli::kExitIo;
     }
+    if (auto p = checkFolderArgs(entries)) {
+      cli::usageError(kProg, *p);
+      return cli::kExitUsage;
+    }
   } else {
     if (!o.bakeArgs.empty()) {
       cli::usageError(kProg, "vff-bake options after -- apply to a folder; a manifest sets them in \"defaults\"");
@@ -104,13 +154,17 @@ int bakeLibrary(const Options& o) {
       return rc;
     }
   }
-  std::map<std::string, std::string> outputs;
+  std::map<std::string, std::string> outputs;  // (a manifest's entries are checked as it is read: rule 13014)
   for (const Entry& e : entries)
     if (auto [it, fresh] = outputs.emplace(e.output, e.name); !fresh) {
-      cli::printError(kProg, e.name + " and " + it->second + " would both be baked to " + e.output +
+      cli::usageError(kProg, e.name + " and " + it->second + " would both be baked to " + e.outputName +
                                  " (name outputs in a manifest)");
       return cli::kExitUsage;
     }
+  if (o.format == cli::OutputFormat::kJson && (!o.dryRun || o.slurm)) {
+    cli::usageError(kProg, "--format json lists a local --dry-run (a bake's report: --json FILE)");
+    return cli::kExitUsage;
+  }
 
   const unsigned cores = parallel::resolveThreads(0);
   WorkerOptions wo;
@@ -169,6 +223,7 @@ int bakeLibrary(const Options& o) {
     wo.threads = report.threadsPerWorker;
     if (o.dryRun) {
       for (const Unit& u : units) {
+        if (o.format == cli::OutputFormat::kJson) break;
         const Entry& e = entries[u.entry];
         std::printf("%s %s", wo.vffBake.c_str(), e.mesh.c_str());
         for (const auto& a : e.args) std::printf(" %s", a.c_str());
@@ -186,7 +241,17 @@ int bakeLibrary(const Options& o) {
                                                     .progress = progress});
     }
   }
-  if (o.dryRun) return cli::kExitSuccess;
+  if (o.dryRun) {
+    // What the bake would report before baking: the entries that fail, and its exit code then.
+    if (o.format == cli::OutputFormat::kJson) std::printf("%s\n", dryRunJson(entries, report, units, todo).dump(1).c_str());
+    for (size_t i : report.failed)
+      std::fprintf(stderr, "%s: error: %s: %s (exit %d)\n", kProg, entries[i].name.c_str(), entries[i].error.c_str(),
+                   entries[i].exitCode);
+    if (o.format != cli::OutputFormat::kJson)
+      std::printf("# %s: %zu to bake, %zu up to date, %zu failing\n", counted(entries.size(), "entry", "entries").c_str(),
+                  todo.size(), report.upToDate.size(), report.failed.size());
+    return report.failed.empty() ? cli::kExitSuccess : failureExitCode(entries, report);
+  }
   report.entryOutcomes = finishEntries(entries, todo, report.outcomes, wo);
   for (const EntryOutcome& out : report.entryOutcomes) (out.result.ok ? report.baked : report.failed).push_back(out.entry);
   std::sort(report.baked.begin(), report.baked.end());
@@ -206,6 +271,25 @@ int bakeLibrary(const Options& o) {
   return report.failed.empty() ? cli::kExitSuccess : failureExitCode(entries, report);
 }
 
+// `vff-library key MESH -- OPTIONS`: the key's text and the key, for finding why a run missed the cache.
+int printKey(const std::string& mesh, const std::vector<std::string>& args) {
+  if (std::find(args.begin(), args.end(), "--split") != args.end()) {
+    cli::usageError(kProg, "a split entry's key also names its output: see bake --dry-run --format json");
+    return cli::kExitUsage;
+  }
+  Entry e;
+  e.name = mesh;
+  e.mesh = fs::absolute(fs::path(mesh)).lexically_normal().string();
+  e.args = args;
+  const auto text = keyText(e, {.dir = "", .threads = 1, .statNotes = false});
+  if (!text) {
+    cli::printError(kProg, mesh + ": " + e.error);
+    return e.exitCode;
+  }
+  std::printf("%skey %s\n", text->c_str(), keyHash(*text).c_str());
+  return cli::kExitSuccess;
+}
+
 int run(int argc, char** argv) {
   Options o;
   CLI::App app{"Bakes an asset library (a manifest, or a folder and a glob) into visibility fields through a\n"
@@ -220,8 +304,14 @@ int run(int argc, char** argv) {
   CLI::App* shard = app.add_subcommand("run-shard", "bake one Slurm array task's share of a plan (the batch script runs it)");
   shard->add_option("plan", o.planPath, "the plan (STATE/round-N.plan.json)")->required();
   shard->add_option("task", o.task, "the array task (SLURM_ARRAY_TASK_ID)")->required();
+  CLI::App* key = app.add_subcommand("key", "print the cache key of a mesh baked with vff-bake's options: the key's "
+                                            "text (spec/library.md section 6), then \"key KEY\"");
+  std::string keyMesh;
+  key->add_option("mesh", keyMesh, "the input")->required();
+  key->add_option("bake-options", o.bakeArgs, "vff-bake's options, after -- (e.g. -- -m 32 --normals)");
   if (auto rc = cli::parse(app, kProg, argc, argv)) return *rc;
   if (shard->parsed()) return runShard(o.planPath, o.task);
+  if (key->parsed()) return printKey(keyMesh, o.bakeArgs);
   return bakeLibrary(o);
 }
 

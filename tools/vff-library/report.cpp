@@ -57,11 +57,11 @@ void printReport(const std::vector<Entry>& entries, const Report& r, std::FILE* 
   for (const auto& f : j["failed"])
     std::fprintf(to, "%s: error: %s: %s (exit %d)\n", kProg, f["mesh"].get<std::string>().c_str(),
                  f["error"].get<std::string>().c_str(), f["exitCode"].get<int>());
-  std::fprintf(to, "%s: %zu entries: %zu baked, %zu up to date, %zu failed; %.3g Mrays in %.2f s (%.1f Mrays/s, %s",
-               kProg, entries.size(), r.baked.size(), r.upToDate.size(), r.failed.size(),
+  std::fprintf(to, "%s: %s: %zu baked, %zu up to date, %zu failed; %.3g Mrays in %.2f s (%.1f Mrays/s, %s",
+               kProg, counted(entries.size(), "entry", "entries").c_str(), r.baked.size(), r.upToDate.size(), r.failed.size(),
                double(j["rays"].get<uint64_t>()) / 1e6, r.seconds, j["raysPerSecond"].get<double>() / 1e6,
                r.mode.c_str());
-  if (r.mode == "local") std::fprintf(to, ", %u x %u threads", r.workers, r.threadsPerWorker);
+  if (r.mode == "local") std::fprintf(to, ", %u x %s", r.workers, counted(r.threadsPerWorker, "thread", "threads").c_str());
   for (const auto& id : r.slurmJobs) std::fprintf(to, ", job %s", id.c_str());
   std::fprintf(to, ")\n");
 }

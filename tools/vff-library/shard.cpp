@@ -74,8 +74,8 @@ std::vector<EntryOutcome> finishEntries(const std::vector<Entry>& entries, const
     for (const Unit& u : parts) missing += !exists(partPath(wo.cacheDir, e.key, u.begin, u.end));
     if (missing) {
       if (o.result.error.empty()) {
-        o.result.error = std::to_string(missing) + " of its " + std::to_string(parts.size()) +
-                         " map ranges are not baked; the next run bakes them";
+        o.result.error = std::to_string(missing) + " of its " + counted(parts.size(), "map range", "map ranges") +
+                         (missing == 1 ? " is" : " are") + " not baked; the next run bakes " + (missing == 1 ? "it" : "them");
         o.result.exitCode = cli::kExitRuntime;
       }
       out.push_back(o);
@@ -85,7 +85,7 @@ std::vector<EntryOutcome> finishEntries(const std::vector<Entry>& entries, const
     o.result.seconds += merged.seconds;
     o.result.ok = merged.ok;
     if (!merged.ok) {
-      o.result.error = "merging its " + std::to_string(parts.size()) + " map ranges: " + merged.error;
+      o.result.error = "merging its " + counted(parts.size(), "map range", "map ranges") + ": " + merged.error;
       o.result.exitCode = merged.exitCode;
     } else if (auto problem = installOutput(wo.cacheDir, e)) {
       o.result.ok = false;

@@ -5,7 +5,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -48,10 +50,14 @@ nlohmann::json makePlan(const std::vector<Entry>& entries, const std::vector<Uni
                    [&](const Unit& a, const Unit& b) { return unitRays(entries, a) > unitRays(entries, b); });
   nlohmann::json plan = {{"vffLibraryPlan", 1}, {"vffBake", wo.vffBake}, {"cache", wo.cacheDir},
                          {"tasks", tasks}, {"entries", nlohmann::json::array()}};
+  // Largest first, each to the task with the least work so far (the lowest such task on a tie).
+  std::vector<uint64_t> load(tasks, 0);
   for (size_t i = 0; i < order.size(); ++i) {
     const Entry& e = entries[order[i].entry];
+    const unsigned task = unsigned(std::min_element(load.begin(), load.end()) - load.begin());
+    load[task] += std::max<uint64_t>(1, unitRays(entries, order[i]));
     plan["entries"].push_back({{"index", order[i].entry}, {"begin", order[i].begin}, {"end", order[i].end},
-                               {"task", i % tasks}, {"key", e.key}, {"mesh", e.mesh}, {"args", e.args},
+                               {"task", task}, {"key", e.key}, {"mesh", e.mesh}, {"args", e.args},
                                {"split", e.split}, {"output", e.output},
                                {"rays", unitRays(entries, order[i])}});
   }
@@ -76,7 +82,40 @@ bool jobActive(const std::string& jobId, const std::string& dir) {
   return !trim(readText(dir + "/squeue.out")).empty();
 }
 
+// A plan's entry as run-shard reads it: every member of its type, else why not.
+std::optional<std::string> planEntryProblem(const nlohmann::json& j) {
+  if (!j.is_object()) return "not an object";
+  for (const char* k : {"index", "begin", "end", "task", "rays"})
+    if (!j.contains(k) || !j[k].is_number_unsigned()) return std::string(k) + ": not an integer >= 0";
+  for (const char* k : {"key", "mesh", "split", "output"})
+    if (!j.contains(k) || !j[k].is_string()) return std::string(k) + ": not a string";
+  if (!j.contains("args") || !j["args"].is_array() ||
+      !std::all_of(j["args"].begin(), j["args"].end(), [](const nlohmann::json& a) { return a.is_string(); }))
+    return "args: not an array of strings";
+  if (j["key"].get<std::string>().size() != 32 || j["begin"].get<uint64_t>() > UINT32_MAX || j["end"].get<uint64_t>() > UINT32_MAX)
+    return "key or map range out of range";
+  return std::nullopt;
+}
+
+// The plan's problem (run-shard trusts nothing it reads), or nothing.
+std::optional<std::string> planProblem(const nlohmann::json& plan) {
+  if (!plan.is_object() || !plan.contains("vffLibraryPlan") || plan["vffLibraryPlan"] != 1) return "not a vff-library plan";
+  for (const char* k : {"vffBake", "cache"})
+    if (!plan.contains(k) || !plan[k].is_string()) return std::string(k) + ": not a string";
+  if (!plan.contains("entries") || !plan["entries"].is_array()) return "entries: not an array";
+  for (size_t i = 0; i < plan["entries"].size(); ++i)
+    if (auto p = planEntryProblem(plan["entries"][i])) return "entries[" + std::to_string(i) + "]." + *p;
+  return std::nullopt;
+}
+
 }  // namespace
+
+unsigned arrayTasks(uint64_t rays, size_t units, unsigned tasks, uint64_t raysPerTask) {
+  const uint64_t most = std::min<uint64_t>(1000, std::max<size_t>(1, units));
+  if (tasks) return unsigned(std::min<uint64_t>(tasks, most));
+  const uint64_t byWork = raysPerTask ? rays / raysPerTask + (rays % raysPerTask != 0) : most;
+  return unsigned(std::clamp<uint64_t>(byWork, 1, most));
+}
 
 std::optional<std::string> runSlurm(const std::vector<Entry>& entries, const std::vector<Unit>& todo,
                                     const WorkerOptions& wo, const SlurmOptions& so,
@@ -99,8 +138,9 @@ std::optional<std::string> runSlurm(const std::vector<Entry>& entries, const std
   auto unitId = [](const Unit& u) { return std::to_string(u.entry) + ":" + std::to_string(u.begin) + ":" + std::to_string(u.end); };
   cli::Progress progress(kProg, so.progress, 0, "entries");
   for (unsigned round = 0; !pending.empty(); ++round) {
-    const unsigned tasks = so.tasks ? std::min<unsigned>(so.tasks, unsigned(pending.size()))
-                                    : std::min<unsigned>(1000, unsigned(pending.size()));
+    uint64_t rays = 0;
+    for (const Unit& u : pending) rays += unitRays(entries, u);
+    const unsigned tasks = arrayTasks(rays, pending.size(), so.tasks, so.raysPerTask);
     const std::string stem = state + "/round-" + std::to_string(round);
     const std::string plan = stem + ".plan.json", script = stem + ".sh";
     const nlohmann::json planJson = makePlan(entries, pending, wo, tasks);
@@ -138,17 +178,20 @@ std::optional<std::string> runSlurm(const std::vector<Entry>& entries, const std
     std::map<std::string, EntryOutcome> reported;
     for (unsigned t = 0; t < tasks; ++t) {
       auto r = nlohmann::json::parse(readText(stem + ".report-" + std::to_string(t) + ".json"), nullptr, false);
-      if (r.is_discarded() || !r.contains("entries")) continue;
+      if (!r.is_object() || !r.contains("entries") || !r["entries"].is_array()) continue;
+      // A report is read without trusting its types: what it lacks is looked for in the cache.
       for (const auto& j : r["entries"]) {
+        if (!j.is_object()) continue;
         EntryOutcome o;
-        o.entry = j.value("index", size_t{0});
-        o.unit = {o.entry, j.value("begin", 0u), j.value("end", 0u)};
+        o.entry = size_t(jsonCount(j, "index"));
+        if (o.entry >= entries.size()) continue;
+        o.unit = {o.entry, uint32_t(jsonCount(j, "begin")), uint32_t(jsonCount(j, "end"))};
         o.where = "slurm " + jobId + "_" + std::to_string(t);
-        o.result.ok = j.value("ok", false);
-        o.result.exitCode = j.value("exitCode", 0);
-        o.result.error = j.value("error", std::string());
-        o.result.rays = j.value("rays", uint64_t{0});
-        o.result.seconds = j.value("seconds", 0.0);
+        o.result.ok = j.contains("ok") && j["ok"].is_boolean() && j["ok"].get<bool>();
+        o.result.exitCode = j.contains("exitCode") && j["exitCode"].is_number_integer() ? j["exitCode"].get<int>() : 0;
+        o.result.error = j.contains("error") && j["error"].is_string() ? j["error"].get<std::string>() : "";
+        o.result.rays = jsonCount(j, "rays");
+        if (j.contains("seconds") && j["seconds"].is_number()) o.result.seconds = j["seconds"].get<double>();
         reported[unitId(o.unit)] = o;
       }
     }
@@ -189,13 +232,13 @@ std::optional<std::string> runSlurm(const std::vector<Entry>& entries, const std
 
 int runShard(const std::string& planPath, unsigned task) {
   auto plan = nlohmann::json::parse(readText(planPath), nullptr, false);
-  if (plan.is_discarded() || plan.value("vffLibraryPlan", 0) != 1) {
-    cli::printError(kProg, planPath + ": not a vff-library plan");
+  if (auto p = planProblem(plan)) {
+    cli::printError(kProg, planPath + ": " + *p);
     return cli::kExitInvalidFile;
   }
   WorkerOptions wo;
-  wo.vffBake = plan.value("vffBake", std::string("vff-bake"));
-  wo.cacheDir = plan.value("cache", std::string());
+  wo.vffBake = plan["vffBake"].get<std::string>();
+  wo.cacheDir = plan["cache"].get<std::string>();
   const char* cpus = std::getenv("SLURM_CPUS_PER_TASK");
   wo.threads = cpus && std::atoi(cpus) > 0 ? unsigned(std::atoi(cpus)) : 1;
   removeStalePrivateDirs(wo.cacheDir);
@@ -209,14 +252,14 @@ int runShard(const std::string& planPath, unsigned task) {
                         {"entries", nlohmann::json::array()}};
   int rc = cli::kExitSuccess;
   for (const auto& j : plan["entries"]) {
-    if (j.value("task", 0u) != task) continue;
+    if (j["task"].get<uint64_t>() != task) continue;
     Entry e;
-    e.key = j.value("key", std::string());
-    e.mesh = j.value("mesh", std::string());
-    e.args = j.value("args", std::vector<std::string>{});
-    e.split = j.value("split", std::string());
-    e.output = j.value("output", std::string());
-    const Unit u{0, j.value("begin", 0u), j.value("end", 0u)};
+    e.key = j["key"].get<std::string>();
+    e.mesh = j["mesh"].get<std::string>();
+    e.args = j["args"].get<std::vector<std::string>>();
+    e.split = j["split"].get<std::string>();
+    e.output = j["output"].get<std::string>();
+    const Unit u{0, uint32_t(j["begin"].get<uint64_t>()), uint32_t(j["end"].get<uint64_t>())};
     BakeResult r;
     struct stat st{};
     if (u.part() ? ::stat(partPath(wo.cacheDir, e.key, u.begin, u.end).c_str(), &st) == 0 : inCache(wo.cacheDir, e)) {
@@ -225,7 +268,7 @@ int runShard(const std::string& planPath, unsigned task) {
       r = bakeUnit(e, u, wo);
     }
     if (!r.ok) rc = cli::kExitRuntime;
-    out["entries"].push_back({{"index", j.value("index", size_t{0})}, {"begin", u.begin}, {"end", u.end}, {"ok", r.ok}, {"exitCode", r.exitCode},
+    out["entries"].push_back({{"index", j["index"].get<uint64_t>()}, {"begin", u.begin}, {"end", u.end}, {"ok", r.ok}, {"exitCode", r.exitCode},
                               {"error", r.error}, {"rays", r.rays}, {"seconds", r.seconds}});
     // Written after each entry: a task killed later still reports what it did.
     if (auto p = writeText(report, out.dump(1))) cli::printError(kProg, report + ": " + *p);

@@ -96,9 +96,9 @@ BakeResult runVffBake(std::vector<std::string> args, const std::string& to, cons
   r.exitCode = rc;
   if (rc == 0) {
     auto summary = nlohmann::json::parse(readText(dir + "/stdout.json"), nullptr, false);
-    if (!summary.is_discarded()) r.rays = summary.value("rays", uint64_t{0});
-    if (!summary.is_discarded() && summary.contains("fields") && summary["fields"].is_array())  // a scene
-      for (const auto& f : summary["fields"]) r.rays += f.value("rays", uint64_t{0});
+    r.rays = jsonCount(summary, "rays");
+    if (summary.is_object() && summary.contains("fields") && summary["fields"].is_array())  // a scene
+      for (const auto& f : summary["fields"]) r.rays += jsonCount(f, "rays");
     std::error_code ec;
     fs::create_directories(fs::path(to).parent_path(), ec);
     struct stat st{};
@@ -116,6 +116,9 @@ BakeResult runVffBake(std::vector<std::string> args, const std::string& to, cons
     r.exitCode = cli::kExitRuntime;
   } else {
     r.error = lastErrorLine(readText(dir + "/stderr.txt"));
+    // The report names the entry: vff-bake's prefix and the path of its input (args[1]) are left out.
+    for (const std::string& prefix : {std::string("vff-bake: error: "), args.size() > 1 ? args[1] + ": " : std::string("\n")})
+      if (r.error.compare(0, prefix.size(), prefix) == 0) r.error.erase(0, prefix.size());
     if (rc > 128) r.error = "vff-bake killed by signal " + std::to_string(rc - 128) + (r.error.empty() ? "" : ": " + r.error);
     if (r.error.empty()) r.error = "vff-bake failed with exit code " + std::to_string(rc);
   }
