@@ -98,7 +98,7 @@ TEST(SceneDescription, WriterRefusesWhatTheReaderRefuses) {
   s.instances[0].field = 1;
   auto text = formatSceneDescription(s);
   ASSERT_FALSE(text);
-  EXPECT_EQ(text.error().code, Code::kSceneValue);
+  EXPECT_EQ(text.error().code, Code::kSceneFieldIndex);
   EXPECT_NE(text.error().message.find("instances[0].field"), std::string::npos) << text.error().message;
 }
 
@@ -113,18 +113,18 @@ TEST(SceneDescription, EveryRuleHasItsError) {
   const Bad bad[] = {
       {"not json", Code::kSceneJson, "bad.json:1:"},
       {"[1]", Code::kSceneJson, "not an object"},
-      {R"({"fields":[],"instances":[]})", Code::kSceneVersion, "asset"},
+      {R"({"fields":[],"instances":[]})", Code::kSceneValue, "bad.json: asset: a required member is missing"},
       {R"({"asset":{"format":"gltf","version":1},"fields":[],"instances":[]})", Code::kSceneVersion, "\"gltf\""},
       {R"({"asset":{"format":"vff-scene","version":2},"fields":[],"instances":[]})", Code::kSceneVersion,
-       "asset.version is 2"},
+       "asset.version: is 2"},
       {R"({"asset":{"format":"vff-scene","version":1},"instances":[]})", Code::kSceneValue, "fields"},
-      {R"({"asset":{"format":"vff-scene","version":1},"fields":[{"uri":""}],"instances":[]})", Code::kSceneValue,
+      {R"({"asset":{"format":"vff-scene","version":1},"fields":[{"uri":""}],"instances":[]})", Code::kSceneUri,
        "fields[0].uri"},
       {R"({"asset":{"format":"vff-scene","version":1},"fields":[{"uri":"https://x/a.vff"}],"instances":[]})",
-       Code::kSceneValue, "URI scheme"},
+       Code::kSceneUri, "URI scheme"},
       {R"({"asset":{"format":"vff-scene","version":1},"fields":[{"name":"x"}],"instances":[]})", Code::kSceneValue,
        "fields[0].uri"},
-      {nullptr, Code::kSceneValue, "instances[0].field"},  // {"field":1}
+      {nullptr, Code::kSceneFieldIndex, "instances[0].field"},  // {"field":1}
       {nullptr, Code::kSceneValue, "instances[0].rotation"},
       {nullptr, Code::kSceneValue, "instances[0].scale"},
       {nullptr, Code::kSceneValue, "instances[0].translation[2]"},
@@ -158,6 +158,8 @@ TEST(SceneDescription, FilesAndUris) {
   EXPECT_EQ(resolveSceneUri(path, "sub/b.vff"), (dir / "sub/b.vff").string());
   EXPECT_EQ(resolveSceneUri(path, "/abs/c.vff"), "/abs/c.vff");
   EXPECT_EQ(resolveSceneUri("s.json", "b.vff"), "b.vff");
+  EXPECT_EQ(resolveSceneUri("d/s.json", "a%20b%2Fc%25.vff"), "d/a b/c%.vff");
+  EXPECT_EQ(resolveSceneUri("d/s.json", "%2Fabs.vff"), "/abs.vff");
   auto missing = readSceneDescription((dir / "none.json").string());
   ASSERT_FALSE(missing);
   EXPECT_EQ(missing.error().code, Code::kIoOpen);
@@ -166,6 +168,41 @@ TEST(SceneDescription, FilesAndUris) {
   for (const auto& e : std::filesystem::directory_iterator(dir)) files += e.is_regular_file();
   EXPECT_EQ(files, 1u);
   std::filesystem::remove_all(dir);
+}
+
+// "Finite" and "> 0" hold of the binary32 values (spec/scene.md section 1, rule 4).
+TEST(SceneDescription, NumbersAreCheckedInBinary32) {
+  const std::string head = R"({"asset":{"format":"vff-scene","version":1},"fields":[{"uri":"a.vff"}],"instances":[)";
+  auto big = parseSceneDescription(head + R"({"field":0,"translation":[0,1e39,0]}]})", "b.json");
+  ASSERT_FALSE(big);
+  EXPECT_EQ(big.error().code, Code::kSceneValue);
+  EXPECT_EQ(big.error().message, "b.json: instances[0].translation[1]: the number 1e+39 is not finite in binary32");
+  auto tiny = parseSceneDescription(head + R"({"field":0,"scale":1e-50}]})", "b.json");
+  ASSERT_FALSE(tiny);
+  EXPECT_EQ(tiny.error().message, "b.json: instances[0].scale: must be positive in binary32, got 1e-50");
+  // FLT_MAX and the largest binary64 below the halfway point to 2^128 round to FLT_MAX: finite.
+  auto edge = parseSceneDescription(head + R"({"field":0,"translation":[3.4028235e38,3.4028235677973362e38,0]}]})", "b.json");
+  ASSERT_TRUE(edge) << edge.error().toString();
+  EXPECT_EQ(edge->instances[0].translation.y, 3.4028235e38f);
+  auto half = parseSceneDescription(head + R"({"field":0,"translation":[0,3.4028235677973366e38,0]}]})", "b.json");
+  ASSERT_FALSE(half);
+  EXPECT_EQ(half.error().code, Code::kSceneValue);
+}
+
+TEST(SceneDescription, MinorVersionIsANonNegativeInteger) {
+  const auto with = [](const std::string& minor) {
+    return parseSceneDescription(R"({"asset":{"format":"vff-scene","version":1,"minorVersion":)" + minor +
+                                     R"(},"fields":[],"instances":[]})", "m.json");
+  };
+  EXPECT_TRUE(with("0"));
+  EXPECT_TRUE(with("7"));
+  EXPECT_TRUE(with("2.0"));  // an integer by value, as JSON Schema counts them
+  for (const char* bad : {"-1", "\"1\"", "1.5", "null"}) {
+    auto r = with(bad);
+    ASSERT_FALSE(r) << bad;
+    EXPECT_EQ(r.error().code, Code::kSceneValue) << bad;
+    EXPECT_EQ(r.error().message, std::string("m.json: asset.minorVersion: expected a non-negative integer, got ") + bad);
+  }
 }
 
 // The JSON text rules (vff/strict_json.h, spec/scene.md section 1), one case each.

@@ -102,6 +102,8 @@ enum class Code : uint32_t {
   kSceneJson = 11001,          // not one JSON object
   kSceneVersion = 11002,       // not a vff-scene, or a version this reader does not implement
   kSceneValue = 11003,         // a member is missing or has a value the spec does not allow
+  kSceneUri = 11004,           // a field's uri is not a file reference the spec allows
+  kSceneFieldIndex = 11005,    // an instance's field index is not one of the fields
   // 9xxx: API usage and resources (not file problems)
   kInvalidArgument = 9001,     // a caller-supplied argument is invalid
   kOutOfRange = 9002,          // an index is out of range

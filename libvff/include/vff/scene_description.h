@@ -34,7 +34,7 @@ namespace vff {
 inline constexpr int kSceneDescriptionVersion = 1;
 
 struct SceneField {
-  std::string uri;         // the .vff file, relative to the description's folder or absolute
+  std::string uri;         // as written: a reference to the .vff file (resolveSceneUri decodes it)
   std::string name;        // may be empty
   std::string sourceJson;  // the `source` object as JSON text, or empty
 };
@@ -58,10 +58,15 @@ struct SceneDescription {
   std::string extrasJson;  // the top-level `extras` as JSON text, or empty
 };
 
-// Parses a description held in memory; `name` names it in messages. Every rule of spec/scene.md is
-// checked: kSceneJson (not one JSON object), kSceneVersion (not a vff-scene, or not version 1),
-// kSceneValue (a missing or wrong member; the message gives its JSON location, such as
-// "instances[3].rotation"). Rotations are normalised.
+// Parses a description held in memory; `name` names it in messages. Every rule of spec/scene.md
+// section 5 is checked, in the order of its table (the first error is the one that order finds):
+// kSceneJson (11001: not one JSON text by section 1's rules, "NAME:LINE:COLUMN: PATH: what"; or not an
+// object), kSceneVersion (11002: asset.format is not "vff-scene", or asset.version is not 1),
+// kSceneValue (11003: a member missing or of the wrong type, a number not finite in binary32, a
+// quaternion not of norm 1 within 1e-3, a scale not positive), kSceneUri (11004: a field's uri is not
+// a file reference), kSceneFieldIndex (11005: an instance's field is not an index into fields). Value
+// messages read "NAME: PATH: what", PATH the JSON location ("instances[3].rotation"). Numbers of
+// translation, rotation and scale are rounded to binary32 first; rotations are normalised.
 VFF_API Result<SceneDescription> parseSceneDescription(std::string_view json, const std::string& name);
 
 // Reads and parses a file (kIoOpen, kIoRead; then as above, messages naming the file).
@@ -77,8 +82,9 @@ VFF_API Result<std::string> formatSceneDescription(const SceneDescription& scene
 // either the whole new file or the old one (kIoOpen, kIoWrite).
 VFF_API Status writeSceneDescription(const std::string& path, const SceneDescription& scene);
 
-// The path of a field's `uri` for a description read from `descriptionPath`: absolute URIs as they
-// are, relative ones joined to the description's folder.
+// The path of a field's `uri` for a description read from `descriptionPath`: the uri's %XY escapes
+// decoded (spec/scene.md section 3), then an absolute path ('/' first) as it is, a relative one
+// joined to the description's folder. `uri` is one the reader accepted.
 VFF_API std::string resolveSceneUri(const std::string& descriptionPath, const std::string& uri);
 
 // A scene description with its fields open and its instances placed in a committed vff::Scene:

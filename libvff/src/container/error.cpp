@@ -76,6 +76,8 @@ const char* codeName(Code code) noexcept {
     case Code::kSceneJson: return "scene-json";
     case Code::kSceneVersion: return "scene-version";
     case Code::kSceneValue: return "scene-value";
+    case Code::kSceneUri: return "scene-uri";
+    case Code::kSceneFieldIndex: return "scene-field-index";
     case Code::kInvalidArgument: return "invalid-argument";
     case Code::kOutOfRange: return "out-of-range";
     case Code::kBadState: return "bad-state";

@@ -3,11 +3,11 @@
 
 #include <unistd.h>
 
-#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -18,17 +18,46 @@ namespace {
 
 using nlohmann::json;
 
-Error valueError(const std::string& name, const std::string& where, const std::string& what) {
-  return makeError(Code::kSceneValue, name + ": " + where + ": " + what);
+// The message forms of spec/scene.md section 5: "FILE: PATH: what".
+Error sceneError(Code code, const std::string& name, const std::string& where, const std::string& what) {
+  return makeError(code, name + ": " + where + ": " + what);
 }
 
-// A finite number that fits a float.
-Result<float> number(const json& v, const std::string& name, const std::string& where) {
-  if (!v.is_number()) return valueError(name, where, "expected a number, got " + v.dump());
+Error valueError(const std::string& name, const std::string& where, const std::string& what) {
+  return sceneError(Code::kSceneValue, name, where, what);
+}
+
+// A value as a message quotes it: its JSON text, cut short.
+std::string shown(const json& v) {
+  std::string s = v.dump();
+  if (s.size() > 40) s = s.substr(0, 37) + "...";
+  return s;
+}
+
+Error missing(const std::string& name, const std::string& where) {
+  return valueError(name, where, "a required member is missing");
+}
+
+// Integers are JSON numbers whose binary64 value is an integer (1, 1.0 and 1e0 alike, as JSON Schema).
+bool isInteger(const json& v) {
+  if (v.is_number_integer()) return true;
+  if (!v.is_number_float()) return false;
   const double d = v.get<double>();
-  const auto f = float(d);
-  if (!std::isfinite(d) || !std::isfinite(f)) return valueError(name, where, "the number is not finite as a float");
-  return f;
+  return std::isfinite(d) && std::trunc(d) == d;
+}
+
+// A number's binary32 value (round to nearest), or nothing where it rounds to infinity: magnitudes
+// from 2^128 - 2^103 (halfway between FLT_MAX and 2^128) up.
+std::optional<float> binary32(double d) {
+  if (!(std::fabs(d) < 0x1.ffffffp127)) return std::nullopt;
+  return float(d);
+}
+
+Result<float> number(const json& v, const std::string& name, const std::string& where) {
+  if (!v.is_number()) return valueError(name, where, "expected a number, got " + shown(v));
+  const auto f = binary32(v.get<double>());
+  if (!f) return valueError(name, where, "the number " + shown(v) + " is not finite in binary32");
+  return *f;
 }
 
 Status numbers(const json& obj, const char* key, size_t n, float* out, const std::string& name,
@@ -37,7 +66,7 @@ Status numbers(const json& obj, const char* key, size_t n, float* out, const std
   const json& a = obj[key];
   const std::string w = where + "." + key;
   if (!a.is_array() || a.size() != n)
-    return valueError(name, w, "expected an array of " + std::to_string(n) + " numbers, got " + a.dump());
+    return valueError(name, w, "expected an array of " + std::to_string(n) + " numbers, got " + shown(a));
   for (size_t i = 0; i < n; ++i) {
     auto f = number(a[i], name, w + "[" + std::to_string(i) + "]");
     if (!f) return std::move(f).error();
@@ -49,46 +78,112 @@ Status numbers(const json& obj, const char* key, size_t n, float* out, const std
 Result<std::string> optionalString(const json& obj, const char* key, const std::string& name,
                                    const std::string& where) {
   if (!obj.contains(key)) return std::string();
-  if (!obj[key].is_string()) return valueError(name, where + "." + key, "expected a string, got " + obj[key].dump());
+  if (!obj[key].is_string()) return valueError(name, where + "." + key, "expected a string, got " + shown(obj[key]));
   return obj[key].get<std::string>();
 }
 
-bool hasScheme(const std::string& uri) {
-  // RFC 3986 scheme: a letter, then letters, digits, '+', '-', '.', then ':'.
-  if (uri.empty() || !std::isalpha(static_cast<unsigned char>(uri[0]))) return false;
-  for (char c : uri) {
-    if (c == ':') return true;
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '+' && c != '-' && c != '.') return false;
+bool isAlpha(char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z'); }
+bool isDigit(char c) { return c >= '0' && c <= '9'; }
+int hexValue(char c) {
+  if (isDigit(c)) return c - '0';
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+  return -1;
+}
+
+// The length of the RFC 3986 scheme that `uri` starts with (ALPHA *( ALPHA / DIGIT / "+" / "-" /
+// "." ) ":"), without its colon; 0 where it has none.
+size_t schemeLength(const std::string& uri) {
+  if (uri.empty() || !isAlpha(uri[0])) return 0;
+  for (size_t i = 1; i < uri.size(); ++i) {
+    const char c = uri[i];
+    if (c == ':') return i;
+    if (!isAlpha(c) && !isDigit(c) && c != '+' && c != '-' && c != '.') return 0;
   }
-  return false;
+  return 0;
+}
+
+bool validUtf8(const std::string& s) {
+  size_t i = 0;
+  while (i < s.size()) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    size_t n = c < 0x80 ? 0 : (c >> 5) == 0x6 ? 1 : (c >> 4) == 0xE ? 2 : (c >> 3) == 0x1E ? 3 : 9;
+    if (n == 9 || i + n >= s.size()) return false;
+    uint32_t cp = n == 0 ? c : c & (0x3Fu >> n);
+    for (size_t k = 1; k <= n; ++k) {
+      const auto d = static_cast<unsigned char>(s[i + k]);
+      if ((d & 0xC0) != 0x80) return false;
+      cp = (cp << 6) | (d & 0x3F);
+    }
+    static const uint32_t kMin[] = {0, 0x80, 0x800, 0x10000};
+    if (cp < kMin[n] || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return false;
+    i += n + 1;
+  }
+  return true;
+}
+
+// `%XY` escapes decoded; a '%' without two hex digits after it is kept as it is (the reader refuses it).
+std::string percentDecoded(const std::string& uri) {
+  std::string out;
+  for (size_t i = 0; i < uri.size(); ++i) {
+    if (uri[i] == '%' && i + 2 < uri.size() && hexValue(uri[i + 1]) >= 0 && hexValue(uri[i + 2]) >= 0) {
+      out += char(hexValue(uri[i + 1]) * 16 + hexValue(uri[i + 2]));
+      i += 2;
+    } else {
+      out += uri[i];
+    }
+  }
+  return out;
+}
+
+// Rule scene-uri (11004), its checks in the order of spec/scene.md section 5.
+Status checkUri(const std::string& uri, const std::string& name, const std::string& where) {
+  auto bad = [&](const std::string& what) { return sceneError(Code::kSceneUri, name, where, what); };
+  if (uri.empty()) return bad("is empty");
+  if (const size_t n = schemeLength(uri))
+    return bad(n == 1 ? "'" + uri + "' starts with a Windows drive letter, which URI syntax reads as a scheme; "
+                            "use a reference relative to the description"
+                      : "'" + uri + "' has a URI scheme (" + uri.substr(0, n) + ":); a file reference is required");
+  if (uri.find('\\') != std::string::npos) return bad("'" + uri + "' has a backslash; the separator is '/'");
+  if (uri.rfind("//", 0) == 0) return bad("'" + uri + "' starts with '//', a network-path reference");
+  if (uri.find_first_of("?#") != std::string::npos)
+    return bad("'" + uri + "' has a query or fragment ('?' or '#'); write them as %3F and %23");
+  for (size_t i = 0; i < uri.size(); ++i)
+    if (uri[i] == '%' && (i + 2 >= uri.size() || hexValue(uri[i + 1]) < 0 || hexValue(uri[i + 2]) < 0))
+      return bad("'" + uri + "' has a '%' at byte " + std::to_string(i) + " without two hex digits after it");
+  const std::string path = percentDecoded(uri);
+  if (path.find('\0') != std::string::npos) return bad("'" + uri + "' decodes to a NUL byte");
+  if (!validUtf8(path)) return bad("'" + uri + "' decodes to bytes that are not UTF-8");
+  return {};
 }
 
 Result<SceneField> parseField(const json& f, const std::string& name, const std::string& where) {
-  if (!f.is_object()) return valueError(name, where, "expected an object");
+  if (!f.is_object()) return valueError(name, where, "expected an object, got " + shown(f));
   SceneField out;
-  if (!f.contains("uri") || !f["uri"].is_string()) return valueError(name, where + ".uri", "a string is required");
+  if (!f.contains("uri")) return missing(name, where + ".uri");
+  if (!f["uri"].is_string()) return valueError(name, where + ".uri", "expected a string, got " + shown(f["uri"]));
   out.uri = f["uri"].get<std::string>();
-  if (out.uri.empty()) return valueError(name, where + ".uri", "is empty");
-  if (hasScheme(out.uri)) return valueError(name, where + ".uri", "'" + out.uri + "' has a URI scheme; a file path is required");
+  if (Status s = checkUri(out.uri, name, where + ".uri"); !s) return std::move(s).error();
   auto n = optionalString(f, "name", name, where);
   if (!n) return std::move(n).error();
   out.name = std::move(*n);
   if (f.contains("source")) {
-    if (!f["source"].is_object()) return valueError(name, where + ".source", "expected an object");
+    if (!f["source"].is_object()) return valueError(name, where + ".source", "expected an object, got " + shown(f["source"]));
     out.sourceJson = f["source"].dump();
   }
   return out;
 }
 
 Result<SceneInstance> parseInstance(const json& i, size_t fieldCount, const std::string& name, const std::string& where) {
-  if (!i.is_object()) return valueError(name, where, "expected an object");
+  if (!i.is_object()) return valueError(name, where, "expected an object, got " + shown(i));
   SceneInstance out;
-  if (!i.contains("field") || !i["field"].is_number_integer())
-    return valueError(name, where + ".field", "an integer field index is required");
-  const auto field = i["field"].get<int64_t>();
-  if (field < 0 || uint64_t(field) >= fieldCount)
-    return valueError(name, where + ".field", "index " + std::to_string(field) + " is not one of the " +
-                                                  std::to_string(fieldCount) + " fields");
+  if (!i.contains("field")) return missing(name, where + ".field");
+  const json& fv = i["field"];
+  if (!isInteger(fv)) return valueError(name, where + ".field", "expected an integer, got " + shown(fv));
+  const double field = fv.get<double>();
+  if (field < 0 || field >= double(fieldCount))
+    return sceneError(Code::kSceneFieldIndex, name, where + ".field",
+                      "index " + shown(fv) + " is not one of the " + std::to_string(fieldCount) + " fields");
   out.field = uint32_t(field);
   auto n = optionalString(i, "name", name, where);
   if (!n) return std::move(n).error();
@@ -97,6 +192,7 @@ Result<SceneInstance> parseInstance(const json& i, size_t fieldCount, const std:
   if (Status s = numbers(i, "translation", 3, t, name, where); !s) return std::move(s).error();
   out.translation = {t[0], t[1], t[2]};
   if (Status s = numbers(i, "rotation", 4, out.rotation.data(), name, where); !s) return std::move(s).error();
+  // The norm in binary64 of the binary32 components, in this order (a reader elsewhere gets the same bits).
   const auto& q = out.rotation;
   const double norm = std::sqrt(double(q[0]) * q[0] + double(q[1]) * q[1] + double(q[2]) * q[2] + double(q[3]) * q[3]);
   if (!(std::fabs(norm - 1.0) <= 1e-3)) {
@@ -104,15 +200,34 @@ Result<SceneInstance> parseInstance(const json& i, size_t fieldCount, const std:
     std::snprintf(buf, sizeof buf, "the quaternion's norm is %.9g, not within 1e-3 of 1", norm);
     return valueError(name, where + ".rotation", buf);
   }
-  for (float& c : out.rotation) c = float(c / norm);
+  for (float& c : out.rotation) c = float(double(c) / norm);
   if (i.contains("scale")) {
     auto s = number(i["scale"], name, where + ".scale");
     if (!s) return std::move(s).error();
-    if (!(*s > 0)) return valueError(name, where + ".scale", "must be positive, got " + i["scale"].dump());
+    if (!(*s > 0)) return valueError(name, where + ".scale", "must be positive in binary32, got " + shown(i["scale"]));
     out.scale = *s;
   }
   if (i.contains("extras")) out.extrasJson = i["extras"].dump();
   return out;
+}
+
+Result<std::string> parseAsset(const json& doc, const std::string& name) {
+  if (!doc.contains("asset")) return missing(name, "asset");
+  const json& asset = doc["asset"];
+  if (!asset.is_object()) return valueError(name, "asset", "expected an object, got " + shown(asset));
+  if (!asset.contains("format")) return missing(name, "asset.format");
+  if (asset["format"] != "vff-scene")
+    return sceneError(Code::kSceneVersion, name, "asset.format", "is " + shown(asset["format"]) + ", not \"vff-scene\"");
+  if (!asset.contains("version")) return missing(name, "asset.version");
+  const json& v = asset["version"];
+  if (!isInteger(v) || v.get<double>() != kSceneDescriptionVersion)
+    return sceneError(Code::kSceneVersion, name, "asset.version", "is " + shown(v) + "; this reader implements version 1");
+  if (asset.contains("minorVersion")) {
+    const json& m = asset["minorVersion"];
+    if (!isInteger(m) || m.get<double>() < 0)
+      return valueError(name, "asset.minorVersion", "expected a non-negative integer, got " + shown(m));
+  }
+  return optionalString(asset, "generator", name, "asset");
 }
 
 // The shortest text that reads back as the same float.
@@ -169,24 +284,14 @@ Result<SceneDescription> parseSceneDescription(std::string_view text, const std:
   if (auto problem = detail::parseStrictJson(text, doc))
     return makeError(Code::kSceneJson, describeJsonProblem(*problem, name));
   if (!doc.is_object()) return makeError(Code::kSceneJson, name + ": the JSON value is not an object");
-  if (!doc.contains("asset") || !doc["asset"].is_object())
-    return makeError(Code::kSceneVersion, name + ": asset: an object with format \"vff-scene\" is required");
-  const json& asset = doc["asset"];
-  if (!asset.contains("format") || asset["format"] != "vff-scene")
-    return makeError(Code::kSceneVersion, name + ": asset.format is " +
-                                              (asset.contains("format") ? asset["format"].dump() : "missing") +
-                                              ", not \"vff-scene\"");
-  if (!asset.contains("version") || !asset["version"].is_number_integer() ||
-      asset["version"].get<int64_t>() != kSceneDescriptionVersion)
-    return makeError(Code::kSceneVersion, name + ": asset.version is " +
-                                              (asset.contains("version") ? asset["version"].dump() : "missing") +
-                                              "; this reader implements version 1");
   SceneDescription out;
-  auto gen = optionalString(asset, "generator", name, "asset");
+  auto gen = parseAsset(doc, name);
   if (!gen) return std::move(gen).error();
   out.generator = std::move(*gen);
-  for (const char* key : {"fields", "instances"})
-    if (!doc.contains(key) || !doc[key].is_array()) return valueError(name, key, "an array is required");
+  for (const char* key : {"fields", "instances"}) {
+    if (!doc.contains(key)) return missing(name, key);
+    if (!doc[key].is_array()) return valueError(name, key, "expected an array, got " + shown(doc[key]));
+  }
   for (size_t i = 0; i < doc["fields"].size(); ++i) {
     auto f = parseField(doc["fields"][i], name, "fields[" + std::to_string(i) + "]");
     if (!f) return std::move(f).error();
@@ -278,9 +383,10 @@ Status writeSceneDescription(const std::string& path, const SceneDescription& sc
 }
 
 std::string resolveSceneUri(const std::string& descriptionPath, const std::string& uri) {
-  if (!uri.empty() && uri[0] == '/') return uri;
+  const std::string path = percentDecoded(uri);
+  if (!path.empty() && path[0] == '/') return path;
   const size_t slash = descriptionPath.find_last_of('/');
-  return slash == std::string::npos ? uri : descriptionPath.substr(0, slash + 1) + uri;
+  return slash == std::string::npos ? path : descriptionPath.substr(0, slash + 1) + path;
 }
 
 }  // namespace vff
