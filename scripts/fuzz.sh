@@ -14,7 +14,7 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"
 runs="${1:-20000}"
-all=(open_validate decode scene query_input mesh)
+all=(open_validate decode scene query_input mesh manifest merge)
 read -r -a targets <<<"${VFF_FUZZ_TARGETS:-${all[*]}}"
 cmake --preset fuzz >/dev/null
 binaries=()
@@ -37,10 +37,13 @@ for t in "${targets[@]}"; do
     mesh) seeds=(tests/fuzz/seeds/mesh); dict=tests/fuzz/mesh.dict ;;
     scene) seeds=(tests/fuzz/seeds/scene); dict=tests/fuzz/scene.dict ;;
     query_input) seeds=(tests/fuzz/seeds/query_input); dict=tests/fuzz/query_input.dict ;;
+    manifest) seeds=(tests/fuzz/seeds/manifest); dict=tests/fuzz/manifest.dict ;;
+    merge) seeds=(tests/fuzz/seeds/merge); dict=tests/fuzz/vff.dict ;;
     *) echo "unknown fuzz target $t" >&2; exit 1 ;;
   esac
   # The spec's vectors of the readers, where they exist, seed them too.
   if [ "$t" = scene ] && [ -d spec/conformance/scene ]; then seeds+=(spec/conformance/scene); fi
+  if [ "$t" = manifest ] && [ -d spec/conformance/library ]; then seeds+=(spec/conformance/library); fi
   mkdir -p "$work/$t/corpus" "$work/$t/artifacts"
   limit=(-runs="$runs")
   if [ -n "${VFF_FUZZ_SECONDS:-}" ]; then limit=(-max_total_time="$VFF_FUZZ_SECONDS"); fi
