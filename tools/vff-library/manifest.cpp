@@ -11,8 +11,8 @@
 #include <sstream>
 
 #include "cli.h"
-#include "json_text.h"
 #include "library.h"
+#include "vff/strict_json.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -85,7 +85,7 @@ std::optional<std::string> unknownMember(const Checker& c, const json& o, const 
   for (const auto& [k, v] : o.items()) {
     if (std::none_of(known.begin(), known.end(), [&](const char* n) { return k == n; })) {
       std::string p = path;
-      appendPathKey(p, k);
+      appendJsonPathKey(p, k);
       return c.fail(kRuleUnknownMember, p, "not a member of " + what);
     }
   }
@@ -96,7 +96,7 @@ std::optional<std::string> unknownMember(const Checker& c, const json& o, const 
 std::optional<std::string> checkOptions(const Checker& c, const json& o, const std::string& path) {
   for (const auto& [k, v] : o.items()) {
     std::string p = path;
-    appendPathKey(p, k);
+    appendJsonPathKey(p, k);
     auto kind = bakeOptionKinds().find(k);
     if (kind == bakeOptionKinds().end())
       return c.fail(kRuleUnknownOption, p, "not a vff-bake option a library sets (spec/library.md section 4)");
@@ -228,11 +228,11 @@ std::optional<std::string> parseManifest(std::string_view text, const std::strin
                                          std::vector<Entry>* entries, int* rc) {
   const Checker c(path, rc);
   *rc = cli::kExitInvalidFile;
-  if (auto p = checkJsonText(text))
+  if (auto p = checkStrictJson(text))  // the JSON text rules (section 1), which scene descriptions share
     return path + ":" + std::to_string(p->line) + ":" + std::to_string(p->column) + ": " + ruleLabel(kRuleManifestJson) +
            ": " + (p->path.empty() ? "" : p->path + ": ") + p->message;
   const json m = json::parse(text, nullptr, false);
-  if (m.is_discarded()) return c.fail(kRuleManifestJson, "", "not JSON");  // checkJsonText takes no text json does not
+  if (m.is_discarded()) return c.fail(kRuleManifestJson, "", "not JSON");  // (checkStrictJson takes no text json does not)
   if (!m.is_object() || !m.contains("vffLibrary"))
     return c.fail(kRuleManifestObject, "", "not a vff library manifest (an object with \"vffLibrary\": 1)");
   std::string pattern = "{dir}{stem}.vff";
