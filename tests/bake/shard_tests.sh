@@ -130,6 +130,37 @@ test_partial_is_valid_and_says_so() {
   cmp "$WORK/w.vff" "$WORK/m.vff" || fail "a part of every map merges to other bytes"
 }
 
+# vff-inspect's report of a partial result: "partial" gives the range, and the statistics and the
+# histogram count the range's maps only, so the parts' counts add up to the whole bake's.
+test_inspect_counts_only_the_range() {
+  knot
+  bake "$WORK/knot.obj" -o "$WORK/w.vff" "${small[@]}"
+  bake "$WORK/knot.obj" -o "$WORK/a.vff" "${small[@]}" --map-range 0:30
+  bake "$WORK/knot.obj" -o "$WORK/b.vff" "${small[@]}" --map-range 30:82
+  expect_rc 0
+  local doc
+  doc=$("$VFF_INSPECT" "$WORK/a.vff" --format json) || fail "vff-inspect a.vff"
+  [[ $doc == *'"partial": {'*'"mapBegin": 0,'*'"mapCount": 82,'*'"mapEnd": 30,'*'"maps": 30'* ]] ||
+    fail "no partial range in the report: $doc"
+  # 30 maps of 16x16 texels, not 82
+  [[ $doc == *'"texels": 7680,'* ]] || fail "the statistics count more than the range's 30 maps"
+  "$VFF_INSPECT" "$WORK/w.vff" --format json | grep -q '"partial": null' || fail "a whole field reports partial"
+  # hits and misses, and each histogram bin, of the two parts add up to the whole's
+  local counts
+  counts() { "$VFF_INSPECT" "$1" --format json | grep -oE '"(hits|misses|count)": [0-9]+' | grep -oE '[0-9]+$'; }
+  local sum
+  sum=$(paste -d+ <(counts "$WORK/a.vff") <(counts "$WORK/b.vff") | bc | tr '\n' ' ')
+  [[ $sum == "$(counts "$WORK/w.vff" | tr '\n' ' ')" ]] || fail "parts' counts $sum are not the whole's"
+  run "$VFF_INSPECT" "$WORK/b.vff"
+  expect_out "(maps 30:82 only: the others are fillers, not the field's)"
+  # a "vff.partial" without a usable range is still partial; the statistics then count every map
+  "$EDIT" "$WORK/b.vff" "$WORK/norange.vff" /vff.partial/mapEnd 90 || fail "edit"
+  run "$VFF_INSPECT" "$WORK/norange.vff" --format json
+  expect_rc 0
+  expect_out '"mapBegin": null'
+  expect_out '"texels": 20992,'
+}
+
 # ---- Usage errors ------------------------------------------------------------------------------------
 test_bad_ranges_are_usage_errors() {
   knot

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,10 +30,26 @@ struct DistanceStats {
   uint32_t unreadableBlocks = 0;  // blocks skipped because they failed to decode (skipBadBlocks)
 };
 
-// Reads every block of the distance plane once (zero-copy for stored blocks, one reusable buffer
-// for compressed ones). `bins` >= 1. With skipBadBlocks, a block that cannot be read is counted in
-// unreadableBlocks instead of failing the call (used with --validate, which reports the problem).
-Result<DistanceStats> distanceStats(const File& file, uint32_t bins, bool skipBadBlocks);
+// The maps a report counts, [begin, end): all of them, or a partial result's range.
+struct MapSpan {
+  uint32_t begin = 0;
+  uint32_t end = UINT32_MAX;
+};
+
+// Reads every block of the distance plane that holds a map of `maps` once (zero-copy for stored
+// blocks, one reusable buffer for compressed ones) and counts those maps only. `bins` >= 1. With
+// skipBadBlocks, a block that cannot be read is counted in unreadableBlocks instead of failing the
+// call (used with --validate, which reports the problem).
+Result<DistanceStats> distanceStats(const File& file, uint32_t bins, bool skipBadBlocks, MapSpan maps = {});
+
+// A partial result (spec/partial.md: META has "vff.partial"): its range when "vff.partial" is an
+// object whose mapBegin, mapEnd and mapCount are integers with mapBegin < mapEnd <= mapCount = FDSC
+// mapCount, else a span of the whole field with `known` false. Nothing for a file that is not one.
+struct PartialInfo {
+  MapSpan range;
+  bool known = false;
+};
+std::optional<PartialInfo> partialInfo(const File& file);
 
 // ---- The report ---------------------------------------------------------------------------------
 enum class ChecksumStatus { kVerified, kFailed, kNotVerified };
@@ -46,10 +63,11 @@ struct ChecksumState {
 ChecksumState checksumsVerifiedAtOpen(const File& file);
 ChecksumState checksumsFromReport(const File& file, const Report& report);
 
-// The summary of an opened file: "format", "sections", "field", "planes", "layout",
-// "statistics", "histogram", "metadata" (see spec/inspect-schema.json).
+// The summary of an opened file: "format", "sections", "field", "planes", "layout", "partial",
+// "statistics", "histogram", "metadata" (see spec/inspect-schema.json). `partial`: partialInfo(file),
+// whose range `stats` counted.
 nlohmann::json summarize(const File& file, const ChecksumState& checksums, const DistanceStats& stats,
-                         uint32_t histogramBins);
+                         uint32_t histogramBins, const std::optional<PartialInfo>& partial);
 
 // {"valid": bool, "errors": n, "warnings": n, "issues": [...]} for a validation report.
 nlohmann::json validationJson(const Report& report);

@@ -51,7 +51,9 @@ int run(int argc, char** argv);
 
 }  // namespace
 
-int main(int argc, char** argv) { return cli::runGuarded(kProg, run, argc, argv); }
+int main(int argc, char** argv) {
+  return cli::runGuarded(kProg, run, argc, argv);
+}
 
 namespace {
 
@@ -147,9 +149,11 @@ int run(int argc, char** argv) {
         return cli::kExitUsage;
       }
     }
-    auto stats = inspect::distanceStats(*file, o.histogramBins, /*skipBadBlocks=*/o.validate);
+    const auto partial = inspect::partialInfo(*file);
+    auto stats = inspect::distanceStats(*file, o.histogramBins, /*skipBadBlocks=*/o.validate,
+                                        partial ? partial->range : inspect::MapSpan{});
     if (!stats) return cli::reportError(kProg, label, stats.error());
-    doc.update(inspect::summarize(*file, checksums, *stats, o.histogramBins));
+    doc.update(inspect::summarize(*file, checksums, *stats, o.histogramBins, partial));
 
     if (!o.preview.empty()) {
       auto g = inspect::writePreview(*file, o.preview, o.previewMaps);

@@ -1,4 +1,5 @@
-// statistics.cpp - hit ratio and distance histogram over every map of the distance plane.
+// statistics.cpp - hit ratio and distance histogram over the maps of the distance plane (all of
+// them, or a partial result's range: its other maps are fillers, not the field's).
 //
 // Speed: the plane is read block by block (zero-copy views for stored blocks; compressed blocks are
 // decoded into one reusable buffer, so a large zstd file does not fill the reader's cache). For the
@@ -16,6 +17,7 @@
 #include "vff/bc4.h"
 #include "vff/direction.h"
 #include "vff/encoding.h"
+#include "vff/format.h"
 
 namespace vff::inspect {
 
@@ -30,7 +32,7 @@ uint32_t binOf(double distance, double diameter, uint32_t bins) {
 
 }  // namespace
 
-Result<DistanceStats> distanceStats(const File& file, uint32_t bins, bool skipBadBlocks) {
+Result<DistanceStats> distanceStats(const File& file, uint32_t bins, bool skipBadBlocks, MapSpan maps) {
   const FieldDesc& field = file.field();
   const PlaneInfo& plane = file.plane(Plane::kDistance);
   const DistanceEncoding enc = field.distanceEncoding;
@@ -61,6 +63,11 @@ Result<DistanceStats> distanceStats(const File& file, uint32_t bins, bool skipBa
   uint64_t scratchSize = 0;
   for (uint32_t b = 0; b < plane.blocks.size(); ++b) {
     const BlockInfo& blk = plane.blocks[b];
+    // The block's maps within `maps`; a block with none is not read.
+    const uint32_t first = std::max(blk.firstMap, maps.begin);
+    const uint32_t last = uint32_t(std::min<uint64_t>(uint64_t{blk.firstMap} + blk.mapCount, maps.end));
+    if (first >= last) continue;
+    const uint32_t mapsHere = last - first;
     std::span<const uint8_t> data;
     if (blk.codec == Codec::kStored) {
       auto view = file.blockData(Plane::kDistance, b);
@@ -84,7 +91,10 @@ Result<DistanceStats> distanceStats(const File& file, uint32_t bins, bool skipBa
       }
       data = std::span<const uint8_t>(scratch.get(), blk.rawSize);
     }
-    const uint64_t blockTexels = texelsPerMap * blk.mapCount;
+    const uint64_t mapBytes = distanceMapBytes(enc, m);
+    if (data.size() >= uint64_t{blk.mapCount} * mapBytes)
+      data = data.subspan(uint64_t{first - blk.firstMap} * mapBytes, uint64_t{mapsHere} * mapBytes);
+    const uint64_t blockTexels = texelsPerMap * mapsHere;
     st.texels += blockTexels;
 
     switch (enc) {
@@ -132,8 +142,7 @@ Result<DistanceStats> distanceStats(const File& file, uint32_t bins, bool skipBa
           st.hits += hits;
           st.misses += blockTexels - hits;
         } else {
-          const uint64_t mapBytes = distanceMapBytes(enc, m);
-          for (uint32_t k = 0; k < blk.mapCount; ++k) {
+          for (uint32_t k = 0; k < mapsHere; ++k) {
             const auto map = data.subspan(k * mapBytes, mapBytes);
             for (uint32_t j = 0; j < m; ++j)
               for (uint32_t i = 0; i < m; ++i) {
@@ -163,6 +172,21 @@ Result<DistanceStats> distanceStats(const File& file, uint32_t bins, bool skipBa
     st.bins[binOf(t.distance, diameter, bins)] += n;
   }
   return st;
+}
+
+std::optional<PartialInfo> partialInfo(const File& file) {
+  const std::string_view text = file.metadata();
+  const nlohmann::json meta = nlohmann::json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/false);
+  if (!meta.is_object() || !meta.contains("vff.partial")) return std::nullopt;
+  PartialInfo info;
+  const nlohmann::json& p = meta["vff.partial"];
+  auto u32 = [&](const char* k) {
+    return p.contains(k) && p[k].is_number_unsigned() && p[k].get<uint64_t>() <= UINT32_MAX;
+  };
+  if (!p.is_object() || !u32("mapBegin") || !u32("mapEnd") || !u32("mapCount")) return info;
+  const uint32_t begin = p["mapBegin"], end = p["mapEnd"], count = p["mapCount"];
+  if (begin < end && end <= count && count == file.field().mapCount) info = PartialInfo{{begin, end}, true};
+  return info;
 }
 
 }  // namespace vff::inspect

@@ -83,7 +83,9 @@ json planeJson(const File& file, Plane p) {
   j["filters"] = filters;
   json blocks = json::array();
   for (const BlockInfo& b : pi.blocks)
-    blocks.push_back({{"storedBytes", b.storedSize}, {"rawBytes", b.rawSize}, {"codec", codecName(b.codec)},
+    blocks.push_back({{"storedBytes", b.storedSize},
+                      {"rawBytes", b.rawSize},
+                      {"codec", codecName(b.codec)},
                       {"filter", filterName(b.filter)}});
   j["blocks"] = std::move(blocks);
   j["sliceBytes"] = file.sliceBytes(p);
@@ -112,7 +114,8 @@ ChecksumState checksumsFromReport(const File& file, const Report& report) {
   return s;
 }
 
-json summarize(const File& file, const ChecksumState& checksums, const DistanceStats& stats, uint32_t histogramBins) {
+json summarize(const File& file, const ChecksumState& checksums, const DistanceStats& stats, uint32_t histogramBins,
+               const std::optional<PartialInfo>& partial) {
   const FileInfo& info = file.info();
   const FieldDesc& field = file.field();
   const LayoutDesc& layout = file.layout();
@@ -180,6 +183,19 @@ json summarize(const File& file, const ChecksumState& checksums, const DistanceS
       {"maxTextureSize", layout.maxTextureSize},
       {"maxLayers", layout.maxLayers},
   };
+
+  // A partial result (spec/partial.md): its range, whose maps alone the statistics count (the others
+  // are fillers of misses, not the field's); null bounds when "vff.partial" gives no usable range.
+  if (!partial) {
+    doc["partial"] = nullptr;
+  } else if (partial->known) {
+    doc["partial"] = {{"mapBegin", partial->range.begin},
+                      {"mapEnd", partial->range.end},
+                      {"mapCount", field.mapCount},
+                      {"maps", partial->range.end - partial->range.begin}};
+  } else {
+    doc["partial"] = {{"mapBegin", nullptr}, {"mapEnd", nullptr}, {"mapCount", field.mapCount}, {"maps", nullptr}};
+  }
 
   doc["statistics"] = {
       {"texels", stats.texels},

@@ -125,13 +125,15 @@ void printSummary(const json& doc, std::FILE* out) {
                u64(f["missCode"]));
   std::fprintf(out, "  normals:    %s\n", str(f["normalEncoding"]).c_str());
   // A partial result of vff-bake --map-range (spec/partial.md): say so beside the field it is part of.
-  if (const json& m = doc["metadata"]; m.is_object() && m.contains("vff.partial") && m["vff.partial"].is_object()) {
-    const json& p = m["vff.partial"];
-    auto has = [&](const char* k) { return p.contains(k) && p[k].is_number_unsigned(); };
-    if (has("mapBegin") && has("mapEnd") && has("mapCount"))
-      std::fprintf(out, "  partial:    maps %" PRIu64 ":%" PRIu64 " of %" PRIu64
+  if (doc.contains("partial") && doc["partial"].is_object()) {
+    const json& p = doc["partial"];
+    if (p["mapBegin"].is_number_unsigned())
+      std::fprintf(out,
+                   "  partial:    maps %" PRIu64 ":%" PRIu64 " of %" PRIu64
                    " only (vff-bake --map-range); the others hold misses until vff-bake --merge\n",
                    u64(p["mapBegin"]), u64(p["mapEnd"]), u64(p["mapCount"]));
+    else
+      std::fprintf(out, "  partial:    a partial result whose \"vff.partial\" gives no usable map range\n");
   }
 
   std::fprintf(out, "\npayload:\n");
@@ -155,6 +157,9 @@ void printSummary(const json& doc, std::FILE* out) {
   std::fprintf(out, "\nhits:        %" PRIu64 " of %" PRIu64 " texels, hit ratio %s (%s %%)\n", u64(st["hits"]),
                u64(st["texels"]), num(st["hitRatio"].get<double>(), 6).c_str(),
                num(100 * st["hitRatio"].get<double>(), 3).c_str());
+  if (doc.contains("partial") && doc["partial"].is_object() && doc["partial"]["mapBegin"].is_number_unsigned())
+    std::fprintf(out, "             (maps %" PRIu64 ":%" PRIu64 " only: the others are fillers, not the field's)\n",
+                 u64(doc["partial"]["mapBegin"]), u64(doc["partial"]["mapEnd"]));
   if (u64(st["unreadableBlocks"]) != 0)
     std::fprintf(out, "             (%" PRIu64 " unreadable blocks left out)\n", u64(st["unreadableBlocks"]));
 
