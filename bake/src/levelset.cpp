@@ -10,6 +10,8 @@
 // per task), so the output does not depend on the thread count either.
 #include "vff/bake/levelset.h"
 
+#include <sys/stat.h>
+
 #include <openvdb/io/File.h>
 #include <openvdb/math/Ray.h>
 #include <openvdb/openvdb.h>
@@ -28,6 +30,7 @@
 #include <memory>
 #include <vector>
 
+#include "mesh_importers.h"
 #include "platform/parallel.h"
 #include "vff/bake/exception_text.h"
 #include "vff/bake/sphere.h"
@@ -75,7 +78,7 @@ std::string gridList(const openvdb::GridPtrVec& grids) {
 
 Result<uint64_t> hashFile(const std::string& path) {
   std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return makeError(Code::kIoOpen, "cannot open " + path + ": " + std::strerror(errno));
+  if (!f) return makeError(Code::kIoOpen, path + ": " + std::strerror(errno));
   XXH3_state_t* s = XXH3_createState();
   XXH3_64bits_reset(s);
   std::vector<unsigned char> buf(1 << 20);
@@ -85,7 +88,7 @@ Result<uint64_t> hashFile(const std::string& path) {
   std::fclose(f);
   const uint64_t h = XXH3_64bits_digest(s);
   XXH3_freeState(s);
-  if (failed) return makeError(Code::kIoRead, "cannot read " + path);
+  if (failed) return makeError(Code::kIoRead, path + ": cannot be read");
   return h;
 }
 
@@ -112,7 +115,10 @@ bool looksLikeVdb(const std::string& path) {
 }
 
 Result<LevelSet> LevelSet::load(const std::string& path, const LevelSetLoadOptions& options) {
-  // Open errors and the magic number first, so that OpenVDB only ever sees .vdb files.
+  // Open errors (a FIFO or folder too: not a regular file) and the magic number first, so that
+  // OpenVDB only ever sees .vdb files.
+  struct stat st {};
+  if (Status s = detail::checkReadable(path, &st); !s) return std::move(s).error();
   auto hash = hashFile(path);
   if (!hash) return std::move(hash).error();
   if (!looksLikeVdb(path))

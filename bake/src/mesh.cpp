@@ -1,6 +1,8 @@
 #include "vff/bake/mesh.h"
 
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 #include <xxhash.h>
 
 #include <algorithm>
@@ -8,7 +10,6 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 
 #include "mesh_importers.h"
 
@@ -100,9 +101,15 @@ uint64_t geometryHash(const Mesh& m) {
 
 namespace detail {
 Status checkReadable(const std::string& path, struct stat* st) {
-  if (stat(path.c_str(), st) != 0) return makeError(Code::kIoOpen, path + ": " + std::strerror(errno));
+  // Opened (without blocking: a FIFO's open waits for a writer) and then looked at, so that what is
+  // checked is what was opened; the importers open it again by name.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) return makeError(Code::kIoOpen, path + ": " + std::strerror(errno));
+  const bool statted = ::fstat(fd, st) == 0;
+  const int err = errno;
+  ::close(fd);
+  if (!statted) return makeError(Code::kIoOpen, path + ": " + std::strerror(err));
   if (!S_ISREG(st->st_mode)) return makeError(Code::kIoOpen, path + ": not a regular file");
-  if (!std::ifstream(path, std::ios::binary)) return makeError(Code::kIoOpen, path + ": cannot be read");
   return {};
 }
 }  // namespace detail

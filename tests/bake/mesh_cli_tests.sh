@@ -44,12 +44,12 @@ test_ply_tristrips_longer_than_the_file_is_refused() {
   } >"$WORK/long.ply"
   bake "$WORK/long.ply" -o "$WORK/x.vff"
   expect_rc 3
-  expect_err "long.ply: element 1 row 0: the file ends inside the body"
+  expect_err "long.ply: mesh-parse (10002): element 1 row 0: the file ends inside the body"
   [[ ! -e $WORK/x.vff ]] || fail "output left behind"
   printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement tristrips 1\nproperty list int int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n4000000000 0 1 2\n' >"$WORK/long_ascii.ply"
   bake "$WORK/long_ascii.ply" -o "$WORK/x.vff"
   expect_rc 3
-  expect_err "long_ascii.ply: element 1 row 0: missing or malformed value"
+  expect_err "long_ascii.ply: mesh-parse (10002): element 1 row 0: missing or malformed value"
   [[ ! -e $WORK/x.vff ]] || fail "output left behind"
 }
 

@@ -114,7 +114,7 @@ test_inspect_shows_codec_filter_and_blocks() {
   compress "$WORK/a.vff" "$WORK/z.vff" --blocks
   expect_rc 0
   expect_out "block 0:"
-  expect_out_re "distance .* ratio [0-9.]+; [0-9]+ blocks \(zstd [0-9]+, hits-med [1-9]"
+  expect_out_re "distance .* ratio [0-9.]+; [0-9]+ blocks? \(zstd [0-9]+, hits-med [1-9]"
   run "$VFF_INSPECT" "$WORK/z.vff"
   expect_rc 0
   expect_out "vff 1.1"

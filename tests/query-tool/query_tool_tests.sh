@@ -392,10 +392,10 @@ test_errors_and_exit_codes() {
   mkdir -p "$WORK/folder.vff"
   query "$WORK/folder.vff" --ray 0 0 5 0 0 -1
   expect_rc 2
-  expect_err "$WORK/folder.vff: not a regular file"
+  expect_err "vff-query: error: $WORK/folder.vff: io-open (1001): not a regular file"
   query "$VECTORS/bit1-stored.vff" -i "$WORK/folder.vff"
   expect_rc 2
-  expect_err "cannot read $WORK/folder.vff"
+  expect_err "vff-query: error: $WORK/folder.vff: io-read (1002): Is a directory"
   # An empty field file is not a field (nothing is read past its end).
   : >"$WORK/empty.vff"
   query "$WORK/empty.vff" --ray 0 0 5 0 0 -1

@@ -61,7 +61,14 @@ std::string formatDiagnostic(std::string_view prog, std::string_view severity, s
   std::string s = std::string(prog) + ": " + std::string(severity) + ": ";
   if (!place.empty()) s += place + ": ";
   s += codeName(error.code);
-  s += " (" + std::to_string(static_cast<uint32_t>(error.code)) + "): " + error.message;
+  // libvff and the baker name the file in their messages ("P: not a regular file"), for callers
+  // that print only the message; the diagnostic names it once, in its place.
+  std::string_view message = error.message;
+  if (!file.empty() && message.size() > file.size() + 2 && message.starts_with(file) &&
+      message.substr(file.size(), 2) == ": ")
+    message.remove_prefix(file.size() + 2);
+  s += " (" + std::to_string(static_cast<uint32_t>(error.code)) + "): ";
+  s += message;
   return s;
 }
 
@@ -174,6 +181,13 @@ std::string formatBytes(uint64_t bytes) {
   return buf;
 }
 
+std::string count(uint64_t n, std::string_view noun, std::string_view plural) {
+  std::string s = std::to_string(n) + " ";
+  if (n == 1) return s += noun;
+  if (!plural.empty()) return s += plural;
+  return (s += noun) += "s";
+}
+
 std::string hex(uint64_t value) {
   char buf[24];
   (void)std::snprintf(buf, sizeof buf, "0x%" PRIx64, value);
@@ -188,6 +202,19 @@ std::string hexDigits64(uint64_t value) {
 
 std::string hex64(uint64_t value) {
   return "0x" + hexDigits64(value);
+}
+
+Status checkRegularFile(const std::string& path) {
+  // O_NONBLOCK: the open of a FIFO for reading would otherwise wait for a writer.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) return makeError(Code::kIoOpen, path + ": " + std::strerror(errno));
+  struct stat st {};
+  const bool statted = ::fstat(fd, &st) == 0;
+  const int err = errno;
+  ::close(fd);
+  if (!statted) return makeError(Code::kIoOpen, path + ": " + std::strerror(err));
+  if (S_ISREG(st.st_mode)) return {};
+  return makeError(Code::kIoOpen, path + ": not a regular file");  // (libvff's words for the same refusal)
 }
 
 Result<std::vector<uint8_t>> readStdin() {

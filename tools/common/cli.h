@@ -112,6 +112,9 @@ void checkStdoutAtExit(std::string_view prog);
 // ---- Formatting ---------------------------------------------------------------------------------
 // "17309696 bytes (16.508 MiB)": the exact count and MiB (2^20 bytes) with three decimals.
 std::string formatBytes(uint64_t bytes);
+// "1 field", "3 fields": a count and its noun, plural unless the count is 1 (`plural` where the
+// noun does not take an -s: count(2, "mesh", "meshes")).
+std::string count(uint64_t n, std::string_view noun, std::string_view plural = {});
 // "0x1f40"
 std::string hex(uint64_t value);
 // "0x0123456789abcdef" (always 16 digits, for checksums)
@@ -120,6 +123,12 @@ std::string hex64(uint64_t value);
 std::string hexDigits64(uint64_t value);
 
 // ---- Files --------------------------------------------------------------------------------------
+// Refuses, before anything reads it, an input path that is not a regular file: kIoOpen (exit 2),
+// "PATH: not a regular file" for a FIFO, a folder, a device or a socket; or the
+// reason it cannot be opened. A FIFO would block a reader until a writer came, and a field must be
+// mapped or read to a known size. (Standard input, "-", is read as a stream and not checked here.)
+Status checkRegularFile(const std::string& path);
+
 // The whole of standard input (for a FILE argument of "-"). Fails with kIoRead.
 Result<std::vector<uint8_t>> readStdin();
 

@@ -49,9 +49,10 @@ void reportLevelSetBake(const Options& o, const bake::BakeOptions& bo, const bak
     std::printf("%s\n", summary.dump(2).c_str());
   } else if (!o.quiet) {
     std::fprintf(stderr,
-                 "%s: %s: grid \"%s\" (%" PRIu64 " active voxels of %g): %u maps of %ux%u (%.0f rays, %.1f%% hits) "
+                 "%s: %s: grid \"%s\" (%s of %g): %s of %ux%u (%.0f rays, %.1f%% hits) "
                  "in %.2f s (%.1f Mrays/s), %.3f MiB payload -> %s\n",
-                 kProg, o.mesh.c_str(), info.grid.c_str(), info.activeVoxels, info.voxelSize, field.mapCount,
+                 kProg, o.mesh.c_str(), info.grid.c_str(), cli::count(info.activeVoxels, "active voxel").c_str(),
+                 info.voxelSize, cli::count(field.mapCount, "map").c_str(),
                  field.mapResolution, field.mapResolution, rays, 100.0 * double(s.hits) / rays, s.seconds,
                  rays / s.seconds / 1e6, double(payload) / 1048576.0, o.output.c_str());
   }

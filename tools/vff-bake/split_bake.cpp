@@ -314,10 +314,10 @@ int bakeGltfSplit(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
                   {"triangles", obj.geometry.triangleCount()}, {"fileBytes", fileBytes}});
     report.push_back(entry);
     if (!o.quiet && !o.json)
-      std::fprintf(stderr, "%s: %s: object %zu/%zu (mesh %d%s, %zu triangles, %zu instance%s) -> %s\n", kProg,
-                   o.mesh.c_str(), i + 1, objects->size(), obj.mesh,
-                   obj.name.empty() ? "" : (" '" + obj.name + "'").c_str(), obj.geometry.triangleCount(),
-                   obj.placements.size(), obj.placements.size() == 1 ? "" : "s", out.c_str());
+      std::fprintf(stderr, "%s: %s: object %zu/%zu (mesh %d%s, %s, %s) -> %s\n", kProg, o.mesh.c_str(), i + 1,
+                   objects->size(), obj.mesh, obj.name.empty() ? "" : (" '" + obj.name + "'").c_str(),
+                   cli::count(obj.geometry.triangleCount(), "triangle").c_str(),
+                   cli::count(obj.placements.size(), "instance").c_str(), out.c_str());
   }
 
   // The description, to its temporary too; then the whole set goes into place.
@@ -339,8 +339,9 @@ int bakeGltfSplit(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
                               {"seconds", secondsSince(t0)}};
     std::printf("%s\n", summary.dump(2).c_str());
   } else if (!o.quiet) {
-    std::fprintf(stderr, "%s: %s: %zu fields, %zu instances in %.2f s -> %s\n", kProg, o.mesh.c_str(),
-                 scene.fields.size(), scene.instances.size(), secondsSince(t0), o.output.c_str());
+    std::fprintf(stderr, "%s: %s: %s, %s in %.2f s -> %s\n", kProg, o.mesh.c_str(),
+                 cli::count(scene.fields.size(), "field").c_str(), cli::count(scene.instances.size(), "instance").c_str(),
+                 secondsSince(t0), o.output.c_str());
   }
   return cli::kExitSuccess;
 }

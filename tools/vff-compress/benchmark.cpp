@@ -83,10 +83,10 @@ Row ours(const File& src, const std::vector<uint8_t>& dist, uint32_t g, int repe
   r.bytes = f.info().sections.back().storedSize;  // the DIST section: block index and blocks
   for (const SectionInfo& s : f.info().sections)
     if (s.tag == kTagDistance) r.bytes = s.storedSize;
-  r.codec = "vff zstd-19 + hits-med, G " + std::to_string(pi.mapsPerBlock) + " (" + std::to_string(pi.blocks.size()) +
-            " blocks)";
-  r.note = std::to_string(filtered) + " of " + std::to_string(pi.blocks.size()) + " blocks filtered; compress on " +
-           std::to_string(parallel::resolveThreads(w.threads)) + " threads";
+  r.codec = "vff zstd-19 + hits-med, G " + std::to_string(pi.mapsPerBlock) + " (" + cli::count(pi.blocks.size(), "block") +
+            ")";
+  r.note = std::to_string(filtered) + " of " + cli::count(pi.blocks.size(), "block") + " filtered; compress on " +
+           cli::count(parallel::resolveThreads(w.threads), "thread");
   return r;
 }
 
@@ -215,7 +215,7 @@ int benchmark(const std::vector<std::string>& files, int repeat, const std::stri
       d.distance.insert(d.distance.end(), bytes->begin(), bytes->end());
     }
     const std::vector<uint8_t>& raw = d.distance;
-    std::printf("%s: %u maps of %ux%u %s, distance payload %s\n", path.c_str(), fd.mapCount, fd.mapResolution,
+    std::printf("%s: %s of %ux%u %s, distance payload %s\n", path.c_str(), cli::count(fd.mapCount, "map").c_str(), fd.mapResolution,
                 fd.mapResolution, distanceEncodingName(fd.distanceEncoding), cli::formatBytes(raw.size()).c_str());
     std::vector<Row> rows;
     bool exact[4] = {};

@@ -52,10 +52,10 @@ nlohmann::json planeJson(const vff::compress::PlaneReport& r) {
 void printPlane(const char* name, const vff::compress::PlaneReport& r, bool blocks) {
   std::vector<uint64_t> s = r.blockStored;
   std::sort(s.begin(), s.end());
-  std::printf("  %-8s %s raw -> %s stored, ratio %.3f; %zu blocks (zstd %u, hits-med %u), block stored bytes "
+  std::printf("  %-8s %s raw -> %s stored, ratio %.3f; %s (zstd %u, hits-med %u), block stored bytes "
               "min %llu / median %llu / max %llu\n",
               name, vff::cli::formatBytes(r.rawBytes).c_str(), vff::cli::formatBytes(r.storedBytes).c_str(),
-              ratio(r.rawBytes, r.storedBytes), r.blockStored.size(), r.zstd, r.filtered,
+              ratio(r.rawBytes, r.storedBytes), vff::cli::count(r.blockStored.size(), "block").c_str(), r.zstd, r.filtered,
               static_cast<unsigned long long>(s.empty() ? 0 : s.front()),
               static_cast<unsigned long long>(s.empty() ? 0 : s[s.size() / 2]),
               static_cast<unsigned long long>(s.empty() ? 0 : s.back()));

@@ -86,9 +86,10 @@ int saveVff(const Options& o, const FieldData& d) {
   if (vff::Status s = vff::writeFile(o.output, d.field, d.distance, d.normals, w); !s)
     return vff::cli::reportError(kProg, o.output, s.error());
   if (!o.quiet)
-    std::printf("%s: %u maps of %ux%u %s, %u slices of %ux%u (%s, gutter %u), codec %s\n", o.output.c_str(),
-                d.field.mapCount, d.field.mapResolution, d.field.mapResolution,
-                vff::distanceEncodingName(d.field.distanceEncoding), layout->sliceCount, layout->sliceWidth,
+    std::printf("%s: %s of %ux%u %s, %s of %ux%u (%s, gutter %u), codec %s\n", o.output.c_str(),
+                vff::cli::count(d.field.mapCount, "map").c_str(), d.field.mapResolution, d.field.mapResolution,
+                vff::distanceEncodingName(d.field.distanceEncoding), vff::cli::count(layout->sliceCount, "slice").c_str(),
+                layout->sliceWidth,
                 layout->sliceHeight, vff::layoutTargetName(layout->target), layout->gutter, vff::codecName(w.codec));
   return vff::cli::kExitSuccess;
 }
@@ -138,9 +139,10 @@ int toExr(const Options& o, const FieldData& d) {
   if (vff::Status s = vff::convert::writeExr(o.output, d, e); !s)
     return vff::cli::reportError(kProg, o.output, s.error());
   if (!o.quiet)
-    std::printf("%s: %u slices of %ux%u (%s)%s, %u maps\n", o.output.c_str(), d.layout.sliceCount, d.layout.sliceWidth,
-                d.layout.sliceHeight, o.half ? "HALF" : "FLOAT",
-                d.field.normalEncoding != vff::NormalEncoding::kNone ? " with normals" : "", d.field.mapCount);
+    std::printf("%s: %s of %ux%u (%s)%s, %s\n", o.output.c_str(), vff::cli::count(d.layout.sliceCount, "slice").c_str(),
+                d.layout.sliceWidth, d.layout.sliceHeight, o.half ? "HALF" : "FLOAT",
+                d.field.normalEncoding != vff::NormalEncoding::kNone ? " with normals" : "",
+                vff::cli::count(d.field.mapCount, "map").c_str());
   return vff::cli::kExitSuccess;
 }
 
@@ -157,10 +159,11 @@ int toVdb(const Options& o, const FieldData& d, const char* inputKind) {
   if (vff::Status s = vff::convert::writeVdb(o.output, d, v, &report); !s)
     return vff::cli::reportError(kProg, o.output, s.error());
   if (!o.quiet)
-    std::printf("%s: grid \"distance\"%s, %llu active voxels (hit texels) in %u slices of %ux%u, %u maps\n",
-                o.output.c_str(), d.field.normalEncoding != vff::NormalEncoding::kNone ? " and \"normal\"" : "",
-                static_cast<unsigned long long>(report.activeVoxels), d.layout.sliceCount, d.layout.sliceWidth,
-                d.layout.sliceHeight, d.field.mapCount);
+    std::printf("%s: grid \"distance\"%s, %s (hit texels) in %s of %ux%u, %s\n", o.output.c_str(),
+                d.field.normalEncoding != vff::NormalEncoding::kNone ? " and \"normal\"" : "",
+                vff::cli::count(report.activeVoxels, "active voxel").c_str(),
+                vff::cli::count(d.layout.sliceCount, "slice").c_str(), d.layout.sliceWidth, d.layout.sliceHeight,
+                vff::cli::count(d.field.mapCount, "map").c_str());
   return vff::cli::kExitSuccess;
 }
 
@@ -175,6 +178,8 @@ void warnCount(const Options& o, uint64_t count, const char* what) {
 // "exr", "vdb"), with a warning for each kind of value an EXR or VDB import did not find exact.
 // Returns the exit code of a failure (an input of the output's kind is a usage error).
 std::optional<int> readInput(const Options& o, FieldData* d, const char** kind) {
+  // Before the magic numbers are read: a FIFO would block the reads until a writer came.
+  if (vff::Status st = vff::cli::checkRegularFile(o.input); !st) return vff::cli::reportError(kProg, o.input, st.error());
   const bool exr = vff::convert::looksLikeExr(o.input);
   const bool vdb = !exr && vff::convert::looksLikeVdb(o.input);
   *kind = exr ? "exr" : vdb ? "vdb" : "vff";

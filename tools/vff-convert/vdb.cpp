@@ -199,7 +199,7 @@ Result<FieldData> readVdb(const std::string& path, VdbReadReport* report) {
   if (std::FILE* probe = std::fopen(path.c_str(), "rb")) {
     std::fclose(probe);
   } else {
-    return makeError(Code::kIoOpen, "cannot open " + path + ": " + std::strerror(errno));
+    return makeError(Code::kIoOpen, path + ": " + std::strerror(errno));
   }
   if (!looksLikeVdb(path)) return makeError(Code::kBadMagic, "not an OpenVDB file (no .vdb magic number)");
   FieldData d;
@@ -289,7 +289,7 @@ Result<FieldData> readVdb(const std::string& path, VdbReadReport* report) {
     return makeError(Code::kOutOfMemory, "out of memory while reading " + path);
   } catch (const std::exception& e) {
     // The file opened and has the magic number, so a failure here is a corrupt or truncated file.
-    return makeError(Code::kSectionDecode, "cannot read " + path + " as OpenVDB (corrupt or truncated): " + exceptionText(e));
+    return makeError(Code::kSectionDecode, path + ": cannot be read as OpenVDB (corrupt or truncated): " + exceptionText(e));
   }
   return d;
 }

@@ -57,7 +57,9 @@ void FileBytes::release() noexcept {
 }
 
 Result<FileBytes> FileBytes::read(const std::string& path) {
-  const Fd fd(::open(path.c_str(), O_RDONLY | O_CLOEXEC));
+  // O_NONBLOCK: a FIFO would otherwise block the open until a writer came, before read(fd) below
+  // could refuse it as not a regular file; a regular file's reads ignore the flag.
+  const Fd fd(::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK));
   if (fd.get() < 0) return makeError(Code::kIoOpen, path + ": " + std::strerror(errno));
   return read(fd.get(), path);
 }

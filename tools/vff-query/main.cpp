@@ -132,7 +132,7 @@ class Input {
       return in;
     }
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) return makeError(Code::kIoOpen, "cannot open " + path + ": " + std::strerror(errno));
+    if (fd < 0) return makeError(Code::kIoOpen, path + ": " + std::strerror(errno));
     struct stat st {};
     if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode)) {
       auto file = FileBytes::read(fd, path);
@@ -146,7 +146,7 @@ class Input {
     while ((n = ::read(fd, buf, sizeof buf)) > 0) in.owned_.insert(in.owned_.end(), buf, buf + n);
     const int err = errno;
     ::close(fd);
-    if (n < 0) return makeError(Code::kIoRead, "cannot read " + path + ": " + std::strerror(err));
+    if (n < 0) return makeError(Code::kIoRead, path + ": " + std::strerror(err));
     return in;
   }
   std::span<const uint8_t> bytes() const {

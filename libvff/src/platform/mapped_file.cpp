@@ -15,7 +15,9 @@ MappedFile::~MappedFile() {
 }
 
 Status MappedFile::open(const std::string& path, bool populate) {
-  int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  // O_NONBLOCK: opening a FIFO (or a device) for reading would otherwise wait for a writer before
+  // the check below could refuse it; on a regular file the flag changes nothing.
+  int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0) return makeError(Code::kIoOpen, path + ": " + std::strerror(errno));
   struct stat st {};
   if (fstat(fd, &st) != 0) {
