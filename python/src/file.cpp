@@ -2,6 +2,8 @@
 // maps as numpy arrays that view the file's memory and keep the File alive.
 #include <pybind11/stl.h>
 
+#include <nlohmann/json.hpp>
+
 #include "bindings.h"
 #include "errors.h"
 
@@ -161,6 +163,22 @@ py::object metadataDict(const PyFile& self) {
   return py::module_::import("json").attr("loads")(py::str(text.data(), text.size()));
 }
 
+// A partial result (spec/partial.md: META has "vff.partial"): None for a whole field, else the tuple
+// (mapBegin, mapEnd), both None when "vff.partial" gives no range mapBegin < mapEnd <= mapCount =
+// FDSC mapCount.
+py::object partialRange(const PyFile& self) {
+  const std::string_view text = self.file.metadata();
+  const nlohmann::json meta = nlohmann::json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/false);
+  if (!meta.is_object() || !meta.contains("vff.partial")) return py::none();
+  const nlohmann::json& p = meta["vff.partial"];
+  auto u32 = [&](const char* k) { return p.contains(k) && p[k].is_number_unsigned() && p[k].get<uint64_t>() <= UINT32_MAX; };
+  if (p.is_object() && u32("mapBegin") && u32("mapEnd") && u32("mapCount")) {
+    const uint64_t begin = p["mapBegin"], end = p["mapEnd"], count = p["mapCount"];
+    if (begin < end && end <= count && count == self.file.field().mapCount) return py::make_tuple(begin, end);
+  }
+  return py::make_tuple(py::none(), py::none());
+}
+
 }  // namespace
 
 std::shared_ptr<PyFile> openFile(const std::string& path, const std::string& checksums) {
@@ -255,6 +273,10 @@ keeps it alive, so `del f` never invalidates them.)doc")
       .def_property_readonly("metadata", &metadataDict, "The META JSON object as a dict ({} without META).")
       .def_property_readonly("metadata_text", [](const PyFile& f) { return std::string(f.file.metadata()); },
                              "The META JSON text exactly as stored (empty without META).")
+      .def_property_readonly("partial", &partialRange, R"doc(
+None, or for a partial result of vff-bake --map-range (spec/partial.md) the range (map_begin,
+map_end) of the field's maps it holds, both None when its "vff.partial" gives no valid range. Its
+other maps are fillers: vff.FieldQuery refuses such a file (vff.UnsupportedError).)doc")
       .def("describe", [](const PyFile& f) { return describe(f.file); }, "Everything vff.inspect() reports, as a dict.")
       .def("validate", &validateFile, py::arg("decode_blocks") = true, R"doc(
 Runs the full validator over the file's bytes. Returns a list of vff.Problem (id, name, severity,
