@@ -254,8 +254,16 @@ TEST(StrictJson, NestsAtMost64Deep) {
   EXPECT_EQ(far->byte, 64u);
 }
 
+TEST(StrictJson, PathsNameTheValueBeingRead) {
+  EXPECT_EQ(where("{\"asset\": {\"version\": 1} \"fields\": []}"),
+            "f.json:1:33: asset: syntax error while parsing object - unexpected string literal; expected '}'");
+  EXPECT_EQ(where("{\"a\": [{\"b\": 1}, {\"c\": [1,, 2]}]}"),
+            "f.json:1:27: a[1].c[1]: syntax error while parsing value - unexpected ','; expected '[', '{', or a literal");
+}
+
 TEST(StrictJson, RefusesBadUtf8AndLoneSurrogates) {
-  EXPECT_NE(where("{\"a\": \"\xC3\x28\"}"), "accepted");
+  // The message does not echo the bytes that are not UTF-8.
+  EXPECT_EQ(where("{\"a\": \"\xC3\x28\"}"), "f.json:1:9: a: syntax error while parsing value - invalid string: ill-formed UTF-8 byte");
   EXPECT_NE(where(R"({"a": "\ud800"})"), "accepted");
   EXPECT_EQ(where(R"({"a": "\ud83d\ude00"})"), "accepted");
 }

@@ -74,6 +74,12 @@ std::string parserMessage(const nlohmann::detail::exception& ex) {
   if (m.rfind("parse error", 0) == 0) {
     if (const size_t colon = m.find(": "); colon != std::string::npos) m.erase(0, colon + 2);
   }
+  // The bytes it quotes ("; last read: '...'") may be the very ones that are not UTF-8: the place
+  // stands for them.
+  if (const size_t read = m.find("; last read: "); read != std::string::npos) {
+    const size_t expected = m.find("; expected", read);
+    m.erase(read, expected == std::string::npos ? std::string::npos : expected - read);
+  }
   return m;
 }
 
@@ -98,7 +104,7 @@ class Handler {
 
   bool key(std::string& k) {
     json& obj = *stack_.back();
-    pending_ = k;
+    keys_.back() = k;
     if (obj.contains(k)) {
       std::string what = "the member name ";
       what += json(k).dump();
@@ -161,7 +167,7 @@ class Handler {
     const json& top = *stack_.back();
     if (top.is_array()) return "[" + std::to_string(top.size()) + "]";
     std::string s;
-    appendJsonPathKey(s, pending_);
+    appendJsonPathKey(s, keys_.back());
     return s[0] == '[' ? s : "." + s;  // (path() drops a leading '.')
   }
 
@@ -183,7 +189,7 @@ class Handler {
       top.push_back(std::move(v));
       return &top.back();
     }
-    json& slot = top[pending_];
+    json& slot = top[keys_.back()];
     slot = std::move(v);
     return &slot;
   }
@@ -202,12 +208,14 @@ class Handler {
     json* v = add(std::move(container));
     segments_.push_back(std::move(seg));
     stack_.push_back(v);
+    keys_.emplace_back();
     return true;
   }
 
   bool close() {
     stack_.pop_back();
     segments_.pop_back();
+    keys_.pop_back();
     return true;
   }
 
@@ -221,7 +229,7 @@ class Handler {
   json& root_;
   std::vector<json*> stack_;
   std::vector<std::string> segments_;  // where each open container stands in its parent
-  std::string pending_;                // the innermost object's last key
+  std::vector<std::string> keys_;      // each open object's last member name
 };
 
 }  // namespace
