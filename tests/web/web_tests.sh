@@ -37,6 +37,13 @@ test_node_summary() {
   node_test test/summary.test.js
 }
 
+# Partial results (spec/conformance/partial): reported with their range, the summary vff-inspect's.
+test_node_partial() {
+  need_node
+  [[ -x ${VFF_INSPECT:-} ]] || skip "vff-inspect is not built"
+  node_test test/partial.test.js
+}
+
 # The spec's worked examples: hits-med, BC4, normals, positions, nearest sample, layout.
 test_node_units() { need_node; node_test test/units.test.js; }
 

@@ -97,3 +97,22 @@ export function checkJsonText(b) {
   }
   return null;
 }
+
+/**
+ * A partial result (spec/partial.md: META has "vff.partial"): null for a whole field, else
+ * {mapBegin, mapEnd, mapCount, maps} as vff-inspect --format json reports it ("partial"), with
+ * mapBegin, mapEnd and maps null when "vff.partial" gives no range mapBegin < mapEnd <= mapCount =
+ * the field's mapCount. `meta` is the parsed META object (or null), `fieldMapCount` FDSC mapCount.
+ */
+export function partialRange(meta, fieldMapCount) {
+  if (!meta || typeof meta !== 'object' || !Object.hasOwn(meta, 'vff.partial')) return null;
+  const p = meta['vff.partial'];
+  const u32 = (k) => p && typeof p === 'object' && !Array.isArray(p) && Number.isInteger(p[k]) && p[k] >= 0 && p[k] <= 0xffffffff;
+  if (u32('mapBegin') && u32('mapEnd') && u32('mapCount')) {
+    const { mapBegin, mapEnd, mapCount } = p;
+    if (mapBegin < mapEnd && mapEnd <= mapCount && mapCount === fieldMapCount) {
+      return { mapBegin, mapEnd, mapCount, maps: mapEnd - mapBegin };
+    }
+  }
+  return { mapBegin: null, mapEnd: null, mapCount: fieldMapCount, maps: null };
+}

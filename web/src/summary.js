@@ -1,6 +1,8 @@
 // summary.js - the text `vff-inspect FILE` prints (tools/vff-inspect/text.cpp), from a decoded
-// file: format, sections, field, payload, layout, hit ratio, distance histogram and metadata.
+// file: format, sections, field, payload, layout, hit ratio, distance histogram and metadata. A
+// partial result (spec/partial.md) says so, and its statistics count only its range's maps.
 import { ENCODING_NAMES, POSITION_NAMES, DIRECTION_NAMES } from './container.js';
+import { partialRange } from './meta.js';
 
 const HISTOGRAM_BINS = 16;     // vff-inspect's default --histogram-bins
 
@@ -67,12 +69,13 @@ function planeLines(file, name, p) {
   return out;
 }
 
-function histogramLines(file) {
+function histogramLines(file, partial) {
   const f = file.field, e = f.distanceEncoding;
   let hits = 0, texels = 0;
   const bins = new Array(HISTOGRAM_BINS).fill(0);
   const diameter = 2 * f.sphere.radius;
-  for (let k = 0; k < f.mapCount; ++k) {
+  const ranged = partial && partial.mapBegin !== null;
+  for (let k = ranged ? partial.mapBegin : 0; k < (ranged ? partial.mapEnd : f.mapCount); ++k) {
     const d = file.distances(k);
     texels += d.length;
     for (const v of d) {
@@ -84,7 +87,9 @@ function histogramLines(file) {
     }
   }
   const ratio = hits / texels;
-  const out = ['', `hits:        ${hits} of ${texels} texels, hit ratio ${fixed(ratio, 6)} (${fixed((100 * ratio), 3)} %)`, ''];
+  const out = ['', `hits:        ${hits} of ${texels} texels, hit ratio ${fixed(ratio, 6)} (${fixed((100 * ratio), 3)} %)`];
+  if (ranged) out.push(`             (maps ${partial.mapBegin}:${partial.mapEnd} only: the others are fillers, not the field's)`);
+  out.push('');
   if (e === 4) {
     out.push(`histogram:   hits only (bit1 stores no distance): ${hits} hits, ${texels - hits} misses`);
     return out;
@@ -103,6 +108,7 @@ function histogramLines(file) {
 /** The summary of an opened file, named `name`, line for line as vff-inspect prints it. */
 export function summary(file, name) {
   const h = file.header, f = file.field, L = file.layout;
+  const partial = partialRange(file.metadata?.value ?? null, f.mapCount);
   const out = [
     `file:        ${name}`,
     `format:      vff ${h.versionMajor}.${h.versionMinor}, ${bytes(h.fileSize)}`,
@@ -124,13 +130,16 @@ export function summary(file, name) {
     '  frame:      duff2017',
     `  distance:   ${ENCODING_NAMES[f.distanceEncoding]}, miss code ${f.missCode}`,
     `  normals:    ${f.normalEncoding ? 'oct-snorm16' : 'none'}`,
+    ...(!partial ? [] : partial.mapBegin === null
+      ? ['  partial:    a partial result whose "vff.partial" gives no usable map range']
+      : [`  partial:    maps ${partial.mapBegin}:${partial.mapEnd} of ${partial.mapCount} only (vff-bake --map-range); the others hold misses until vff-bake --merge`]),
     '', 'payload:', ...planeLines(file, 'distance', file.planes.distance), ...planeLines(file, 'normal', file.planes.normal),
     '', 'layout:',
     `  target:    ${L.target === 1 ? '2d-array' : '3d'}`,
     `  tiles:     ${L.tileSize} texels (gutter ${L.gutter}), ${L.tilesPerRow} per row x ${L.tilesPerColumn} per column = ${L.tilesPerRow * L.tilesPerColumn} per slice`,
     `  slices:    ${L.sliceWidth} x ${L.sliceHeight} texels, ${L.sliceCount} slice${L.sliceCount === 1 ? '' : 's'}`,
     `  limits:    max texture size ${L.maxTextureSize}, max layers ${L.maxLayers}`,
-    ...histogramLines(file), '');
+    ...histogramLines(file, partial), '');
   out.push(file.metadata ? `metadata:\n${dump(file.metadata.value)}` : 'metadata: none');
   return out.join('\n');
 }
