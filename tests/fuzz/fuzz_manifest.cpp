@@ -58,7 +58,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (message) {
     if (rc < 1 || rc > 5) fail("a refusal with an exit code that is not documented", std::to_string(rc) + ": " + *message);
     if (message->empty()) fail("an empty message", "");
-    if (message->find("internal error") != std::string::npos) fail("an internal error", *message);
+    // (A message may quote the input, which may hold those words itself.)
+    if (message->find("internal error") != std::string::npos && text.find("internal error") == std::string_view::npos)
+      fail("an internal error", *message);
     return 0;
   }
   if (rc != 0) fail("no message but a non-zero exit code", std::to_string(rc));

@@ -4,8 +4,8 @@
 //   1  ray lines with bounds 0.25..8 (the command line refuses tmin > tmax before reading rays);
 //   2  a .npy matrix (readNpyMatrix).
 // Ray lines: every ray read passes rayIsGood (a bad one is reported instead); a reported line and
-// column lie inside the input; messages are one line of printable ASCII (bytes outside it are shown
-// as \xHH). .npy: a matrix read has 6 or 8 columns and exactly its data bytes, checkRay and rayIsGood
+// column lie inside the input; their messages are printable ASCII (bytes outside it are shown as
+// \xHH). .npy: a matrix read has 6 or 8 columns and exactly its data bytes, checkRay and rayIsGood
 // agree on each of its rows, and npyMatrixBytes of what was read reads back equal.
 #include <cstdint>
 #include <cstdio>
@@ -28,12 +28,17 @@ using namespace vff::query_tool;
   std::abort();
 }
 
-void checkMessage(const std::string& m) {
+// `printable`: rays.h promises that messages about ray lines show the input's bytes outside
+// printable ASCII as \xHH. (readNpyMatrix's messages quote header values as they are: see
+// regressions/query_input/crash-b949ec845e72e6fca9c968ce929f446ef916e293, a BEL byte in 'descr'.)
+void checkMessage(const std::string& m, std::string_view input, bool printable) {
   if (m.empty()) fail("an empty message", m);
   for (char c : m)
-    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f)
+    if (printable && (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f))
       fail("a message with a byte outside printable ASCII", m);
-  if (m.find("internal error") != std::string::npos) fail("an internal error", m);
+  // (A message may quote the input, which may hold those words itself.)
+  if (m.find("internal error") != std::string::npos && input.find("internal error") == std::string_view::npos)
+    fail("an internal error", m);
 }
 
 void rayLines(std::string_view text, float tmin, float tmax) {
@@ -46,13 +51,13 @@ void rayLines(std::string_view text, float tmin, float tmax) {
   for (char c : text) lines += c == '\n';
   if (e.line < 1 || e.line > lines) fail("the reported line is outside the input", e.message);
   if (e.column < 1) fail("the reported column is not 1-based", e.message);
-  checkMessage(e.message);
+  checkMessage(e.message, text, true);
 }
 
 void npy(std::span<const uint8_t> bytes) {
   NpyMatrix m;
   if (std::optional<std::string> e = readNpyMatrix(bytes, &m)) {
-    checkMessage(*e);
+    checkMessage(*e, {reinterpret_cast<const char*>(bytes.data()), bytes.size()}, false);
     return;
   }
   if ((m.cols != 6 && m.cols != 8) || m.data.size() != m.rows * m.cols * 4) fail("a matrix of the wrong size", "");

@@ -1,6 +1,6 @@
 // Fuzz target: the scene description reader (vff/scene_description.h, spec/scene.md) on arbitrary
-// text. Whatever the bytes, parseSceneDescription returns a description or one of the three scene
-// errors, its message naming the description. A description it accepts must survive the writer:
+// text. Whatever the bytes, parseSceneDescription returns a description or a scene error (an ID of
+// spec/scene.md, 11xxx), its message naming the description. A description it accepts must survive the writer:
 // formatSceneDescription gives text that parses again to an equal description and formats to the
 // same bytes (the writer promises that equal descriptions give equal bytes).
 #include <cstdint>
@@ -50,10 +50,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   vff::Result<vff::SceneDescription> a = vff::parseSceneDescription(text, kName);
   if (!a) {
     const vff::Error& e = a.error();
-    if (e.code != vff::Code::kSceneJson && e.code != vff::Code::kSceneVersion && e.code != vff::Code::kSceneValue)
+    if (uint32_t(e.code) / 1000 != uint32_t(vff::Code::kSceneJson) / 1000)
       fail("refused with a code that is not a scene error", e.toString());
     if (e.message.rfind(kName, 0) != 0) fail("the message does not start with the description's name", e.message);
-    if (e.message.find("internal error") != std::string::npos) fail("an internal error", e.message);
+    // (A message may quote the input, which may hold those words itself.)
+    if (e.message.find("internal error") != std::string::npos && text.find("internal error") == std::string_view::npos)
+      fail("an internal error", e.message);
     return 0;
   }
   vff::Result<std::string> t = vff::formatSceneDescription(*a);
