@@ -229,4 +229,142 @@ test_split_entry_errors() {
   expect_err "--split names a scene description per entry: give it in a manifest"
 }
 
+# The conformance vectors are what their generator writes (deterministic), and every rule of
+# spec/library.md section 8 has an invalid vector.
+VECTORS="$(dirname "$SCHEMA")/conformance/library"
+test_vectors_match_their_generator() {
+  python3 "$VECTORS/gen_vectors.py" "$WORK/gen"
+  python3 "$VECTORS/gen_vectors.py" "$WORK/gen2"
+  diff -r "$WORK/gen" "$WORK/gen2" || fail "the generator is not deterministic"
+  diff -r -x gen_vectors.py -x README.md -x __pycache__ "$WORK/gen" "$VECTORS" || fail "the committed vectors differ from gen_vectors.py's"
+}
+
+test_every_rule_has_a_vector() {
+  local ids
+  ids=$(grep -oE '^\| 13[0-9]{3} ' "$(dirname "$SCHEMA")/library.md" | tr -d '| ' | sort -u)
+  [[ $(echo "$ids" | wc -l) == 15 ]] || fail "spec/library.md lists $(echo "$ids" | wc -l) rules: $ids"
+  for id in $ids; do
+    ls "$VECTORS/invalid/$id/"*.json >/dev/null 2>&1 || fail "rule $id has no invalid vector"
+  done
+}
+
+# A value of the wrong JSON type is a manifest error naming its key and entry (exit 3), never an
+# internal error; a plan of the wrong types is refused as such too.
+test_wrong_types_are_manifest_errors() {
+  mkdir -p "$WORK/lib"
+  local m
+  for m in '{"vffLibrary": "1", "entries": []}|vffLibrary' '{"vffLibrary": 1, "shardMaps": "5", "entries": []}|shardMaps' \
+           '{"vffLibrary": 1, "entries": [{"mesh": "a.obj", "output": 5}]}|entries[0].output' \
+           '{"vffLibrary": 1, "output": 7, "entries": []}|output' \
+           '{"vffLibrary": 1, "entries": [{"mesh": "a.obj", "options": {"normals": "yes"}}]}|entries[0].options.normals'; do
+    printf '%s' "${m%|*}" >"$WORK/lib/m.json"
+    run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields"
+    expect_rc 3
+    expect_err "$WORK/lib/m.json: "
+    expect_err "): ${m##*|}: must be "
+    ! grep -q "internal error" "$WORK/err" || fail "internal error for ${m%|*}"
+  done
+  echo '{"vffLibraryPlan": 1, "vffBake": "vff-bake", "cache": "c", "entries": [{"task": "0"}]}' >"$WORK/plan.json"
+  run "$VFF_LIBRARY" run-shard "$WORK/plan.json" 0
+  expect_rc 3
+  expect_err "$WORK/plan.json: entries[0].index: not an integer >= 0"
+  ! grep -q "internal error" "$WORK/err" || fail "internal error for a plan"
+}
+
+# The options after -- are checked once, before any mesh is read: one usage error, not one per entry;
+# a range without an upper bound is said readably.
+test_folder_options_checked_once() {
+  mkdir -p "$WORK/lib"
+  local n
+  for n in 1 2 3 4; do "$MESHGEN" box "$WORK/lib/m$n.obj"; done
+  run "$VFF_LIBRARY" bake "$WORK/lib" --out "$WORK/fields" -- --count 0 -m 8
+  expect_rc 1
+  [[ $(grep -c "error:" "$WORK/err") == 1 ]] || { show; fail "one error line expected"; }
+  expect_err "vff-library: error: bake-option (13015): the options after --: --count: Value 0 is not > 0 (for m1.obj, a mesh input)"
+  run "$VFF_LIBRARY" bake "$WORK/lib" --out "$WORK/fields" -- --scene -2
+  expect_rc 1
+  expect_err "--scene: Value -2 is not >= 0"
+  ! grep -qE '[0-9]{40}' "$WORK/err" || fail "a 309-digit range"
+  [[ -z $(find "$WORK/fields" -name '*.vff' 2>/dev/null) ]] || fail "a refused run baked"
+}
+
+# A dry run names the entries that will fail, with their problem, and exits as the bake does; each
+# message names the entry's path once.
+test_dry_run_lists_failing_entries() {
+  mkdir -p "$WORK/lib"
+  "$MESHGEN" box "$WORK/lib/a.obj"
+  echo '{"vffLibrary": 1, "defaults": {"count": 2, "map-size": 4},
+         "entries": [{"mesh": "a.obj"}, {"mesh": "gone.obj"}, {"mesh": "a.obj", "output": "b.vff", "options": {"gutter": 99}}]}' \
+    >"$WORK/lib/m.json"
+  run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields" --dry-run
+  expect_rc 4  # exits 2 and 1 differ: 4
+  expect_out "# 3 entries: 1 to bake, 0 up to date, 2 failing"
+  expect_err "vff-library: error: gone.obj: io-open (1001): No such file or directory (exit 2)"
+  expect_err "vff-library: error: a.obj: bake-option (13015): entries[2].options: --gutter: Value 99 not in range 0 to 64 (exit 1)"
+  [[ $(grep -o "gone.obj" "$WORK/err" | wc -l) == 1 ]] || { show; fail "the path named more than once"; }
+  [[ -z $(find "$WORK/fields" -name '*.vff' 2>/dev/null) ]] || fail "a dry run baked"
+  run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields" --dry-run --format json
+  expect_rc 4
+  [[ $(python3 -c "import json; print([e['state'] for e in json.load(open('$WORK/out'))['entries']])") == "['bake', 'failed', 'failed']" ]] \
+    || { show; fail "states"; }
+  lib_bake "$WORK/lib/m.json"
+  expect_rc 4
+  expect_err "vff-library: 3 entries: 1 baked, 0 up to date, 2 failed"
+  [[ $(json '[f["exitCode"] for f in r["failed"]]') == "[2, 1]" ]] || { show; fail "failed entries"; }
+  echo '{"vffLibrary": 1, "entries": [{"mesh": "gone.obj"}]}' >"$WORK/lib/one.json"
+  lib_bake "$WORK/lib/one.json"
+  expect_rc 2
+  expect_err "vff-library: 1 entry: 0 baked"
+}
+
+# spec/library.md section 6's example: the key text and key of tetra.obj, a mesh written here.
+test_key_of_the_spec_example() {
+  mkdir -p "$WORK/lib"
+  printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n' >"$WORK/lib/tetra.obj"
+  local key=0925ee93d25dc507d9804a3bdd1707b4 text
+  text='vff-library key 1
+baker vff-bake 0.1.0
+format 1
+source tetra.obj
+geometry mesh obj f3dff744aca0d090 3c27cbe67ed21652 0 -1
+options {"allowClippedSphere":false,"codec":"stored","directions":"concentric-equal-area","encoding":"unorm8-diameter","grid":"","layout":["2d-array",2048,2048,0],"m":4,"mapsPerBlock":0,"n":2,"normals":true,"positions":"octa-hemi2","scene":-1,"zstdLevel":0}'
+  run "$VFF_LIBRARY" key "$WORK/lib/tetra.obj" -- --count 2 --map-size 4 --normals
+  expect_rc 0
+  [[ $(cat "$WORK/out") == "$text"$'\n'"key $key" ]] || { show; fail "the key text differs from spec/library.md's example"; }
+  # The text's XXH3-128 is the key, and the spec shows this very text and key.
+  grep -qF "$key" "$(dirname "$SCHEMA")/library.md" || fail "spec/library.md lacks the key"
+  grep -qF "$(echo "$text" | tail -1)" "$(dirname "$SCHEMA")/library.md" || fail "spec/library.md lacks the options line"
+  # Other spellings, and a manifest of the same bake, give the same key.
+  run "$VFF_LIBRARY" key "$WORK/lib/tetra.obj" -- -n 2 -m 4 --normals --codec stored --positions octa-hemi2
+  expect_out "key $key"
+  echo '{"vffLibrary": 1, "entries": [{"mesh": "tetra.obj", "options": {"count": 2, "map-size": 4, "normals": true}}]}' >"$WORK/lib/m.json"
+  run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields" --dry-run --format json
+  expect_rc 0
+  [[ $(python3 -c "import json; print(json.load(open('$WORK/out'))['entries'][0]['key'])") == "$key" ]] || { show; fail "the bake's key"; }
+  lib_bake "$WORK/lib/m.json"
+  [[ -f $WORK/fields/.vff-cache/09/$key.vff ]] || fail "the field is not cached at its key"
+}
+
+# Slurm arrays are sized by the work: a small library is one task; --rays-per-task and --tasks
+# spread it, the largest bakes first, each to the least loaded task (the plan of a dry run).
+test_slurm_plan_sized_by_work() {
+  mkdir -p "$WORK/lib"
+  "$MESHGEN" box "$WORK/lib/a.obj"
+  echo '{"vffLibrary": 1, "defaults": {"count": 2, "map-size": 4},
+         "entries": [{"mesh": "a.obj", "output": "a.vff"}, {"mesh": "a.obj", "output": "b.vff", "options": {"map-size": 8}},
+                     {"mesh": "a.obj", "output": "c.vff", "options": {"map-size": 5}}, {"mesh": "a.obj", "output": "d.vff", "options": {"map-size": 6}}]}' \
+    >"$WORK/lib/m.json"
+  plan() { python3 -c "import json; p=json.load(open('$WORK/state/round-0.plan.json')); print(p['tasks'], sorted((e['output'][-5:], e['task']) for e in p['entries']))"; }
+  run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields" --slurm --dry-run --state "$WORK/state"
+  expect_rc 0
+  expect_out "'--array=0-0'"
+  [[ $(plan) == "1 [('a.vff', 0), ('b.vff', 0), ('c.vff', 0), ('d.vff', 0)]" ]] || fail "one task: $(plan)"
+  # 26 maps each: 416, 1664, 650 and 936 rays; 3666 in all.
+  run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields" --slurm --dry-run --state "$WORK/state" --rays-per-task 1500
+  expect_out "'--array=0-2'"
+  [[ $(plan) == "3 [('a.vff', 2), ('b.vff', 0), ('c.vff', 2), ('d.vff', 1)]" ]] || fail "three tasks: $(plan)"
+  run "$VFF_LIBRARY" bake "$WORK/lib/m.json" --out "$WORK/fields" --slurm --dry-run --state "$WORK/state" --tasks 9
+  expect_out "'--array=0-3'"  # at most one per bake
+}
+
 run_test "$1"

@@ -57,6 +57,9 @@ std::string shown(const json& v) {
   return s;  // true, false, null
 }
 
+// A string as JSON writes it (a byte that is not UTF-8 shown as U+FFFD: a message never throws).
+std::string jsonQuoted(const std::string& s) { return json(s).dump(-1, ' ', false, json::error_handler_t::replace); }
+
 bool isCount(const json& v) { return v.is_number_unsigned() || (v.is_number_integer() && v.get<int64_t>() >= 0); }
 
 // A manifest being checked: its name in messages, and the exit code of the first problem.
@@ -83,7 +86,7 @@ class Checker {
 std::optional<std::string> unknownMember(const Checker& c, const json& o, const std::string& path,
                                          std::initializer_list<const char*> known, const std::string& what) {
   for (const auto& [k, v] : o.items()) {
-    if (std::none_of(known.begin(), known.end(), [&](const char* n) { return k == n; })) {
+    if (std::none_of(known.begin(), known.end(), [&key = k](const char* n) { return key == n; })) {
       std::string p = path;
       appendJsonPathKey(p, k);
       return c.fail(kRuleUnknownMember, p, "not a member of " + what);
@@ -269,15 +272,17 @@ std::optional<std::string> parseManifest(std::string_view text, const std::strin
     if (!e.split.empty() && !named && rel.size() > 4 && rel.compare(rel.size() - 4, 4, ".vff") == 0)
       rel = rel.substr(0, rel.size() - 4) + ".vffscene.json";
     const std::string outPath = named ? where + ".output" : where;
-    const std::string shownName = named ? "" : "output \"" + rel + "\" (from the pattern " + json(pattern).dump() + ") ";
+    // A name the pattern made is shown with the pattern; a given one is at its path already.
+    const std::string fromPattern = "output " + jsonQuoted(rel) +
+                                    " (from the pattern " + jsonQuoted(pattern) + ") ";
     if (auto p = outputNameProblem(rel))
-      return c.fail(kRuleOutputPath, outPath, (named ? "" : shownName) + *p + ": an output is a relative path inside the output folder");
+      return c.fail(kRuleOutputPath, outPath, (named ? "" : fromPattern) + *p + ": an output is a relative path inside the output folder");
     if (!e.split.empty() && (rel.size() < 5 || rel.compare(rel.size() - 5, 5, ".json") != 0))
-      return c.fail(kRuleSplitOutput, outPath,
-                    shownName + "must name the split entry's scene description (.json), not " + json(rel).dump());
+      return c.fail(kRuleSplitOutput, outPath, (named ? "" : fromPattern) +
+                    "must name the split entry's scene description (.json), not " + jsonQuoted(rel));
     if (auto [it, fresh] = outputs.emplace(rel, i); !fresh)
-      return c.fail(kRuleDuplicateOutput, outPath,
-                    shownName + json(rel).dump() + " is the output of entries[" + std::to_string(it->second) + "] too");
+      return c.fail(kRuleDuplicateOutput, outPath, (named ? jsonQuoted(rel) + " " : fromPattern) + "is the output of entries[" +
+                                                       std::to_string(it->second) + "] too");
     e.outputName = rel;
     e.output = (out / rel).lexically_normal().string();
     e.shardMaps = j.contains("shardMaps") ? j["shardMaps"].get<uint64_t>() : shardDefault;
