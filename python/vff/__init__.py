@@ -17,7 +17,7 @@ section and the offset. The version is libvff's (vff.__version__).
 
 from collections import namedtuple as _namedtuple
 
-from ._errors import (Error, IoError, InvalidFileError, MeshError, InvalidArgumentError,
+from ._errors import (Error, IoError, InvalidFileError, MeshError, SceneError, InvalidArgumentError,
                       UnsupportedError, OperationError)
 
 Problem = _namedtuple("Problem", "id name severity section offset message")
@@ -27,7 +27,7 @@ name, "error" or "warning", the section's FourCC (or None), the file offset (or 
 from ._vff import (__version__, format_version, batch_kernel, File, FieldQuery, Instance, Scene, Hits, open,
                    load_scene, inspect, bake, bake_file, compress, decompress, convert)
 
-__all__ = ["Error", "IoError", "InvalidFileError", "MeshError", "InvalidArgumentError",
+__all__ = ["Error", "IoError", "InvalidFileError", "MeshError", "SceneError", "InvalidArgumentError",
            "UnsupportedError", "OperationError", "Problem", "File", "FieldQuery", "Instance", "Scene", "Hits",
            "open", "load_scene", "inspect", "bake", "bake_file", "compress", "decompress", "convert",
            "batch_kernel", "format_version", "__version__"]

@@ -48,6 +48,10 @@ class MeshError(Error):
     """A mesh cannot be baked (codes 10xxx)."""
 
 
+class SceneError(Error):
+    """A scene description breaks a rule of spec/scene.md section 5 (codes 11xxx; ``code`` is the ID)."""
+
+
 class InvalidArgumentError(Error, ValueError):
     """An argument is invalid or out of range (9001, 9002)."""
 
@@ -66,6 +70,8 @@ def error_class(code):
         return IoError
     if 2000 <= code < 9000:
         return InvalidFileError
+    if 11000 <= code < 12000:
+        return SceneError
     if code >= 10000:
         return MeshError
     if code in (9001, 9002):

@@ -202,11 +202,87 @@ def test_load_scene_equals_its_description(tmp_path):
         scene.add(instances[0])
     doc["instances"][0]["field"] = 5
     path.write_text(json.dumps(doc))
-    with pytest.raises(vff.Error) as e:
+    with pytest.raises(vff.SceneError) as e:
         vff.load_scene(str(path))
-    assert e.value.name == "scene-value" and "instances[0]" in str(e.value)
+    assert e.value.name == "scene-field-index" and e.value.code == 11005
+    assert e.value.message == "%s: instances[0].field: index 5 is not one of the 2 fields" % path
     with pytest.raises(vff.IoError):
         vff.load_scene(str(tmp_path / "none.json"))
+
+
+SCENE_VECTORS = VECTORS / "scene"
+
+
+def scene_vectors(kind):
+    return sorted(p for p in (SCENE_VECTORS / kind).glob("**/*.json") if not p.name.endswith(".expected.json"))
+
+
+def test_scene_errors_are_scene_errors(tmp_path):
+    # A scene description's problem is a vff.SceneError (a vff.Error), carrying the rule's ID, and
+    # its message places a JSON syntax error at LINE:COLUMN.
+    path = tmp_path / "bad.vffscene.json"
+    path.write_bytes(b'{"asset": {"format": "vff-scene", "version": 1},\n "fields": [,]}')
+    with pytest.raises(vff.SceneError) as e:
+        vff.load_scene(str(path))
+    assert isinstance(e.value, vff.Error) and not isinstance(e.value, vff.MeshError)
+    assert (e.value.code, e.value.name) == (11001, "scene-json")
+    assert e.value.message.startswith("%s:2:13: fields[0]: syntax error" % path), e.value.message
+    assert str(e.value).startswith("scene-json (11001): ")
+
+
+def test_scene_vectors_invalid():
+    # Every invalid vector raises the ID of its folder; one failure line per vector.
+    vectors = scene_vectors("invalid")
+    assert len(vectors) >= 30
+    failures = []
+    for path in vectors:
+        want = int(path.parent.name)
+        try:
+            vff.load_scene(str(path))
+            failures.append("%s: accepted" % path.relative_to(SCENE_VECTORS))
+        except vff.SceneError as e:
+            if e.code != want or not e.message.startswith(str(path) + ":"):
+                failures.append("%s: %s (%d): %s" % (path.relative_to(SCENE_VECTORS), e.name, e.code, e.message))
+    assert not failures, "\n".join(failures)
+
+
+def test_scene_vectors_valid():
+    # The valid vectors whose fields all exist load, and place their instances as expected.json says;
+    # the others fail only at opening a field (an I/O error, not a scene error).
+    vectors = scene_vectors("valid")
+    assert len(vectors) >= 8
+    failures, loaded = [], 0
+    for path in vectors:
+        want = json.loads(path.with_name(path.stem + ".expected.json").read_text())
+        name = str(path.relative_to(SCENE_VECTORS))
+        if not all(f["exists"] for f in want["fields"]):
+            with pytest.raises(vff.IoError):
+                vff.load_scene(str(path))
+            continue
+        scene = vff.load_scene(str(path))
+        loaded += 1
+        if len(scene) != len(want["instances"]):
+            failures.append("%s: %d instances" % (name, len(scene)))
+            continue
+        for k, w in enumerate(want["instances"]):
+            got = scene.instance(k)
+            c, r = got.world_sphere
+            if list(np.float32(got.translation)) != list(np.float32(w["translation"])) or \
+                    np.float32(got.scale) != np.float32(w["scale"]):
+                failures.append("%s: instances[%d] placed at %s, scale %r" % (name, k, got.translation, got.scale))
+            if not (np.allclose(c, w["worldSphere"]["center"], rtol=1e-5, atol=1e-5)
+                    and np.isclose(r, w["worldSphere"]["radius"], rtol=1e-5)):
+                failures.append("%s: instances[%d] world sphere %s, %r" % (name, k, c, r))
+    assert loaded >= 4
+    assert not failures, "\n".join(failures)
+
+
+def test_scene_vectors_are_generated():
+    # The committed vectors are what generate.py makes (it is deterministic).
+    import subprocess
+    import sys
+    r = subprocess.run([sys.executable, str(SCENE_VECTORS / "generate.py"), "--check"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
 
 
 def test_stubs_name_every_public_name():
