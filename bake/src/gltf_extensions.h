@@ -16,11 +16,17 @@ namespace vff::bake::detail {
 
 // gltf_prepare.cpp: reads the file and refuses (kMeshUnsupported, naming the extension and the
 // file) any required extension that is not KHR_mesh_quantization, KHR_draco_mesh_compression or
-// EXT_meshopt_compression, before a parse error can hide it. What tinygltf would refuse in a valid
+// EXT_meshopt_compression, before a parse error can hide it; except one that changes no geometry
+// (KHR_materials_*, KHR_texture_transform, KHR_texture_basisu, EXT_texture_webp and the like:
+// isGeometryFreeExtension), which gets a note in *notes and is not read. What tinygltf would refuse in a valid
 // compressed file is mended (meshopt fallback buffers without a uri get a placeholder, Draco
 // primitives lose indices that have no data); *bytes is then what tinygltf should parse.
 // A file whose JSON cannot be read is passed on unchanged: tinygltf reports the error.
-Status prepareGltf(const std::string& path, bool binary, std::vector<unsigned char>* bytes);
+Status prepareGltf(const std::string& path, bool binary, std::vector<unsigned char>* bytes,
+                   std::vector<std::string>* notes);
+// Whether a glTF extension affects only what the baker does not read (materials, textures, lights,
+// metadata), so that a file requiring it still has the geometry the baker reads.
+bool isGeometryFreeExtension(const std::string& name);
 
 // Parses what prepareGltf gave, external files relative to the file's folder.
 bool parsePreparedGltf(tinygltf::TinyGLTF& loader, tinygltf::Model* model, std::string* err, std::string* warn,

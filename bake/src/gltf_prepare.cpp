@@ -16,6 +16,11 @@ namespace {
 
 constexpr std::array<const char*, 3> kSupported = {"KHR_mesh_quantization", "KHR_draco_mesh_compression",
                                                    "EXT_meshopt_compression"};
+// Extensions that change materials, textures, lights or metadata, never the triangles: a file that
+// requires one is baked from its geometry alone. (KHR_materials_* are matched by prefix.)
+constexpr std::array<const char*, 9> kGeometryFree = {
+    "KHR_texture_transform", "KHR_texture_basisu",     "EXT_texture_webp", "EXT_texture_avif", "MSFT_texture_dds",
+    "KHR_lights_punctual",   "EXT_lights_image_based", "KHR_xmp_json_ld",  "KHR_xmp"};
 constexpr uint32_t kGlbMagic = 0x46546C67;  // "glTF"
 constexpr uint32_t kChunkJson = 0x4E4F534A;  // "JSON"
 constexpr size_t kGlbHeader = 12, kChunkHeader = 8;
@@ -85,7 +90,15 @@ bool dropDracoIndices(nlohmann::json* doc) {
 
 }  // namespace
 
-Status prepareGltf(const std::string& path, bool binary, std::vector<unsigned char>* bytes) {
+bool isGeometryFreeExtension(const std::string& name) {
+  if (name.starts_with("KHR_materials_")) return true;
+  for (const char* s : kGeometryFree)
+    if (name == s) return true;
+  return false;
+}
+
+Status prepareGltf(const std::string& path, bool binary, std::vector<unsigned char>* bytes,
+                   std::vector<std::string>* notes) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return makeError(Code::kIoOpen, path + ": cannot be read");
   bytes->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
@@ -101,11 +114,15 @@ Status prepareGltf(const std::string& path, bool binary, std::vector<unsigned ch
       const std::string name = e.is_string() ? e.get<std::string>() : e.dump();
       bool known = false;
       for (const char* s : kSupported) known = known || name == s;
-      if (!known)
-        return makeError(Code::kMeshUnsupported,
-                         path + ": requires the glTF extension " + name +
-                             ", which vff cannot read (supported: KHR_mesh_quantization, "
-                             "KHR_draco_mesh_compression, EXT_meshopt_compression)");
+      if (known) continue;
+      if (isGeometryFreeExtension(name)) {
+        if (notes) notes->push_back("requires the glTF extension " + name + ", which changes no geometry: not read");
+        continue;
+      }
+      return makeError(Code::kMeshUnsupported,
+                       path + ": requires the glTF extension " + name +
+                           ", which vff cannot read (geometry: KHR_mesh_quantization, KHR_draco_mesh_compression, "
+                           "EXT_meshopt_compression; materials, textures and lights are not read)");
     }
   }
   const bool fallbacks = placeholderFallbacks(&doc);

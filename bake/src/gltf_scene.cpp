@@ -99,7 +99,8 @@ Result<std::vector<NodeMesh>> sceneMeshes(const tinygltf::Model& model, const st
 // Parses the file and picks the scene (`requested` -1: the default one). *info gets the scenes.
 Result<std::shared_ptr<const tinygltf::Model>> parseScene(const std::string& path, bool binary, int requested,
                                                           int* sceneIndex, MeshInfo* info) {
-  auto model = parseGltf(path, binary);
+  if (info) info->gltfNotes.clear();
+  auto model = parseGltf(path, binary, info ? &info->gltfNotes : nullptr);
   if (!model) return model;
   const auto& scenes = (*model)->scenes;
   if (info) {
@@ -117,6 +118,34 @@ Result<std::shared_ptr<const tinygltf::Model>> parseScene(const std::string& pat
   }
   if (info) info->gltfScene = *sceneIndex;
   return model;
+}
+
+// " 'name'" or nothing.
+std::string quoted(const std::string& name) { return name.empty() ? std::string() : " '" + name + "'"; }
+
+// Notes (MeshInfo::gltfNotes) for what the baked nodes animate and the bake leaves out: a skin (the
+// mesh is baked in its bind pose: the vertices as stored, under the node's transform, not moved by
+// its joints) and morph targets (the base shape; the weights are not applied). Each node and mesh
+// once, in the order of the scene walk.
+void noteAnimation(const tinygltf::Model& model, const std::vector<NodeMesh>& nodes, MeshInfo* info) {
+  if (!info) return;
+  std::vector<bool> morphNoted(model.meshes.size(), false);
+  for (const NodeMesh& n : nodes) {
+    if (n.node >= 0 && model.nodes[size_t(n.node)].skin >= 0) {
+      const tinygltf::Node& node = model.nodes[size_t(n.node)];
+      info->gltfNotes.push_back("node " + std::to_string(n.node) + quoted(node.name) + " (mesh " + std::to_string(n.mesh) +
+                                ") has skin " + std::to_string(node.skin) +
+                                ": baked in its bind pose, not posed by its joints");
+    }
+    const tinygltf::Mesh& mesh = model.meshes[size_t(n.mesh)];
+    bool morphed = false;
+    for (const tinygltf::Primitive& p : mesh.primitives) morphed = morphed || !p.targets.empty();
+    if (morphed && !morphNoted[size_t(n.mesh)]) {
+      morphNoted[size_t(n.mesh)] = true;
+      info->gltfNotes.push_back("mesh " + std::to_string(n.mesh) + quoted(mesh.name) +
+                                " has morph targets: baked as its base shape, its weights not applied");
+    }
+  }
 }
 
 bool isGlb(const std::string& path) {
@@ -154,6 +183,7 @@ Result<Mesh> loadWithTinyGltf(const std::string& path, bool binary, const MeshLo
   if (!model) return std::move(model).error();
   auto nodes = sceneMeshes(**model, path, sceneIndex);
   if (!nodes) return std::move(nodes).error();
+  noteAnimation(**model, *nodes, info);
   std::vector<GltfMeshRef> refs;
   for (const NodeMesh& n : *nodes) refs.push_back({n.mesh, n.world});
   return importGltfMeshes(**model, path, refs);
@@ -173,6 +203,7 @@ Result<std::vector<GltfObject>> loadGltfObjects(const std::string& path, const G
   in->format = detail::isGlb(path) ? "glb" : "gltf";
   auto nodes = detail::sceneMeshes(**model, path, sceneIndex);
   if (!nodes) return std::move(nodes).error();
+  detail::noteAnimation(**model, *nodes, in);
 
   std::vector<GltfObject> objects;
   std::map<int, size_t> sharedObject;  // mesh -> its object in its own frame (kMesh)

@@ -180,14 +180,15 @@ bool skipImages(tinygltf::Image*, const int, std::string*, std::string*, int, in
 
 }  // namespace
 
-Result<std::shared_ptr<const tinygltf::Model>> parseGltf(const std::string& path, bool binary) {
+Result<std::shared_ptr<const tinygltf::Model>> parseGltf(const std::string& path, bool binary,
+                                                         std::vector<std::string>* notes) {
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(skipImages, nullptr);
   auto model = std::make_shared<tinygltf::Model>();
   std::string err, warn;
   bool ok = false;
   std::vector<unsigned char> bytes;
-  if (Status pre = prepareGltf(path, binary, &bytes); !pre) return std::move(pre).error();
+  if (Status pre = prepareGltf(path, binary, &bytes, notes); !pre) return std::move(pre).error();
   try {
     ok = parsePreparedGltf(loader, model.get(), &err, &warn, bytes, path, binary);
   } catch (const std::exception& e) {

@@ -25,8 +25,10 @@ Result<Mesh> loadWithOpenMesh(const std::string& path, const std::string& ext);
 // ---- glTF ---------------------------------------------------------------------------------------
 using GltfMatrix = std::array<double, 16>;  // column-major 4x4, as glTF stores it
 // Parses a .gltf or .glb file (mesh_gltf.cpp); images are skipped. A required extension the
-// importer cannot decode is kMeshUnsupported, naming it.
-Result<std::shared_ptr<const tinygltf::Model>> parseGltf(const std::string& path, bool binary);
+// importer cannot decode is kMeshUnsupported, naming it; one that changes no geometry gets a note
+// in *notes (when given).
+Result<std::shared_ptr<const tinygltf::Model>> parseGltf(const std::string& path, bool binary,
+                                                         std::vector<std::string>* notes = nullptr);
 struct GltfMeshRef {
   int mesh = -1;      // index into model.meshes
   GltfMatrix matrix;  // applied to its positions (normals: the inverse transpose)

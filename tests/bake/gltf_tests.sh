@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # gltf_tests.sh - vff-bake on glTF files that require extensions: compressed files bake the field of
-# the plain one; an extension it cannot read is refused as unsupported (exit 5) with its name and the
-# file's, before anything else about the file is judged. (The decoders' other cases are in
+# the plain one; an extension that changes geometry it cannot read is refused as unsupported (exit 5)
+# with its name and the file's, before anything else about the file is judged; one that changes no
+# geometry (materials, textures) is left unread with a warning. Skins and morph targets: warnings. (The decoders' other cases are in
 # test_gltf_extensions.cpp.)
 #
 # Every function named test_* is one ctest case bake.gltf.NAME (tests/bake/CMakeLists.txt):
@@ -41,13 +42,96 @@ test_unknown_required_extension_is_unsupported() {
   run "$VFF_BAKE" "$WORK/m.gltf" -o "$WORK/x.vff" -n 1 -m 8
   expect_rc 5
   expect_err "vff-bake: error:"
-  expect_err "m.gltf: requires the glTF extension EXT_unheard_of"
+  expect_err "vff-bake: error: $WORK/m.gltf: mesh-unsupported (10003): requires the glTF extension EXT_unheard_of,"
   [[ ! -e $WORK/x.vff ]] || fail "output left behind"
-  glb_of "$(gltf_json '"KHR_texture_basisu"')" >"$WORK/m.glb"
+  glb_of "$(gltf_json '"KHR_texture_basisu","EXT_mesh_gpu_instancing"')" >"$WORK/m.glb"
   run "$VFF_BAKE" "$WORK/m.glb" -o "$WORK/x.vff" -n 1 -m 8
   expect_rc 5
-  expect_err "m.glb: requires the glTF extension KHR_texture_basisu"
+  expect_err "vff-bake: error: $WORK/m.glb: mesh-unsupported (10003): requires the glTF extension EXT_mesh_gpu_instancing,"
   [[ ! -e $WORK/x.vff ]] || fail "output left behind"
+}
+
+# tet_gltf [KEY=VALUE...]: a glTF tetrahedron (mesh 'Tet' at node 0 'Body', positions in a data: URI)
+# on stdout. required=NAMES (comma-separated, JSON-quoted) lists extensionsRequired; skin=1 gives
+# node 0 a skin with joint node 1; morph=1 gives the primitive a morph target and the mesh a weight.
+tet_gltf() {
+  python3 - "$@" <<'PY'
+import base64, json, struct, sys
+opt = dict(a.split('=', 1) for a in sys.argv[1:])
+pos = [0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1]
+idx = [0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3]
+data = struct.pack('<12f', *pos) + struct.pack('<12H', *idx)
+doc = {"asset": {"version": "2.0"},
+       "buffers": [{"byteLength": len(data), "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+       "bufferViews": [{"buffer": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 24}],
+       "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1]},
+                     {"bufferView": 1, "componentType": 5123, "count": 12, "type": "SCALAR"}],
+       "meshes": [{"name": "Tet", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+       "nodes": [{"name": "Body", "mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0}
+if opt.get("required"):
+    names = json.loads("[" + opt["required"] + "]")
+    doc["extensionsUsed"] = doc["extensionsRequired"] = names
+if opt.get("skin") == "1":
+    doc["nodes"][0]["skin"] = 0
+    doc["nodes"].append({"name": "Root"})
+    doc["scenes"][0]["nodes"].append(1)
+    doc["skins"] = [{"joints": [1]}]
+if opt.get("morph") == "1":
+    doc["meshes"][0]["primitives"][0]["targets"] = [{"POSITION": 0}]
+    doc["meshes"][0]["weights"] = [0.5]
+print(json.dumps(doc))
+PY
+}
+
+# bake_tet NAME ARGS...: tet_gltf ARGS... as $WORK/NAME/t.gltf baked to $WORK/NAME/t.vff (the same file
+# name in every folder, so that the fields' metadata are the same when the geometry is).
+bake_tet() {
+  local name=$1
+  shift
+  mkdir -p "$WORK/$name"
+  tet_gltf "$@" >"$WORK/$name/t.gltf"
+  run "$VFF_BAKE" "$WORK/$name/t.gltf" -o "$WORK/$name/t.vff" -n 1 -m 8 -q
+}
+
+# Extensions that change materials or textures only (a real file: SheenCloth.glb requires
+# KHR_texture_transform) do not stop the bake: the field is the plain file's, with a warning naming
+# each extension left unread.
+test_geometry_free_extensions_bake_like_the_plain_file() {
+  bake_tet plain
+  expect_rc 0
+  expect_no_err
+  bake_tet ext 'required="KHR_texture_transform","KHR_materials_sheen","KHR_texture_basisu","EXT_texture_webp","KHR_mesh_quantization"'
+  expect_rc 0
+  local e
+  for e in KHR_texture_transform KHR_materials_sheen KHR_texture_basisu EXT_texture_webp; do
+    expect_err "vff-bake: warning: $WORK/ext/t.gltf: requires the glTF extension $e, which changes no geometry: not read"
+  done
+  [[ $(grep -c warning "$WORK/err") -eq 4 ]] || { show; fail "expected 4 warnings (none for KHR_mesh_quantization)"; }
+  cmp "$WORK/plain/t.vff" "$WORK/ext/t.vff" || fail "the file requiring material extensions bakes another field"
+}
+
+# A skinned node is baked in its bind pose (the field of the same mesh without the skin), with a
+# warning naming the node, its mesh and its skin; --split says the same.
+test_skinned_node_bakes_its_bind_pose_with_a_warning() {
+  bake_tet plain
+  bake_tet skin skin=1
+  expect_rc 0
+  expect_err "vff-bake: warning: $WORK/skin/t.gltf: node 0 'Body' (mesh 0) has skin 0: baked in its bind pose, not posed by its joints"
+  [[ $(grep -c warning "$WORK/err") -eq 1 ]] || { show; fail "expected one warning"; }
+  cmp "$WORK/plain/t.vff" "$WORK/skin/t.vff" || fail "the skinned file bakes another field than its bind pose"
+  run "$VFF_BAKE" "$WORK/skin/t.gltf" --split node -o "$WORK/skin/s.vffscene.json" -n 1 -m 8 -q
+  expect_rc 0
+  expect_err "vff-bake: warning: $WORK/skin/t.gltf: node 0 'Body' (mesh 0) has skin 0: baked in its bind pose"
+}
+
+# A mesh with morph targets is baked as its base shape, with a warning naming the mesh.
+test_morph_targets_bake_the_base_shape_with_a_warning() {
+  bake_tet plain
+  bake_tet morph morph=1
+  expect_rc 0
+  expect_err "vff-bake: warning: $WORK/morph/t.gltf: mesh 0 'Tet' has morph targets: baked as its base shape, its weights not applied"
+  [[ $(grep -c warning "$WORK/err") -eq 1 ]] || { show; fail "expected one warning"; }
+  cmp "$WORK/plain/t.vff" "$WORK/morph/t.vff" || fail "the morphed file bakes another field than its base shape"
 }
 
 # The supported extensions pass the check: this file then fails on its missing data, as invalid

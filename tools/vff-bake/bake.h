@@ -40,7 +40,8 @@ std::string meshMetadata(const Options& o, const bake::BakeOptions& bo, const ba
                          const bake::MeshInfo& info, bool clipped, const nlohmann::json& gltf = nullptr);
 // Reports an error of loading `input`; returns the exit code (a scene the file lacks: usage, 1).
 int reportLoadError(const Error& e, const std::string& input);
-// The note that a glTF file has scenes this run does not bake (not with --quiet).
+// The note that a glTF file has scenes this run does not bake (not with --quiet), and the warnings
+// of MeshInfo::gltfNotes (always).
 void noteUnbakedScenes(const Options& o, const bake::MeshInfo& info);
 
 }  // namespace vff::bake_tool

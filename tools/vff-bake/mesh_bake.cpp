@@ -63,7 +63,7 @@ struct Measures {
 // The --benchmark table on stdout.
 void printBenchmark(const Options& o, const bake::Mesh& mesh, const FieldDesc& field, double rays, const Measures& m,
                     double payloadMiB, double meshMiB, double bvhMiB) {
-  std::printf("mesh            %s: %zu triangles\n", o.mesh.c_str(), mesh.triangleCount());
+  std::printf("mesh            %s: %s\n", o.mesh.c_str(), cli::count(mesh.triangleCount(), "triangle").c_str());
   std::printf("rays            %u maps x %ux%u = %.0f rays, %u threads\n", field.mapCount, field.mapResolution,
               field.mapResolution, rays, parallel::resolveThreads(o.threads));
   std::printf("embree raw      %8.3f s  %7.2f Mrays/s   (rtcIntersect16, same rays, nothing stored)\n", m.raw,
@@ -166,6 +166,10 @@ int reportLoadError(const Error& e, const std::string& input) {
 }
 
 void noteUnbakedScenes(const Options& o, const bake::MeshInfo& info) {
+  // What the bake leaves out of a glTF file (geometry-free extensions, skins, morph targets) is a
+  // warning, printed even with --quiet: the field is not what an engine showing the file animates.
+  for (const std::string& note : info.gltfNotes)
+    std::fprintf(stderr, "%s: warning: %s: %s\n", kProg, o.mesh.c_str(), note.c_str());
   if (o.quiet || info.gltfScenes.size() < 2) return;
   std::string others;
   for (size_t i = 0; i < info.gltfScenes.size(); ++i) {

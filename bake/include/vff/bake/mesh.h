@@ -9,9 +9,14 @@
 //   kIoOpen          the file is missing or unreadable
 //   kMeshFormat      unknown extension
 //   kMeshParse       the importer cannot parse the file
-//   kMeshUnsupported points/lines primitives, a required glTF extension other than
-//                    KHR_mesh_quantization, KHR_draco_mesh_compression and EXT_meshopt_compression,
-//                    attribute types those do not allow, sparse accessors
+//   kMeshUnsupported points/lines primitives, a required glTF extension that changes geometry
+//                    other than KHR_mesh_quantization, KHR_draco_mesh_compression and
+//                    EXT_meshopt_compression (one that changes no geometry: materials, textures,
+//                    lights, is left unread and listed in MeshInfo::gltfNotes), attribute types
+//                    those do not allow, sparse accessors
+// What a glTF file animates is not baked: a skinned mesh is baked in its bind pose (the vertices as
+// stored, under the node's transform), a mesh with morph targets as its base shape; MeshInfo::gltfNotes
+// names each one, for the tools to print as warnings.
 //   kMeshIndex       an index or an accessor outside its buffer
 //   kMeshEmpty       no triangles; kMeshNonFinite a NaN/Inf coordinate (message names the vertex);
 //   kMeshDegenerate  every triangle has zero area
@@ -40,6 +45,10 @@ struct MeshInfo {
   // no scene and every mesh was loaded untransformed).
   std::vector<std::string> gltfScenes;
   int gltfScene = -1;
+  // glTF: what the bake leaves out, one sentence each (no file name): required extensions that
+  // change no geometry ("requires KHR_texture_transform, which changes no geometry: not read"),
+  // skinned nodes baked in their bind pose, meshes with morph targets baked as their base shape.
+  std::vector<std::string> gltfNotes;
 };
 
 struct MeshLoadOptions {
