@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <future>
@@ -37,7 +38,16 @@ uint32_t defaultCount(PositionScheme s) {
   }
 }
 
-// vff-bake's options, from keyword arguments spelled as its long options (--map-size: map_size).
+// The largest map_size, as vff-bake's -m: a field with larger maps exceeds the readers' default
+// ReadOptions::maxMapResolution, so that vff.open and every tool would refuse the file it made.
+constexpr int64_t kMaxBakeMapSize = 4096;
+
+// A count without an upper bound of its own, as the option's u32 (larger ones become the largest,
+// which the baker or writer then refuses with its own reason).
+uint32_t u32(int64_t v) { return uint32_t(std::min<int64_t>(v, UINT32_MAX)); }
+
+// vff-bake's options, from keyword arguments spelled as its long options (--map-size: map_size),
+// with its ranges (a ValueError naming the argument and its range, as vff-bake's usage errors).
 struct Options {
   bake::BakeOptions bake;
   WriteOptions write;
@@ -54,22 +64,22 @@ Options optionsOf(const py::kwargs& kw) {
   for (auto [k, v] : kw) {
     const std::string key = py::str(k);
     if (key == "positions") positions = v.cast<std::string>();
-    else if (key == "count") count = v.cast<uint32_t>();
-    else if (key == "map_size") o.bake.mapResolution = v.cast<uint32_t>();
+    else if (key == "count") count = u32(intArg(v, "count", 0, -1, " (0: the scheme's default)"));
+    else if (key == "map_size") o.bake.mapResolution = uint32_t(intArg(v, "map_size", 1, kMaxBakeMapSize));
     else if (key == "directions") directions = v.cast<std::string>();
     else if (key == "encoding") encoding = v.cast<std::string>();
     else if (key == "normals") o.bake.normals = v.cast<bool>();
-    else if (key == "threads") o.bake.threads = v.cast<unsigned>();
+    else if (key == "threads") o.bake.threads = u32(intArg(v, "threads", 0, -1, " (0: all cores)"));
     else if (key == "center") center = v.cast<std::vector<float>>();
     else if (key == "radius") radius = v.cast<float>();
     else if (key == "codec") codec = v.cast<std::string>();
-    else if (key == "zstd_level") o.write.zstdLevel = v.cast<int>();
-    else if (key == "maps_per_block") o.write.mapsPerBlock = v.cast<uint32_t>();
+    else if (key == "zstd_level") o.write.zstdLevel = int(intArg(v, "zstd_level", 1, 22));
+    else if (key == "maps_per_block") o.write.mapsPerBlock = u32(intArg(v, "maps_per_block", 0, -1, " (0: about 256 KiB per block)"));
     else if (key == "filter") filter = v.cast<std::string>();
     else if (key == "target") target = v.cast<std::string>();
-    else if (key == "max_texture_size") o.write.layout.maxTextureSize = v.cast<uint32_t>();
-    else if (key == "max_layers") o.write.layout.maxLayers = v.cast<uint32_t>();
-    else if (key == "gutter") o.write.layout.gutter = v.cast<uint32_t>();
+    else if (key == "max_texture_size") o.write.layout.maxTextureSize = uint32_t(intArg(v, "max_texture_size", 1, 65536));
+    else if (key == "max_layers") o.write.layout.maxLayers = uint32_t(intArg(v, "max_layers", 1, 65536));
+    else if (key == "gutter") o.write.layout.gutter = uint32_t(intArg(v, "gutter", 0, 64));
     else if (key == "metadata") o.write.metadataJson = py::module_::import("json").attr("dumps")(v).cast<std::string>();
     else if (key == "progress") o.progress = py::reinterpret_borrow<py::object>(v);
     else throw py::type_error("bake: unexpected keyword argument '" + key + "'");
@@ -186,14 +196,16 @@ std::shared_ptr<PyFile> finish(const bake::BakedField& baked, const Options& o, 
 
 constexpr const char* kOptionsDoc = R"doc(
 Keyword arguments (vff-bake's options): positions ("octa-hemi2", "ea-octa-grid", "fibonacci"),
-count (the scheme's n; 0: its default, 4226 maps), map_size (M, 64), directions ("concentric",
+count (the scheme's n; 0: its default, 4226 maps), map_size (M in [1, 4096], 64), directions ("concentric",
 "hemi-oct"), encoding ("unorm8-diameter", "unorm8-chord", "unorm16-diameter", "bit1",
 "bc4-diameter"), normals (False), threads (0: all cores; the output does not depend on it), center
 and radius (the bounding sphere; default the minimal enclosing one), codec ("stored", "zstd"),
-zstd_level (19), maps_per_block (0: about 256 KiB per block), filter ("none", "hits-med"), target
-("2d-array", "3d"), max_texture_size (2048), max_layers (2048), gutter (0), metadata (a dict
+zstd_level (1 to 22, 19), maps_per_block (0: about 256 KiB per block), filter ("none", "hits-med"),
+target ("2d-array", "3d"), max_texture_size (1 to 65536, 2048), max_layers (1 to 65536, 2048), gutter
+(0 to 64, 0), metadata (a dict
 stored as META), progress (a callable taking (maps done, maps total), called on the calling thread).
-Ctrl-C stops the bake (KeyboardInterrupt); a mesh problem raises vff.MeshError.)doc";
+An integer outside its range (vff-bake's: map_size=0, threads=-1) raises ValueError naming it and
+the range. Ctrl-C stops the bake (KeyboardInterrupt); a mesh problem raises vff.MeshError.)doc";
 
 }  // namespace
 
@@ -216,6 +228,10 @@ Writes it to `out` (atomically) when given; returns the field as a vff.File (in 
           return bake::loadMesh(path, &info);
         }();
         const bake::Mesh loaded = take(std::move(mesh));
+        // What the bake leaves out of a glTF file (extensions that change no geometry, skins, morph
+        // targets): vff-bake's warnings, as Python warnings.
+        for (const std::string& note : info.gltfNotes)
+          if (PyErr_WarnEx(PyExc_UserWarning, (path + ": " + note).c_str(), 1) != 0) throw py::error_already_set();
         if (o.write.metadataJson.empty()) {
           const size_t slash = path.find_last_of('/');
           o.write.metadataJson = nlohmann::json{{"vff.generator", "vff (Python)"}, {"vff.generatorVersion", kLibraryVersion},
@@ -228,7 +244,9 @@ Writes it to `out` (atomically) when given; returns the field as a vff.File (in 
       py::arg("path"), py::arg("out"),
       (std::string(R"doc(
 Bakes the mesh file at `path` (.obj, .ply, .off, .stl, .gltf, .glb) into the .vff file `out`, as
-vff-bake does; returns the written file opened.)doc") + kOptionsDoc).c_str());
+vff-bake does; returns the written file opened. What vff-bake warns about in a glTF file (a required
+extension that changes no geometry and is not read, a skinned node baked in its bind pose, a mesh
+with morph targets baked as its base shape) is a UserWarning naming the file.)doc") + kOptionsDoc).c_str());
 }
 
 }  // namespace vff::python

@@ -6,7 +6,9 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
+#include <cstdint>
 #include <cmath>
 #include <cstring>
 #include <optional>
@@ -121,6 +123,31 @@ struct RayBatch {
   }
 };
 
+// Why vff-query would refuse the ray (tools/vff-query/rays.cpp, in the same words), or nothing: an
+// origin or direction that is not finite, a zero direction, a NaN bound, tmin > tmax. Python refuses
+// the same rays (a ValueError), so that a batch and the command answer the same rays or none.
+inline std::optional<std::string> rayProblem(const Ray& r) {
+  const float v[6] = {r.origin.x, r.origin.y, r.origin.z, r.direction.x, r.direction.y, r.direction.z};
+  for (int k = 0; k < 6; ++k)
+    if (!std::isfinite(v[k])) return std::string(k < 3 ? "the origin" : "the direction") + " is not finite";
+  if (v[3] == 0 && v[4] == 0 && v[5] == 0) return "the direction is zero";
+  if (std::isnan(r.tmin) || std::isnan(r.tmax)) return "tmin or tmax is NaN";
+  if (r.tmin > r.tmax) return "tmin is greater than tmax";
+  return std::nullopt;
+}
+// rayProblem(r) finds nothing: the test alone, for every ray of a batch.
+inline bool rayIsGood(const Ray& r) {
+  bool finite = std::isfinite(r.origin.x) & std::isfinite(r.origin.y) & std::isfinite(r.origin.z) &
+                std::isfinite(r.direction.x) & std::isfinite(r.direction.y) & std::isfinite(r.direction.z);
+  return finite && (r.direction.x != 0 || r.direction.y != 0 || r.direction.z != 0) &&
+         r.tmin <= r.tmax;  // (false for a NaN bound)
+}
+// A one-ray call's ray, or a ValueError saying what is wrong with it.
+inline Ray checkedRay(const Ray& r) {
+  if (auto p = rayProblem(r)) throw py::value_error("ray: " + *p);
+  return r;
+}
+
 // The RayOrigin named by `origin`: "on-object" or "off-object" (a ValueError otherwise).
 inline RayOrigin rayOriginOf(const std::string& name) {
   if (name == "on-object") return RayOrigin::kOnObject;
@@ -128,8 +155,41 @@ inline RayOrigin rayOriginOf(const std::string& name) {
   throw py::value_error("ray_origin: expected 'on-object' or 'off-object', got '" + name + "'");
 }
 
+// (threads is taken as any integer so that a negative one is a ValueError naming it, not pybind11's
+// "incompatible function arguments".)
+// Raises a ValueError for the first bad ray of the batch ("ray 12: the direction is zero"), before
+// anything is answered (an out= array keeps its answers). A pass over the rays of its own, on the
+// batch's threads without the GIL: the answers would be lost anyway, and a pass that only reads
+// the arrays adds little to one that also answers them.
+inline void checkRays(const RayBatch& b) {
+  std::atomic<size_t> firstBad{SIZE_MAX};
+  {
+    py::gil_scoped_release unlocked;
+    std::vector<std::vector<Ray>> buffers(vff::parallel::workerCount(b.n, kChunk, b.threads));
+    vff::parallel::parallelForWorkers(b.n, kChunk, b.threads, [&](unsigned w, size_t first, size_t end) {
+      std::vector<Ray>& rays = buffers[w];
+      rays.resize(std::min(kChunk, b.n));
+      b.fill(first, end - first, rays.data());
+      for (size_t k = 0; k < end - first; ++k) {
+        if (rayIsGood(rays[k])) continue;
+        size_t seen = firstBad.load(std::memory_order_relaxed);
+        while (first + k < seen && !firstBad.compare_exchange_weak(seen, first + k, std::memory_order_relaxed)) {
+        }
+        break;
+      }
+    });
+  }
+  const size_t bad = firstBad.load();
+  if (bad == SIZE_MAX) return;
+  Ray r;
+  b.fill(bad, 1, &r);
+  throw py::value_error("ray " + std::to_string(bad) + ": " + rayProblem(r).value_or("refused"));
+}
+
 inline RayBatch batchOf(const py::object& origins, const py::object& directions, const py::object& tmin,
-                 const py::object& tmax, bool interpolated, float intraBias, const std::string& rayOrigin, unsigned threads) {
+                 const py::object& tmax, bool interpolated, float intraBias, const std::string& rayOrigin, int64_t threads) {
+  if (threads < 0 || threads > int64_t(UINT32_MAX))
+    throw py::value_error("threads: expected an integer >= 0 (0: all cores), got " + std::to_string(threads));
   py::array o = vectors(origins, "origins"), d = vectors(directions, "directions");
   if (o.shape(0) != d.shape(0))
     throw py::value_error("origins and directions differ in length: " + std::to_string(o.shape(0)) + " and " +
@@ -146,7 +206,8 @@ inline RayBatch batchOf(const py::object& origins, const py::object& directions,
   b.options.reconstruction = interpolated ? Reconstruction::kInterpolated : Reconstruction::kNearest;
   b.options.intraBias = intraBias;
   b.options.origin = rayOriginOf(rayOrigin);
-  b.threads = vff::parallel::resolveThreads(threads);
+  b.threads = vff::parallel::resolveThreads(unsigned(threads));
+  checkRays(b);
   return b;
 }
 
@@ -298,8 +359,12 @@ a number, or a float32 array of shape (N,). interpolated: the miss-aware blend i
 paper's nearest lookup. ray_origin: where rays that start inside a bounding sphere start, 'on-object' (on
 the object's own surface: spec/geometry.md section 7.3, the default) or 'off-object' (the ground under
 it, another object: section 7.4, which keeps contact shadows at short ranges). intra_bias: for
-'on-object' rays, a fraction of R (negative: the field's default). threads: 0 for all cores; the
-answers do not depend on it. The GIL is released.)doc";
+'on-object' rays, a fraction of R (negative: the field's default). threads: an integer >= 0, 0 for all
+cores; the answers do not depend on it. The GIL is released.
+Rays are checked as vff-query checks them, before any is answered: an origin or direction that is not
+finite, a zero direction, a NaN bound or tmin > tmax raises ValueError naming the first such ray
+("ray 12: the direction is zero"; out is left as it was). To answer the good rays of such a batch,
+select them first: ok = np.isfinite(o).all(1) & np.isfinite(d).all(1) & d.any(1).)doc";
 
 
 inline RigidTransform transformOf(const py::object& rotation, const py::object& translation, float scale) {

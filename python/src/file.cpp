@@ -59,11 +59,19 @@ py::array viewOf(py::object owner, const MapShape& ms, const uint8_t* data, std:
   return a;
 }
 
-py::array mapArray(const std::shared_ptr<PyFile>& self, uint32_t map, const std::string& plane) {
+// A map index given from Python (any integer, so that -1 is this error rather than pybind11's
+// "incompatible function arguments"), or an IndexError naming the range.
+uint32_t mapIndex(const File& f, int64_t map) {
+  const uint32_t n = f.field().mapCount;
+  if (map < 0 || map >= int64_t(n))
+    throw py::index_error("index: map " + std::to_string(map) + " out of range [0, " + std::to_string(int64_t(n) - 1) +
+                          "]: the field has " + std::to_string(n) + " map" + (n == 1 ? "" : "s"));
+  return uint32_t(map);
+}
+
+py::array mapArray(const std::shared_ptr<PyFile>& self, int64_t index, const std::string& plane) {
   const Plane p = planeOf(plane);
-  if (map >= self->file.field().mapCount)
-    throw py::index_error("map " + std::to_string(map) + " out of range: the field has " +
-                          std::to_string(self->file.field().mapCount) + " maps");
+  const uint32_t map = mapIndex(self->file, index);
   const auto bytes = take(self->file.mapData(p, map));
   const MapShape ms = mapShape(self->file, p);
   return viewOf(py::cast(self), ms, bytes.data(), ms.shape);
@@ -106,10 +114,10 @@ py::array sliceArray(const PyFile& self, uint32_t slice, const std::string& plan
 }
 
 // The decoded distances of one map, [j, i] for texel (i, j): NaN for a miss; bit1: 1 hit, 0 miss.
-py::array_t<float> distancesArray(const PyFile& self, uint32_t map) {
+py::array_t<float> distancesArray(const PyFile& self, int64_t index) {
   const File& f = self.file;
   const FieldDesc& d = f.field();
-  if (map >= d.mapCount) throw py::index_error("map " + std::to_string(map) + " out of range");
+  const uint32_t map = mapIndex(f, index);
   const auto bytes = take(f.mapData(Plane::kDistance, map));
   const uint32_t m = d.mapResolution;
   py::array_t<float> out({py::ssize_t(m), py::ssize_t(m)});
@@ -125,10 +133,10 @@ py::array_t<float> distancesArray(const PyFile& self, uint32_t map) {
 }
 
 // The decoded normals of one map, [j, i, xyz]: NaN where the distance is a miss.
-py::array_t<float> normalsArray(const PyFile& self, uint32_t map) {
+py::array_t<float> normalsArray(const PyFile& self, int64_t index) {
   const File& f = self.file;
   const FieldDesc& d = f.field();
-  if (map >= d.mapCount) throw py::index_error("map " + std::to_string(map) + " out of range");
+  const uint32_t map = mapIndex(f, index);
   if (!f.hasNormals()) raise(makeError(Code::kPlanePresence, "the field has no normal plane"));
   const auto dist = take(f.mapData(Plane::kDistance, map));
   const auto norm = take(f.mapData(Plane::kNormal, map));

@@ -35,7 +35,7 @@ py::tuple sitesBatch(const Target& target, const RayBatch& b) {
 template <class Py, class Get>
 void addQueries(py::class_<Py>& c, Get get) {
   c.def("intersect", [get](const Py& self, const py::object& o, const py::object& d, const py::object& tmin, const py::object& tmax,
-                           bool interpolated, float intraBias, const std::string& rayOrigin, unsigned threads, const py::object& out) {
+                           bool interpolated, float intraBias, const std::string& rayOrigin, int64_t threads, const py::object& out) {
         return intersectBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, intraBias, rayOrigin, threads), out);
       },
       py::arg("origins"), py::arg("directions"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(), py::kw_only(),
@@ -45,14 +45,14 @@ void addQueries(py::class_<Py>& c, Get get) {
                                 "earlier call of the same length, filled again instead of new arrays (fresh arrays "
                                 "cost the first touch of their memory; a loop over batches saves it).").c_str());
   c.def("occluded", [get](const Py& self, const py::object& o, const py::object& d, const py::object& tmin, const py::object& tmax,
-                          bool interpolated, float intraBias, const std::string& rayOrigin, unsigned threads) {
+                          bool interpolated, float intraBias, const std::string& rayOrigin, int64_t threads) {
         return occludedBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, intraBias, rayOrigin, threads));
       },
       py::arg("origins"), py::arg("directions"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(), py::kw_only(),
       py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("threads") = 0u,
       (std::string(kBatchDoc) + "\nReturns an (N,) bool array: the ray hits the object within [tmin, tmax].").c_str());
   c.def("visibility", [get](const Py& self, const py::object& o, const py::object& d, const py::object& tmin, const py::object& tmax,
-                            bool interpolated, float intraBias, const std::string& rayOrigin, unsigned threads) {
+                            bool interpolated, float intraBias, const std::string& rayOrigin, int64_t threads) {
         return visibilityBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, intraBias, rayOrigin, threads));
       },
       py::arg("origins"), py::arg("directions"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(), py::kw_only(),
@@ -60,7 +60,7 @@ void addQueries(py::class_<Py>& c, Get get) {
       (std::string(kBatchDoc) + "\nReturns an (N,) float32 array: the probability that each ray reaches tmax unoccluded "
                                 "(0 or 1 with nearest).").c_str());
   c.def("sites", [get](const Py& self, const py::object& o, const py::object& d, const py::object& tmin, const py::object& tmax,
-                       bool interpolated, float intraBias, const std::string& rayOrigin, unsigned threads) {
+                       bool interpolated, float intraBias, const std::string& rayOrigin, int64_t threads) {
         return sitesBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, intraBias, rayOrigin, threads));
       },
       py::arg("origins"), py::arg("directions"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(), py::kw_only(),
@@ -72,20 +72,20 @@ void addQueries(py::class_<Py>& c, Get get) {
                                 "its blend on it.").c_str());
   c.def("intersect_ray", [get](const Py& self, const py::object& o, const py::object& d, float tmin, float tmax, bool interpolated,
                                float intraBias, const std::string& rayOrigin) {
-        return hitTuple(get(self).intersect(Ray{vec3(o, "origin"), vec3(d, "direction"), tmin, tmax}, optionsOf(interpolated, intraBias, rayOrigin)));
+        return hitTuple(get(self).intersect(checkedRay(Ray{vec3(o, "origin"), vec3(d, "direction"), tmin, tmax}), optionsOf(interpolated, intraBias, rayOrigin)));
       },
       py::arg("origin"), py::arg("direction"), py::arg("tmin") = 0.0f, py::arg("tmax") = std::numeric_limits<float>::infinity(),
       py::kw_only(), py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object",
       "One ray, through libvff's one-ray call: (hit, t, point, normal, inside) with point and normal as (x, y, z) tuples.");
   c.def("occluded_ray", [get](const Py& self, const py::object& o, const py::object& d, float tmin, float tmax, bool interpolated,
                               float intraBias, const std::string& rayOrigin) {
-        return get(self).occluded(Ray{vec3(o, "origin"), vec3(d, "direction"), tmin, tmax}, optionsOf(interpolated, intraBias, rayOrigin));
+        return get(self).occluded(checkedRay(Ray{vec3(o, "origin"), vec3(d, "direction"), tmin, tmax}), optionsOf(interpolated, intraBias, rayOrigin));
       },
       py::arg("origin"), py::arg("direction"), py::arg("tmin") = 0.0f, py::arg("tmax") = std::numeric_limits<float>::infinity(),
       py::kw_only(), py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", "One ray: libvff's one-ray occluded().");
   c.def("visibility_ray", [get](const Py& self, const py::object& o, const py::object& d, float tmin, float tmax, bool interpolated,
                                 float intraBias, const std::string& rayOrigin) {
-        return get(self).visibility(Ray{vec3(o, "origin"), vec3(d, "direction"), tmin, tmax}, optionsOf(interpolated, intraBias, rayOrigin));
+        return get(self).visibility(checkedRay(Ray{vec3(o, "origin"), vec3(d, "direction"), tmin, tmax}), optionsOf(interpolated, intraBias, rayOrigin));
       },
       py::arg("origin"), py::arg("direction"), py::arg("tmin") = 0.0f, py::arg("tmax") = std::numeric_limits<float>::infinity(),
       py::kw_only(), py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", "One ray: libvff's one-ray visibility().");

@@ -129,7 +129,7 @@ T sceneRay(const PyScene& self, const Ray& ray, const QueryOptions& qo, const py
 void addSceneQueries(py::class_<PyScene>& c) {
   c.def("intersect", [](const PyScene& self, const py::object& o, const py::object& d, const py::object& tmin,
                         const py::object& tmax, bool interpolated, float intraBias, const std::string& rayOrigin,
-                        const py::object& sources, unsigned threads, const py::object& out) {
+                        const py::object& sources, int64_t threads, const py::object& out) {
         const Scene& scene = committedScene(self);
         const RayBatch b = batchOf(o, d, tmin, tmax, interpolated, intraBias, rayOrigin, threads);
         const std::vector<uint32_t> src = sourcesOf(sources, scene, b.n);
@@ -143,7 +143,7 @@ void addSceneQueries(py::class_<PyScene>& c) {
                                 "length, filled again. Raises vff.OperationError (bad-state) before a commit().").c_str());
   c.def("occluded", [](const PyScene& self, const py::object& o, const py::object& d, const py::object& tmin,
                        const py::object& tmax, bool interpolated, float intraBias, const std::string& rayOrigin,
-                       const py::object& sources, unsigned threads) {
+                       const py::object& sources, int64_t threads) {
         const Scene& scene = committedScene(self);
         const RayBatch b = batchOf(o, d, tmin, tmax, interpolated, intraBias, rayOrigin, threads);
         const std::vector<uint32_t> src = sourcesOf(sources, scene, b.n);
@@ -154,7 +154,7 @@ void addSceneQueries(py::class_<PyScene>& c) {
       (std::string(kBatchDoc) + kSourcesDoc + "\nReturns an (N,) bool array: some instance reports the ray occluded.").c_str());
   c.def("visibility", [](const PyScene& self, const py::object& o, const py::object& d, const py::object& tmin,
                        const py::object& tmax, bool interpolated, float intraBias, const std::string& rayOrigin,
-                       const py::object& sources, unsigned threads) {
+                       const py::object& sources, int64_t threads) {
         const Scene& scene = committedScene(self);
         const RayBatch b = batchOf(o, d, tmin, tmax, interpolated, intraBias, rayOrigin, threads);
         const std::vector<uint32_t> src = sourcesOf(sources, scene, b.n);

@@ -1,5 +1,5 @@
 # Type stubs of the vff package (the extension vff._vff and vff._errors).
-from typing import Any, Callable, Iterator, NamedTuple, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Iterator, Literal, NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -61,6 +61,8 @@ class File:
     partial: Optional[Tuple[Optional[int], Optional[int]]]
     def describe(self) -> dict[str, Any]: ...
     def validate(self, decode_blocks: bool = True) -> list[Problem]: ...
+    # map, distances, normals: index in [0, map_count - 1]; another integer (-1 too) raises IndexError
+    # naming the range.
     def map(self, index: int, plane: str = "distance") -> np.ndarray: ...
     def maps(self, plane: str = "distance") -> np.ndarray: ...
     def distances(self, index: int) -> npt.NDArray[np.float32]: ...
@@ -89,24 +91,27 @@ HitTuple = Tuple[bool, float, Tuple[float, float, float], Tuple[float, float, fl
 class _BatchQueries:
     # The batch queries of FieldQuery, Instance and Scene (a stub's base class only: at run time each
     # class defines its own).
+    # Rays are checked as vff-query checks them, before any is answered: an origin or direction that
+    # is not finite, a zero direction, a NaN tmin or tmax, or tmin > tmax raises ValueError naming the
+    # first such ray ("ray 12: the direction is zero"); `out` is then left as it was. To answer the
+    # good rays of a batch that has bad ones, select them first:
+    #   ok = np.isfinite(o).all(1) & np.isfinite(d).all(1) & d.any(1)
+    # threads: an integer >= 0 (0: all cores); a negative one raises ValueError.
     def intersect(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
                   tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object",
-XX_origin: RayOrigin = "on-object",
                   threads: int = 0, out: Optional[Hits] = None) -> Hits: ...
     def occluded(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
                  tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object",
-XX_origin: RayOrigin = "on-object",
                  threads: int = 0) -> npt.NDArray[np.bool_]: ...
     def visibility(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
                    tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object",
-XX_origin: RayOrigin = "on-object",
                    threads: int = 0) -> npt.NDArray[np.float32]: ...
 
 class _Queries(_BatchQueries):
     def sites(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
               tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object",
-XX_origin: RayOrigin = "on-object",
               threads: int = 0) -> Tuple[npt.NDArray[np.int32], npt.NDArray[np.int32]]: ...
+    # The one-ray calls refuse the same rays as the batches (ValueError "ray: the direction is zero").
     def intersect_ray(self, origin: Vec3, direction: Vec3, tmin: float = 0.0, tmax: float = ..., *,
                       interpolated: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object") -> HitTuple: ...
     def occluded_ray(self, origin: Vec3, direction: Vec3, tmin: float = 0.0, tmax: float = ..., *,
@@ -173,6 +178,9 @@ class Scene:
 
 def load_scene(path: str, checksums: str = "all") -> Scene: ...
 
+# bake and bake_file take vff-bake's options with its ranges: map_size 1 to 4096, count >= 0 (0: the
+# scheme's default), threads >= 0, zstd_level 1 to 22, max_texture_size and max_layers 1 to 65536,
+# gutter 0 to 64; an integer outside its range raises ValueError naming the option and the range.
 def bake(vertices: npt.ArrayLike, faces: npt.ArrayLike, out: Optional[str] = None, *,
          progress: Optional[Callable[[int, int], Any]] = None, **options: Any) -> File: ...
 def bake_file(path: str, out: str, *, progress: Optional[Callable[[int, int], Any]] = None, **options: Any) -> File: ...

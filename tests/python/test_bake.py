@@ -129,3 +129,52 @@ def test_bake_stops_on_ctrl_c_and_on_callback_errors():
 
     with pytest.raises(RuntimeError, match="enough after"):
         vff.bake(v, f, count=48, map_size=64, progress=stop)
+
+
+def test_bake_integer_options_out_of_range_name_their_range():
+    # vff-bake's ranges (-m 1..4096, -j >= 0, ...), as ValueErrors naming the option, before anything
+    # is baked; a non-integer is a TypeError.
+    v, f = uv_sphere(rings=4, segments=8)
+    cases = [({"map_size": 0}, r"map_size: expected an integer in \[1, 4096\], got 0"),
+             ({"map_size": 4097}, r"map_size: expected an integer in \[1, 4096\], got 4097"),
+             ({"threads": -1}, r"threads: expected an integer >= 0 \(0: all cores\), got -1"),
+             ({"count": -1}, r"count: expected an integer >= 0 \(0: the scheme's default\), got -1"),
+             ({"zstd_level": 0}, r"zstd_level: expected an integer in \[1, 22\], got 0"),
+             ({"gutter": 65}, r"gutter: expected an integer in \[0, 64\], got 65"),
+             ({"max_layers": 0}, r"max_layers: expected an integer in \[1, 65536\], got 0")]
+    for kw, message in cases:
+        with pytest.raises(ValueError, match="^" + message + "$"):
+            vff.bake(v, f, **{"count": 2, "map_size": 8, **kw})
+    with pytest.raises(ValueError, match=r"^map_size: expected an integer in \[1, 4096\], got 0$"):
+        vff.bake_file("/nonexistent/mesh.obj", "/nonexistent/out.vff", map_size=0)
+    with pytest.raises(TypeError, match="^map_size: expected an integer, got float$"):
+        vff.bake(v, f, map_size=8.5)
+    assert vff.bake(v, f, count=1, map_size=4, threads=1).map_resolution == 4
+
+
+def test_bake_file_warns_what_a_gltf_loses(tmp_path):
+    # A tetrahedron that requires a material extension and whose node has a skin: baked, with
+    # vff-bake's warnings as UserWarnings naming the file.
+    import base64
+    import json
+    data = np.array([0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1], np.float32).tobytes() + \
+        np.array([0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3], np.uint16).tobytes()
+    doc = {"asset": {"version": "2.0"}, "extensionsUsed": ["KHR_texture_transform"],
+           "extensionsRequired": ["KHR_texture_transform"],
+           "buffers": [{"byteLength": len(data),
+                        "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+           "bufferViews": [{"buffer": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 24}],
+           "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+                          "min": [0, 0, 0], "max": [1, 1, 1]},
+                         {"bufferView": 1, "componentType": 5123, "count": 12, "type": "SCALAR"}],
+           "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+           "nodes": [{"name": "Body", "mesh": 0, "skin": 0}, {"name": "Root"}], "skins": [{"joints": [1]}],
+           "scenes": [{"nodes": [0, 1]}], "scene": 0}
+    path = tmp_path / "t.gltf"
+    path.write_text(json.dumps(doc))
+    with pytest.warns(UserWarning) as record:
+        field = vff.bake_file(str(path), str(tmp_path / "t.vff"), count=1, map_size=8)
+    assert [str(w.message) for w in record] == [
+        str(path) + ": requires the glTF extension KHR_texture_transform, which changes no geometry: not read",
+        str(path) + ": node 0 'Body' (mesh 0) has skin 0: baked in its bind pose, not posed by its joints"]
+    assert field.map_count == 10 and field.map_resolution == 8

@@ -206,3 +206,82 @@ def test_large_batches_own_their_arrays():
     occ = q.occluded(o, d)
     assert vis.shape == (120000,) and vis.dtype == np.float32 and occ.dtype == np.bool_
     assert np.array_equal(occ, keep[2]) and np.array_equal(vis == 0, keep[2])
+
+
+def npy_bytes(*columns):
+    buf = io.BytesIO()
+    np.save(buf, np.hstack(columns).astype(np.float32))
+    return buf.getvalue()
+
+
+def test_bad_rays_raise_like_vff_query():
+    # One rule for the batch and the command (python/vff/__init__.pyi, tools/vff-query/README.md): a
+    # ray with a non-finite origin or direction, a zero direction, a NaN bound or tmin > tmax is
+    # refused, naming the first one, and nothing is answered.
+    path = VECTORS / "valid" / "u8d-stored.vff"
+    f = vff.open(str(path))
+    q = vff.FieldQuery(f)
+    inst = vff.Instance(q, translation=(1, 2, 3))
+    o, d = rays_around(f.center, f.radius, 40000, 31)
+    tmin, tmax = np.zeros(40000, np.float32), np.full(40000, np.inf, np.float32)
+    cases = []  # (origins, directions, tmin, tmax, message)
+    bad_d = d.copy()
+    bad_d[33000] = 0
+    cases.append((o, bad_d, tmin, tmax, "ray 33000: the direction is zero"))
+    bad_o = o.copy()
+    bad_o[20001, 1] = np.nan
+    bad_o[39000, 0] = np.inf
+    cases.append((bad_o, bad_d, tmin, tmax, "ray 20001: the origin is not finite"))
+    inf_d = d.copy()
+    inf_d[7, 2] = -np.inf
+    cases.append((o, inf_d, tmin, tmax, "ray 7: the direction is not finite"))
+    crossed = tmax.copy()
+    crossed[5] = -1
+    cases.append((o, d, tmin, crossed, "ray 5: tmin is greater than tmax"))
+    nan_min = tmin.copy()
+    nan_min[39999] = np.nan
+    cases.append((o, d, nan_min, tmax, "ray 39999: tmin or tmax is NaN"))
+    for co, cd, cmin, cmax, message in cases:
+        for target in (q, inst):
+            for call in (target.intersect, target.occluded, target.visibility, target.sites):
+                with pytest.raises(ValueError, match="^" + message + "$"):
+                    call(co, cd, cmin, cmax, threads=3)
+        # vff-query refuses the same ray: the row and the problem (exit 3, nothing written).
+        rc, out, err = vff_query(path, "--format", "npy", stdin=npy_bytes(co, cd, cmin[:, None], cmax[:, None]))
+        row, problem = message[len("ray "):].split(": ", 1)
+        assert rc == 3 and out == b"", err
+        assert "row " + row + ", column " in err and problem in err, err
+    # A scalar NaN bound names ray 0; the one-ray calls refuse the same rays.
+    with pytest.raises(ValueError, match="^ray 0: tmin or tmax is NaN$"):
+        q.intersect(o, d, tmax=float("nan"))
+    with pytest.raises(ValueError, match="^ray: the direction is zero$"):
+        q.intersect_ray((0, 0, 5), (0, 0, 0))
+    with pytest.raises(ValueError, match="^ray: the origin is not finite$"):
+        inst.occluded_ray((np.nan, 0, 5), (0, 0, -1))
+    with pytest.raises(ValueError, match="^ray: tmin is greater than tmax$"):
+        q.visibility_ray((0, 0, 5), (0, 0, -1), 2.0, 1.0)
+    # out= keeps its answers when the call is refused; the good rays alone are answered.
+    h = q.intersect(o, d)
+    keep = h.t.copy()
+    with pytest.raises(ValueError, match="^ray 6999: the direction is zero$"):  # (39999 - 33000, reversed)
+        q.intersect(o[::-1], bad_d[::-1], out=h)
+    assert np.array_equal(h.t, keep)
+    ok = np.isfinite(bad_o).all(1) & np.isfinite(bad_d).all(1) & bad_d.any(1)
+    assert ok.sum() == 40000 - 3
+    assert np.array_equal(q.intersect(bad_o[ok], bad_d[ok]).t, keep[ok])
+
+
+def test_integer_arguments_out_of_range_raise_value_errors():
+    f = vff.open(str(VECTORS / "valid" / "u8d-stored.vff"))
+    q = vff.FieldQuery(f)
+    o, d = rays_around(f.center, f.radius, 10, 32)
+    for call in (q.intersect, q.occluded, q.visibility, q.sites):
+        with pytest.raises(ValueError, match=r"^threads: expected an integer >= 0 \(0: all cores\), got -1$"):
+            call(o, d, threads=-1)
+    last = f.map_count - 1
+    for call in (f.map, f.distances):
+        for index in (-1, f.map_count):
+            with pytest.raises(IndexError, match=r"^index: map %d out of range \[0, %d\]: the field has %d maps$"
+                               % (index, last, f.map_count)):
+                call(index)
+    assert f.map(last).shape == f.map(0).shape
