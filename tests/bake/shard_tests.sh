@@ -161,6 +161,39 @@ test_inspect_counts_only_the_range() {
   expect_out '"texels": 20992,'
 }
 
+# Parts merge only with the same vff.source.geometryHash (12012), which drops exactly the triangles
+# of zero area (spec/format.md section 9, "the mesh as baked"): a repeated position, exactly
+# collinear vertices; a sliver of nonzero area is kept.
+test_geometry_hash_drops_exactly_zero_area_triangles() {
+  local tetra='v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 0 0\nv 2 0 0\nv 1 1e-30 0\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n'
+  printf "$tetra" >"$WORK/t.obj"
+  # v2 and v5 share a position; v1 v2 v6 lie on the x axis
+  printf "${tetra}f 2 5 3\nf 1 2 6\nf 6 2 1\n" >"$WORK/zero.obj"
+  # v1 v6 v7: twice 1e-30 of area, kept
+  printf "${tetra}f 1 6 7\n" >"$WORK/sliver.obj"
+  local name hash=()
+  for name in t zero sliver; do
+    bake "$WORK/$name.obj" -o "$WORK/$name.vff" "${small[@]}" --center 0 0 0 --radius 3
+    expect_rc 0
+    run "$VFF_INSPECT" "$WORK/$name.vff" --format json
+    hash+=("$(grep -o '"geometryHash": "[0-9a-f]*"' "$WORK/out")")
+    [[ -n ${hash[-1]} ]] || fail "$name.vff has no geometryHash"
+  done
+  [[ ${hash[0]} == "${hash[1]}" ]] || fail "zero-area triangles changed the geometry hash: ${hash[*]}"
+  [[ ${hash[0]} != "${hash[2]}" ]] || fail "a sliver of nonzero area was dropped"
+  run "$VFF_INSPECT" "$WORK/zero.vff" --format json
+  expect_out '"triangles": 4'
+  run "$VFF_INSPECT" "$WORK/sliver.vff" --format json
+  expect_out '"triangles": 5'
+  # so parts of the two meshes with zero-area triangles merge, and the sliver's do not
+  bake "$WORK/t.obj" -o "$WORK/a.vff" "${small[@]}" --center 0 0 0 --radius 3 --map-range 0:41
+  bake "$WORK/zero.obj" -o "$WORK/b.vff" "${small[@]}" --center 0 0 0 --radius 3 --map-range 41:82
+  bake "$WORK/sliver.obj" -o "$WORK/c.vff" "${small[@]}" --center 0 0 0 --radius 3 --map-range 41:82
+  refused 3 "c.vff: merge-geometry (12012)" "$WORK/a.vff" "$WORK/c.vff"
+  # the same geometry from another file is another bake (META vff.source.name), not other geometry
+  refused 3 "b.vff: merge-meta (12016): different bake: META vff.source" "$WORK/a.vff" "$WORK/b.vff"
+}
+
 # ---- Usage errors ------------------------------------------------------------------------------------
 test_bad_ranges_are_usage_errors() {
   knot
