@@ -47,6 +47,9 @@ test_node_partial() {
 # The spec's worked examples: hits-med, BC4, normals, positions, nearest sample, layout.
 test_node_units() { need_node; node_test test/units.test.js; }
 
+# Scene descriptions (spec/conformance/scene): web/src/scene_description.js on every vector.
+test_node_scene_description() { need_node; node_test test/scene_description.test.js; }
+
 # web/src/vff_query_es.js is exactly what web/tools/gen-glsl-es.mjs makes from gpu/glsl/vff_query.glsl.
 test_glsl_es_generated() { need_node; node_test test/glsl.test.js; }
 
