@@ -100,6 +100,12 @@ test_manifests_match_the_schema() {
   "$SCHEMA_CHECK" "$SCHEMA" "$WORK/lib/library.json" || fail "a manifest vff-library bakes does not match the schema"
   echo '{"vffLibrary": 1, "entries": [{"mesh": "a.obj", "options": {"threads": 4}}]}' >"$WORK/lib/m.json"
   ! "$SCHEMA_CHECK" "$SCHEMA" "$WORK/lib/m.json" || fail "the schema takes an option vff-library refuses"
+  # Every valid conformance vector (spec/conformance/library/valid) matches it too.
+  local v
+  for v in "$(dirname "$SCHEMA")"/conformance/library/valid/*.json; do
+    [[ $v == *.expected.json ]] && continue
+    "$SCHEMA_CHECK" "$SCHEMA" "$v" || fail "the valid vector $(basename "$v") does not match the schema"
+  done
 }
 
 test_manifest_errors() {

@@ -60,6 +60,16 @@ VALID = {
         [entry("tetra.obj", "tetra.vff", shard=10), entry("parts/wedge.obj", "parts/wedge.vff")]),
 }
 
+# name: (manifest as text, expected entries): the JSON text rules of section 1 that valid text meets.
+VALID_TEXT = {
+    "bom-and-whitespace": ('\ufeff {"vffLibrary": 1,\r\n\t"entries": [{"mesh": "te\\u0074ra.obj", "output": "\u00e9t\u00e9.vff"}]}\r\n\t ',
+                           [entry("tetra.obj", "\u00e9t\u00e9.vff")]),
+    "large-numbers": ('{"vffLibrary": 1, "shardMaps": 18446744073709551615, "entries": [{"mesh": "tetra.obj", '
+                      '"options": {"radius": 1e30, "center": [1e-400, -0.0, 5e-324]}}]}\n',
+                      [entry("tetra.obj", "tetra.vff", ["--center", "0", "-0", "4.94065646e-324", "--radius", "1e+30"],
+                             shard=18446744073709551615)]),
+}
+
 # (ID, name): (manifest as text, the path or LINE:COLUMN its message names)
 INVALID = {
     (13001, "syntax-error"): ('{"vffLibrary": 1,\n "entries": [}\n', "2:14"),
@@ -119,6 +129,9 @@ def main():
         write(root, rel, text)
     for name, (manifest, entries) in VALID.items():
         write(root, f"valid/{name}.json", json.dumps(manifest, indent=1) + "\n")
+        write(root, f"valid/{name}.expected.json", json.dumps({"exitCode": 0, "entries": entries}, indent=1) + "\n")
+    for name, (text, entries) in VALID_TEXT.items():
+        write(root, f"valid/{name}.json", text)
         write(root, f"valid/{name}.expected.json", json.dumps({"exitCode": 0, "entries": entries}, indent=1) + "\n")
     for (rid, name), (text, where) in INVALID.items():
         rule, code = RULES[rid]
