@@ -126,6 +126,23 @@ nlohmann::json dryRunJson(const std::vector<Entry>& entries, const Report& r, co
   return j;
 }
 
+// The dry run's vff-bake command of each bake (a local run's).
+void printBakeCommands(const std::vector<Entry>& entries, const std::vector<Unit>& units, const WorkerOptions& wo) {
+  for (const Unit& u : units) {
+    const Entry& e = entries[u.entry];
+    std::printf("%s %s", wo.vffBake.c_str(), e.mesh.c_str());
+    for (const auto& a : e.args) std::printf(" %s", a.c_str());
+    if (u.part())
+      std::printf(" --map-range %u:%u -o %s -j %u  # part of %s\n", u.begin, u.end,
+                  partPath(wo.cacheDir, e.key, u.begin, u.end).c_str(), wo.threads, e.output.c_str());
+    else if (!e.split.empty())
+      std::printf(" -o %s/%s -j %u  # -> %s and its fields\n", sceneCachePath(wo.cacheDir, e.key).c_str(),
+                  fs::path(e.output).filename().c_str(), wo.threads, e.output.c_str());
+    else
+      std::printf(" -o %s -j %u  # -> %s\n", cachePath(wo.cacheDir, e.key).c_str(), wo.threads, e.output.c_str());
+  }
+}
+
 int bakeLibrary(const Options& o) {
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<Entry> entries;
@@ -222,20 +239,7 @@ int bakeLibrary(const Options& o) {
     report.threadsPerWorker = o.threads ? o.threads : std::max(1u, cores / report.workers);
     wo.threads = report.threadsPerWorker;
     if (o.dryRun) {
-      for (const Unit& u : units) {
-        if (o.format == cli::OutputFormat::kJson) break;
-        const Entry& e = entries[u.entry];
-        std::printf("%s %s", wo.vffBake.c_str(), e.mesh.c_str());
-        for (const auto& a : e.args) std::printf(" %s", a.c_str());
-        if (u.part())
-          std::printf(" --map-range %u:%u -o %s -j %u  # part of %s\n", u.begin, u.end,
-                      partPath(wo.cacheDir, e.key, u.begin, u.end).c_str(), wo.threads, e.output.c_str());
-        else if (!e.split.empty())
-          std::printf(" -o %s/%s -j %u  # -> %s and its fields\n", sceneCachePath(wo.cacheDir, e.key).c_str(),
-                      fs::path(e.output).filename().c_str(), wo.threads, e.output.c_str());
-        else
-          std::printf(" -o %s -j %u  # -> %s\n", cachePath(wo.cacheDir, e.key).c_str(), wo.threads, e.output.c_str());
-      }
+      if (o.format != cli::OutputFormat::kJson) printBakeCommands(entries, units, wo);
     } else {
       report.outcomes = runPool(entries, units, wo, {.workers = report.workers, .threadsPerWorker = wo.threads,
                                                     .progress = progress});
