@@ -1,11 +1,12 @@
 // vff_fuzz_first_error FILE|FOLDER...: for each file (folders walked recursively, in sorted order),
-// what libvff makes of it, one line "PATH<TAB>error ID" or "PATH<TAB>ok HASH": the reference side
-// of the JavaScript decoder's differential test (tests/fuzz/js/differential.mjs), which computes the
-// same line with web/src and compares.
+// what libvff makes of it under each checksum policy, one line "PATH<TAB>A<TAB>B<TAB>C" (verify-all,
+// lazy, none), each "error ID" or "ok HASH": the reference side of the JavaScript decoder's
+// differential test (tests/fuzz/js/differential.mjs), which computes the same line with web/src and
+// compares. (Without verified checksums, damaged files reach the structure checks and decoders.)
 //
-// The reading is what an application does: File::openMemory (checksums verified, payload limited
-// to kMaxPayloadBytes so that a hostile header cannot make either side allocate much), then every
-// distance map in order, then every normal map. The first error ends it; its ID is printed. When
+// The reading is what an application does: File::openMemory (payload limited to kMaxPayloadBytes
+// so that a hostile header cannot make either side allocate much), then every distance map in
+// order, then every normal map. The first error ends it; its ID is printed. When
 // everything decodes, HASH is the XXH3-64 (hex) of the decoded planes: every distance map's texels
 // as little-endian float32 (the distance; 1 for a bit1 hit; the quiet NaN 0x7fc00000 for a miss),
 // then every normal map's stored bytes.
@@ -41,9 +42,10 @@ std::vector<float> texelCosines(const vff::FieldDesc& f) {
 }
 
 // "error ID" or "ok HASH" for one file's bytes.
-std::string outcome(const std::vector<uint8_t>& bytes) {
+std::string outcome(const std::vector<uint8_t>& bytes, vff::ChecksumPolicy policy) {
   vff::ReadOptions o;
   o.maxPayloadBytes = kMaxPayloadBytes;
+  o.checksums = policy;
   vff::Result<vff::File> f = vff::File::openMemory(bytes, o);
   if (!f) return "error " + std::to_string(uint32_t(f.error().code));
   const vff::FieldDesc& fd = f->field();
@@ -110,7 +112,10 @@ int main(int argc, char** argv) {
   for (const fs::path& p : files) {
     std::ifstream in(p, std::ios::binary);
     const std::vector<uint8_t> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-    std::printf("%s\t%s\n", p.c_str(), outcome(bytes).c_str());
+    std::printf("%s", p.c_str());
+    for (vff::ChecksumPolicy c : {vff::ChecksumPolicy::kVerifyAll, vff::ChecksumPolicy::kLazy, vff::ChecksumPolicy::kNone})
+      std::printf("\t%s", outcome(bytes, c).c_str());
+    std::printf("\n");
   }
   return files.empty() ? 1 : 0;
 }

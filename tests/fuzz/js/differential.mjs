@@ -1,31 +1,38 @@
-// Differential test of the JavaScript decoder (web/src) against libvff: for every input file both
-// must give the same first error ID, or decode the same values. libvff's side is the helper
-// vff_fuzz_first_error (tests/fuzz/first_error.cpp), which prints one line per file; this script
-// computes the same line with web/src and compares.
+// Differential test of the JavaScript decoder (web/src) against libvff: for every input file, under
+// each checksum policy (verify-all, lazy, none), both must give the same first error ID, or decode
+// the same values. libvff's side is the helper vff_fuzz_first_error (tests/fuzz/first_error.cpp),
+// which prints one line per file; this script computes the same line with web/src and compares.
 //
-//   node differential.mjs --helper PATH [--mutants N] [--seed S] [--show K] FILE|FOLDER...
+//   node differential.mjs --helper PATH [--policies P,...] [--mutants N] [--seed S] [--show K] [--save DIR]
+//                         FILE|FOLDER...
+//
+// --policies: the checksum policies compared (default all three). Without verified block checksums
+// (`none`) a damaged zstd frame reaches the two zstd decoders, libzstd and fzstd, which do not
+// refuse the same damaged frames (neither frame has a content checksum): tests/fuzz/README.md.
 //
 // --mutants N adds N damaged copies of every .vff file given (cut short, bytes flipped or
 // overwritten, little-endian fields set to edge values), made by a seeded generator so that a run
-// is repeatable; they live in a temporary folder removed at the end. Exit status: 0 when every file
+// is repeatable; they live in a temporary folder removed at the end. --save DIR copies every file
+// the two disagree on there. Exit status: 0 when every file
 // agrees, 1 when one disagrees (each printed with both answers), 2 on a usage or helper problem.
 import { execFileSync } from 'node:child_process';
-import { mkdtempSync, readFileSync, rmSync, statSync, writeFileSync } from 'node:fs';
+import { copyFileSync, mkdirSync, mkdtempSync, readFileSync, rmSync, statSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { basename, join } from 'node:path';
 import { initVff, openVff, xxh3Hex } from '../../../web/src/vff.js';
 
 const MAX_PAYLOAD_BYTES = 256 * 2 ** 20; // first_error.cpp's kMaxPayloadBytes
 const MISS_BITS = 0x7fc00000;
+const POLICIES = ['verify-all', 'lazy', 'none']; // first_error.cpp's order
 
 function usage(message) {
   console.error(`differential.mjs: ${message}`);
-  console.error('usage: node differential.mjs --helper PATH [--mutants N] [--seed S] [--show K] FILE|FOLDER...');
+  console.error('usage: node differential.mjs --helper PATH [--policies P,...] [--mutants N] [--seed S] [--show K] [--save DIR] FILE|FOLDER...');
   process.exit(2);
 }
 
 function parseArgs(argv) {
-  const o = { helper: null, mutants: 0, seed: 1, show: 20, inputs: [] };
+  const o = { helper: null, policies: POLICIES, mutants: 0, seed: 1, show: 20, save: null, inputs: [] };
   for (let a = 0; a < argv.length; ++a) {
     const v = argv[a];
     const next = () => {
@@ -36,11 +43,14 @@ function parseArgs(argv) {
     else if (v === '--mutants') o.mutants = Number(next());
     else if (v === '--seed') o.seed = Number(next());
     else if (v === '--show') o.show = Number(next());
+    else if (v === '--save') o.save = next();
+    else if (v === '--policies') o.policies = next().split(',');
     else if (v.startsWith('--')) usage(`unknown option ${v}`);
     else o.inputs.push(v);
   }
   if (!o.helper) usage('--helper is required');
   if (!o.inputs.length) usage('no input files or folders');
+  for (const p of o.policies) if (!POLICIES.includes(p)) usage(`unknown checksum policy ${p} (${POLICIES.join(', ')})`);
   for (const k of ['mutants', 'seed', 'show'])
     if (!Number.isInteger(o[k]) || o[k] < 0) usage(`--${k} must be a non-negative integer`);
   return o;
@@ -57,8 +67,30 @@ function rng(seed) {
   };
 }
 
-/** One damaged copy of `good`: its kind and place chosen by `r`. */
+/**
+ * Makes the header of a damaged file consistent again where it can: fileSize (offset 16) the file's
+ * length, headerChecksum (56) the XXH3-64 of bytes 0..55 and the section table (format.md section
+ * 3), so that the damage reaches the checks past the header.
+ */
+function fixHeader(b) {
+  if (b.length < 64) return b;
+  const v = new DataView(b.buffer, b.byteOffset, b.byteLength);
+  v.setBigUint64(16, BigInt(b.length), true);
+  const table = v.getBigUint64(40, true), count = BigInt(v.getUint32(48, true));
+  if (table < 64n || table + 64n * count > BigInt(b.length)) return b;
+  const t = Number(table);
+  const sum = xxh3Hex(b.subarray(0, 56), b.subarray(t, t + 64 * Number(count)));
+  v.setBigUint64(56, BigInt(`0x${sum}`), true);
+  return b;
+}
+
+/** One damaged copy of `good`: its kind and place chosen by `r`; every other one with its header fixed. */
 function mutant(good, r) {
+  const b = damaged(good, r);
+  return r(2) ? fixHeader(b) : b;
+}
+
+function damaged(good, r) {
   const n = good.length;
   // Most fields that steer the decoder sit in the header, the section table and the section and
   // plane headers, all near the start of a section: favour offsets there.
@@ -83,9 +115,9 @@ function mutant(good, r) {
 }
 
 /** What web/src makes of the bytes: "error ID" or "ok HASH", as first_error.cpp defines them. */
-export function outcome(bytes) {
+export function outcome(bytes, checksums) {
   try {
-    const file = openVff(bytes, { maxPayloadBytes: MAX_PAYLOAD_BYTES });
+    const file = openVff(bytes, { maxPayloadBytes: MAX_PAYLOAD_BYTES, checksums });
     const { mapCount, mapResolution: M } = file.field;
     const parts = [];
     for (let k = 0; k < mapCount; ++k) {
@@ -116,8 +148,8 @@ function helperLines(helper, inputs) {
   }
   const lines = out.split('\n').filter((l) => l);
   return lines.map((l) => {
-    const tab = l.lastIndexOf('\t');
-    return { path: l.slice(0, tab), cpp: l.slice(tab + 1) };
+    const cols = l.split('\t');
+    return { path: cols.slice(0, -POLICIES.length).join('\t'), cpp: cols.slice(-POLICIES.length) };
   });
 }
 
@@ -141,15 +173,25 @@ function main() {
     const count = {}, bad = [];
     for (const { path, cpp } of results) {
       if (!statSync(path).isFile()) continue;
-      const js = outcome(new Uint8Array(readFileSync(path)));
-      const kind = cpp.split(' ')[0] === 'ok' ? 'decoded' : cpp;
-      count[kind] = (count[kind] ?? 0) + 1;
-      if (js !== cpp) bad.push({ path, cpp, js });
+      const bytes = new Uint8Array(readFileSync(path));
+      POLICIES.forEach((policy, k) => {
+        if (!o.policies.includes(policy)) return;
+        const js = outcome(bytes, policy);
+        const kind = `${policy} ${cpp[k].startsWith('ok ') ? 'decoded' : cpp[k]}`;
+        count[kind] = (count[kind] ?? 0) + 1;
+        if (js !== cpp[k]) bad.push({ path, policy, cpp: cpp[k], js });
+      });
     }
     const summary = Object.entries(count).sort().map(([k, v]) => `${k}: ${v}`).join(', ');
-    console.log(`compared ${results.length} files (libvff: ${summary})`);
-    for (const b of bad.slice(0, o.show)) console.log(`DISAGREE ${b.path}\n  libvff: ${b.cpp}\n  web:    ${b.js}`);
+    console.log(`compared ${results.length} files, checksums ${o.policies.join(', ')} (libvff: ${summary})`);
+    for (const b of bad.slice(0, o.show))
+      console.log(`DISAGREE ${b.path} (checksums ${b.policy})\n  libvff: ${b.cpp}\n  web:    ${b.js}`);
     if (bad.length > o.show) console.log(`... and ${bad.length - o.show} more`);
+    if (o.save && bad.length) {
+      mkdirSync(o.save, { recursive: true });
+      for (const b of bad) copyFileSync(b.path, join(o.save, basename(b.path)));
+      console.log(`the files they disagree on: ${o.save}`);
+    }
     console.log(bad.length ? `${bad.length} disagreements` : 'no disagreements');
     return bad.length ? 1 : 0;
   } finally {
