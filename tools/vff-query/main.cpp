@@ -246,13 +246,15 @@ std::optional<size_t> answer(const Target& target, const RaySource& src, const Q
 // The command line into `o`, and the checks between its options; an exit code where the run stops.
 std::optional<int> parseCommandLine(int argc, char** argv, Options& o) {
   CLI::App app{
-      "Answers rays with a visibility field: hit, t, point, normal, whether the origin was inside the\n"
-      "bounding sphere and which map and texel answered, one line (or .npy row) per ray, in the order given. Rays come from --ray, from\n"
+      "Answers rays with a visibility field: hit, t, point, normal, whether the hit was found from inside\n"
+      "the bounding sphere and which map and texel answered, one line (or .npy row) per ray, in the order given. Rays come from --ray, from\n"
       "a .npy file, or as text lines (CSV: ox,oy,oz,dx,dy,dz[,tmin,tmax]; JSON: {\"origin\":[..],\n"
       "\"direction\":[..],\"tmin\":..,\"tmax\":..} or [6 or 8 numbers]) from a file or standard input.\n"
       "A bad line is reported as FILE:LINE:COLUMN (exit 3) after the rays before it are answered.\n"
       "Output columns: hit,t,x,y,z,nx,ny,nz,inside,sample,i,j[,visibility] (a miss: t inf, point nan; no\n"
-      "normal: nan; sample, i, j: the map and texel that answered, -1 without a lookup; --no-sites: left out;\n"
+      "normal: nan; inside: 1 for a hit found from inside the bounding sphere by the reversed ray of\n"
+      "spec/geometry.md 7.3, 0 for every miss and every other hit; sample, i, j: the map and texel that\n"
+      "answered, -1 without a lookup; --no-sites: left out;\n"
       "--columns: those named, in that order).\n\n"
       "  vff-query field.vff --ray 0 0 5 0 0 -1\n"
       "  vff-query field.vff -i rays.npy -o hits.npy --interpolated\n",
