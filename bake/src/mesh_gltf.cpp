@@ -1,8 +1,12 @@
 // glTF 2.0 (.gltf and .glb) through tinygltf: parsing, and the triangles of meshes (which meshes and
 // where: gltf_scene.cpp).
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <tiny_gltf.h>
+#include <unistd.h>
 
 #include <array>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 
@@ -174,6 +178,45 @@ class Importer {
   std::string path_;
 };
 
+// tinygltf reads a .gltf's external files (buffers, images) by name, and its own file system
+// functions open them the blocking way: a uri naming a FIFO would hang the bake. These two replace
+// them. Its test of a name opens the file (fopen): a stat does not.
+bool fileExists(const std::string& path, void*) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0;
+}
+
+// Refuses what is not a regular file, as the baker refuses its input (checkReadable), and keeps the
+// first such name (user: a std::string) for the error.
+bool readRegularFile(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) {
+    if (err) *err += "File open error : " + path + "\n";
+    return false;
+  }
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    auto* refused = static_cast<std::string*>(user);
+    if (refused && refused->empty()) *refused = path;
+    if (err) *err += path + ": not a regular file\n";
+    return false;
+  }
+  out->resize(size_t(st.st_size));
+  for (size_t done = 0; done < out->size();) {
+    const ssize_t n = ::read(fd, out->data() + done, out->size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      ::close(fd);
+      if (err) *err += "File read error : " + path + "\n";
+      return false;
+    }
+    done += size_t(n);
+  }
+  ::close(fd);
+  return true;
+}
+
 bool skipImages(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
   return true;  // images are not needed for baking
 }
@@ -184,6 +227,9 @@ Result<std::shared_ptr<const tinygltf::Model>> parseGltf(const std::string& path
                                                          std::vector<std::string>* notes) {
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(skipImages, nullptr);
+  std::string refused;  // an external file that is not a regular file (readRegularFile)
+  loader.SetFsCallbacks({&fileExists, &tinygltf::ExpandFilePath, &readRegularFile, &tinygltf::WriteWholeFile,
+                         &refused});
   auto model = std::make_shared<tinygltf::Model>();
   std::string err, warn;
   bool ok = false;
@@ -194,6 +240,7 @@ Result<std::shared_ptr<const tinygltf::Model>> parseGltf(const std::string& path
   } catch (const std::exception& e) {
     return makeError(Code::kMeshParse, path + ": " + e.what());
   }
+  if (!ok && !refused.empty()) return makeError(Code::kIoOpen, path + ": " + refused + ": not a regular file");
   if (!ok) {
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
     return makeError(Code::kMeshParse, path + ": " + (err.empty() ? std::string("cannot parse glTF") : err));

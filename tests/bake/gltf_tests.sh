@@ -53,7 +53,8 @@ test_unknown_required_extension_is_unsupported() {
 
 # tet_gltf [KEY=VALUE...]: a glTF tetrahedron (mesh 'Tet' at node 0 'Body', positions in a data: URI)
 # on stdout. required=NAMES (comma-separated, JSON-quoted) lists extensionsRequired; skin=1 gives
-# node 0 a skin with joint node 1; morph=1 gives the primitive a morph target and the mesh a weight.
+# node 0 a skin with joint node 1; morph=1 gives the primitive a morph target and the mesh a weight;
+# uri=NAME makes the buffer the external file NAME.
 tet_gltf() {
   python3 - "$@" <<'PY'
 import base64, json, struct, sys
@@ -76,6 +77,8 @@ if opt.get("skin") == "1":
     doc["nodes"].append({"name": "Root"})
     doc["scenes"][0]["nodes"].append(1)
     doc["skins"] = [{"joints": [1]}]
+if opt.get("uri"):
+    doc["buffers"][0]["uri"] = opt["uri"]
 if opt.get("morph") == "1":
     doc["meshes"][0]["primitives"][0]["targets"] = [{"POSITION": 0}]
     doc["meshes"][0]["weights"] = [0.5]
@@ -169,6 +172,19 @@ test_lossy_and_reordered_files_bake() {
     expect_rc 0
     expect_out '"triangles": 8192'
   done
+}
+
+# A buffer uri naming a FIFO is refused as the input itself would be (exit 2, naming both files),
+# not waited on: tinygltf reads external files through the baker's reader.
+test_fifo_buffer_is_refused() {
+  mkdir -p "$WORK/f"
+  mkfifo "$WORK/f/buffer.bin"
+  tet_gltf uri=buffer.bin >"$WORK/f/t.gltf"
+  run timeout 20 "$VFF_BAKE" "$WORK/f/t.gltf" -o "$WORK/f/t.vff" -n 1 -m 8 -q
+  [[ $RC -ne 124 ]] || fail "vff-bake blocked on the FIFO buffer"
+  expect_rc 2
+  expect_err "vff-bake: error: $WORK/f/t.gltf: io-open (1001): $WORK/f/buffer.bin: not a regular file"
+  [[ ! -e $WORK/f/t.vff ]] || fail "output left behind"
 }
 
 run_test "$1"
