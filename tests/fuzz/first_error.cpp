@@ -9,7 +9,8 @@
 // order, then every normal map. The first error ends it; its ID is printed. When
 // everything decodes, HASH is the XXH3-64 (hex) of the decoded planes: every distance map's texels
 // as little-endian float32 (the distance; 1 for a bit1 hit; the quiet NaN 0x7fc00000 for a miss),
-// then every normal map's stored bytes.
+// then every normal map's stored bytes, then (where the slices hold at most kMaxSliceTexels texels
+// in all) every composed slice of the distance plane and then of the normal plane.
 #include <xxhash.h>
 
 #include <algorithm>
@@ -31,6 +32,7 @@ namespace fs = std::filesystem;
 
 constexpr uint64_t kMaxPayloadBytes = uint64_t{256} << 20;  // differential.mjs passes the same
 constexpr uint32_t kMissBits = 0x7fc00000u;
+constexpr uint64_t kMaxSliceTexels = uint64_t{1} << 24;  // differential.mjs uses the same
 
 // The cosine each texel's chord scales with (unorm8-chord), as decodeDistance takes it.
 std::vector<float> texelCosines(const vff::FieldDesc& f) {
@@ -82,6 +84,19 @@ std::string outcome(const std::vector<uint8_t>& bytes, vff::ChecksumPolicy polic
         break;
       }
       XXH3_64bits_update(state, map->data(), map->size());
+    }
+  const vff::LayoutDesc& l = f->layout();
+  if (result.empty() && uint64_t(l.sliceWidth) * l.sliceHeight * l.sliceCount <= kMaxSliceTexels)
+    for (vff::Plane p : {vff::Plane::kDistance, vff::Plane::kNormal}) {
+      if (!f->plane(p).present || !result.empty()) continue;
+      std::vector<uint8_t> slice(f->sliceBytes(p));
+      for (uint32_t s = 0; s < l.sliceCount && result.empty(); ++s) {
+        if (vff::Status st = f->readSlice(p, s, slice); !st) {
+          result = "error " + std::to_string(uint32_t(st.error().code));
+          break;
+        }
+        XXH3_64bits_update(state, slice.data(), slice.size());
+      }
     }
   if (result.empty()) {
     char buf[24];

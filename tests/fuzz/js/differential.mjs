@@ -1,6 +1,6 @@
 // Differential test of the JavaScript decoder (web/src) against libvff: for every input file, under
 // each checksum policy (verify-all, lazy, none), both must give the same first error ID, or decode
-// the same values. libvff's side is the helper vff_fuzz_first_error (tests/fuzz/first_error.cpp),
+// the same values (distances, normals and composed slices). libvff's side is the helper vff_fuzz_first_error (tests/fuzz/first_error.cpp),
 // which prints one line per file; this script computes the same line with web/src and compares.
 //
 //   node differential.mjs --helper PATH [--policies P,...] [--mutants N] [--seed S] [--show K] [--save DIR]
@@ -23,6 +23,7 @@ import { initVff, openVff, xxh3Hex } from '../../../web/src/vff.js';
 
 const MAX_PAYLOAD_BYTES = 256 * 2 ** 20; // first_error.cpp's kMaxPayloadBytes
 const MISS_BITS = 0x7fc00000;
+const MAX_SLICE_TEXELS = 2 ** 24; // first_error.cpp's kMaxSliceTexels
 const POLICIES = ['verify-all', 'lazy', 'none']; // first_error.cpp's order
 
 function usage(message) {
@@ -131,6 +132,10 @@ export function outcome(bytes, checksums) {
       parts.push(new Uint8Array(bits.buffer));
     }
     if (file.planes.normal) for (let k = 0; k < mapCount; ++k) parts.push(file.mapBytes('normal', k).slice());
+    const l = file.layout;
+    if (l.sliceWidth * l.sliceHeight * l.sliceCount <= MAX_SLICE_TEXELS)
+      for (const name of ['distance', 'normal'])
+        if (file.planes[name]) for (let s = 0; s < l.sliceCount; ++s) parts.push(file.slice(name, s));
     return `ok ${xxh3Hex(...parts)}`;
   } catch (e) {
     if (e.id === undefined) return `exception ${String(e.stack ?? e).split('\n').slice(0, 3).join(' | ')}`;
