@@ -229,7 +229,7 @@ Result<std::vector<GltfObject>> loadGltfObjects(const std::string& path, const G
     obj.name = options.split == GltfSplit::kNode ? place.name : (*model)->meshes[size_t(n.mesh)].name;
     auto geometry = detail::importGltfMeshes(**model, path, {{n.mesh, bakedMatrix}});
     if (!geometry) return std::move(geometry).error();
-    const std::string what = path + " mesh " + std::to_string(n.mesh) +
+    const std::string what = path + ": mesh " + std::to_string(n.mesh) +
                              (obj.name.empty() ? std::string() : " '" + obj.name + "'") +
                              (obj.node >= 0 ? " at node " + std::to_string(obj.node) : std::string());
     Status s = checkMesh(&*geometry, what);

@@ -56,8 +56,9 @@ Status checkMesh(Mesh* m, const std::string& what) {
   }
   if (m->indices.empty()) return makeError(Code::kMeshEmpty, what + ": the mesh has no triangles");
   if (kept.empty())
-    return makeError(Code::kMeshDegenerate, what + ": all " + std::to_string(m->indices.size() / 3) +
-                                                " triangles have zero area");
+    return makeError(Code::kMeshDegenerate, what + (m->indices.size() == 3 ? std::string(": its one triangle has zero area")
+                                                                            : ": all " + std::to_string(m->indices.size() / 3) +
+                                                                                  " triangles have zero area"));
   m->indices.swap(kept);
   return {};
 }

@@ -54,12 +54,12 @@ test_unknown_required_extension_is_unsupported() {
 # tet_gltf [KEY=VALUE...]: a glTF tetrahedron (mesh 'Tet' at node 0 'Body', positions in a data: URI)
 # on stdout. required=NAMES (comma-separated, JSON-quoted) lists extensionsRequired; skin=1 gives
 # node 0 a skin with joint node 1; morph=1 gives the primitive a morph target and the mesh a weight;
-# uri=NAME makes the buffer the external file NAME.
+# uri=NAME makes the buffer the external file NAME; flat=1 puts every vertex at the origin.
 tet_gltf() {
   python3 - "$@" <<'PY'
 import base64, json, struct, sys
 opt = dict(a.split('=', 1) for a in sys.argv[1:])
-pos = [0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1]
+pos = [0] * 12 if opt.get("flat") == "1" else [0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1]
 idx = [0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3]
 data = struct.pack('<12f', *pos) + struct.pack('<12H', *idx)
 doc = {"asset": {"version": "2.0"},
@@ -185,6 +185,17 @@ test_fifo_buffer_is_refused() {
   expect_rc 2
   expect_err "vff-bake: error: $WORK/f/t.gltf: io-open (1001): $WORK/f/buffer.bin: not a regular file"
   [[ ! -e $WORK/f/t.vff ]] || fail "output left behind"
+}
+
+# A mesh of a --split that cannot be baked is named after the file, which is named once.
+test_split_names_the_file_once() {
+  mkdir -p "$WORK/flat"
+  tet_gltf flat=1 >"$WORK/flat/t.gltf"
+  run "$VFF_BAKE" "$WORK/flat/t.gltf" --split mesh -o "$WORK/flat/s.vffscene.json" -n 1 -m 8 -q
+  expect_rc 3
+  expect_err "vff-bake: error: $WORK/flat/t.gltf: mesh-degenerate (10006): mesh 0 'Tet': all 4 triangles have zero area"
+  [[ $(grep -o -F "t.gltf" "$WORK/err" | wc -l) -eq 1 ]] || { show; fail "the file is named more than once"; }
+  [[ -z $(ls "$WORK/flat" | grep -v t.gltf) ]] || fail "files left behind"
 }
 
 run_test "$1"

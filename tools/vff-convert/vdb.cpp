@@ -186,9 +186,9 @@ Status writeVdb(const std::string& path, const FieldData& d, const VdbWriteOptio
     MemoryArchive().writeTo(os, grids, openvdb::MetaMap());
     bytes = std::move(os).str();
   } catch (const std::bad_alloc&) {
-    return makeError(Code::kOutOfMemory, "out of memory while building the grids of " + path);
+    return makeError(Code::kOutOfMemory, path + ": out of memory while building the grids");
   } catch (const std::exception& e) {
-    return makeError(Code::kIoWrite, "cannot write " + path + " as OpenVDB: " + exceptionText(e));
+    return makeError(Code::kIoWrite, path + ": cannot be written as OpenVDB: " + exceptionText(e));
   }
   if (Status s = fixUuid(&bytes); !s) return s;
   return cli::writeFileAtomic(path, std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()));
