@@ -351,6 +351,20 @@ options {"allowClippedSphere":false,"codec":"stored","directions":"concentric-eq
   [[ -f $WORK/fields/.vff-cache/09/$key.vff ]] || fail "the field is not cached at its key"
 }
 
+# --shard-maps applies where neither the manifest nor the entry sets shardMaps; an explicit 0 is never.
+test_shard_maps_option_under_the_manifest() {
+  local v="$VECTORS/valid/shard-maps.json" states
+  run "$VFF_LIBRARY" bake "$v" --out "$WORK/fields" --cache "$WORK/cache" --dry-run --format json --shard-maps 3
+  expect_rc 0
+  [[ $(python3 -c "import json; print([e['shardMaps'] for e in json.load(open('$WORK/out'))['entries']])") == "[10, 0]" ]] \
+    || { show; fail "the manifest's shardMaps"; }
+  run "$VFF_LIBRARY" bake "$VECTORS/valid/minimal.json" --out "$WORK/fields" --cache "$WORK/cache" --dry-run --format json --shard-maps 3
+  states=$(python3 -c "import json; j=json.load(open('$WORK/out')); print(j['entries'][0]['shardMaps'], j['bakes'])")
+  # tetra.obj at the default options: 4226 maps in ranges of 3.
+  [[ $states == "3 "* && $(python3 -c "import json; print(len(json.load(open('$WORK/out'))['bakes']))") == 1409 ]] \
+    || fail "--shard-maps where the manifest sets none: ${states:0:80}"
+}
+
 # Slurm arrays are sized by the work: a small library is one task; --rays-per-task and --tasks
 # spread it, the largest bakes first, each to the least loaded task (the plan of a dry run).
 test_slurm_plan_sized_by_work() {

@@ -37,6 +37,7 @@ struct Entry {
   std::string where;              // a manifest entry's JSON path ("entries[3]"); "" for a folder's
   std::string split;              // "mesh" or "node": vff-bake --split (also in args); "": one field
   uint64_t shardMaps = 0;         // above this many maps, bake in map ranges (0: never)
+  bool shardMapsSet = false;      // the manifest or the entry sets shardMaps (--shard-maps applies otherwise)
   // Filled by computeKeys (cache.cpp):
   std::string key;    // 32 hex digits; empty when the entry cannot be baked (error says why)
   std::string error;  // a problem found before baking (unreadable mesh, bad option)

@@ -194,7 +194,7 @@ int bakeLibrary(const Options& o) {
   }
   removeStalePrivateDirs(wo.cacheDir);
   for (Entry& e : entries)
-    if (!e.shardMaps) e.shardMaps = o.shardMaps;
+    if (!e.shardMapsSet) e.shardMaps = o.shardMaps;  // an explicit 0 in a manifest means never
   computeKeys(entries, {.dir = wo.cacheDir, .threads = cores, .statNotes = !o.rehash});
 
   Report report;

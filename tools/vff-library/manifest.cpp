@@ -286,6 +286,7 @@ std::optional<std::string> parseManifest(std::string_view text, const std::strin
     e.outputName = rel;
     e.output = (out / rel).lexically_normal().string();
     e.shardMaps = j.contains("shardMaps") ? j["shardMaps"].get<uint64_t>() : shardDefault;
+    e.shardMapsSet = j.contains("shardMaps") || m.contains("shardMaps");
     e.where = where;
     found.push_back(std::move(e));
   }
