@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "vff/scene_description.h"
 #include "vff/strict_json.h"
@@ -168,6 +169,22 @@ TEST(SceneDescription, FilesAndUris) {
   for (const auto& e : std::filesystem::directory_iterator(dir)) files += e.is_regular_file();
   EXPECT_EQ(files, 1u);
   std::filesystem::remove_all(dir);
+}
+
+// A writer's names go through encodeSceneUri: the reader accepts them and resolves them back.
+TEST(SceneDescription, EncodedUrisResolveToTheirPaths) {
+  const std::string names[] = {"a.vff", "my scene #1.mesh0.vff", "100%?.vff", "C:x.vff", "c:/d/e.vff", "tab\tx.vff",
+                               "back\\slash.vff", "sub/d\xC3\xA9j\xC3\xA0.vff", "/abs/x:y.vff"};
+  for (const std::string& name : names) {
+    const std::string uri = encodeSceneUri(name);
+    auto s = parseSceneDescription(R"({"asset":{"format":"vff-scene","version":1},"fields":[{"uri":)" +
+                                       nlohmann::json(uri).dump() + R"(}],"instances":[]})", "e.json");
+    ASSERT_TRUE(s) << name << ": " << s.error().toString();
+    EXPECT_EQ(resolveSceneUri("d/e.json", s->fields[0].uri), name[0] == '/' ? name : "d/" + name) << uri;
+  }
+  EXPECT_EQ(encodeSceneUri("my scene #1.vff"), "my scene %231.vff");
+  EXPECT_EQ(encodeSceneUri("C:x.vff"), "C%3Ax.vff");
+  EXPECT_EQ(encodeSceneUri("dir/C:x.vff"), "dir/C:x.vff");
 }
 
 // "Finite" and "> 0" hold of the binary32 values (spec/scene.md section 1, rule 4).

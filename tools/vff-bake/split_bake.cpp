@@ -294,7 +294,7 @@ int bakeGltfSplit(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
     }
 
     SceneField f;
-    f.uri = baseName(out);
+    f.uri = encodeSceneUri(baseName(out));  // a file name the reader resolves back (spec/scene.md 3)
     f.name = obj.name;
     nlohmann::json source = {{"file", baseName(o.mesh)}, {"mesh", obj.mesh}};
     if (obj.node >= 0) source["node"] = obj.node;

@@ -87,6 +87,12 @@ VFF_API Status writeSceneDescription(const std::string& path, const SceneDescrip
 // joined to the description's folder. `uri` is one the reader accepted.
 VFF_API std::string resolveSceneUri(const std::string& descriptionPath, const std::string& uri);
 
+// The `uri` that names `path` (a file name or a relative or absolute path with '/' separators):
+// '%', '?', '#', '\\' and control bytes percent-encoded, and a colon that would make a leading
+// scheme (a drive letter, "a:b.vff") written %3A, so that the reader resolves it back to `path`.
+// Writers of descriptions (vff-bake --split) name their fields with it.
+VFF_API std::string encodeSceneUri(const std::string& path);
+
 // A scene description with its fields open and its instances placed in a committed vff::Scene:
 // instance i of the scene is description.instances[i]. It owns everything the scene borrows; it
 // does not move (held by unique_ptr), so the scene's pointers to its fields stay valid.

@@ -389,4 +389,21 @@ std::string resolveSceneUri(const std::string& descriptionPath, const std::strin
   return slash == std::string::npos ? path : descriptionPath.substr(0, slash + 1) + path;
 }
 
+std::string encodeSceneUri(const std::string& path) {
+  static const char kHex[] = "0123456789ABCDEF";
+  const size_t scheme = schemeLength(path);  // the colon at this index would read as a scheme's
+  std::string out;
+  for (size_t i = 0; i < path.size(); ++i) {
+    const auto c = static_cast<unsigned char>(path[i]);
+    if (c == '%' || c == '?' || c == '#' || c == '\\' || c < 0x20 || c == 0x7F || (scheme && i == scheme)) {
+      out += '%';
+      out += kHex[c >> 4];
+      out += kHex[c & 15];
+    } else {
+      out += char(c);
+    }
+  }
+  return out;
+}
+
 }  // namespace vff
