@@ -99,7 +99,7 @@ Hits sceneIntersect(const SceneTarget& target, const RayBatch& b, const py::obje
 }
 
 Ray rayOf(const py::object& o, const py::object& d, float tmin, float tmax) {
-  return Ray{vec3(o, "origin"), vec3(d, "direction"), tmin, tmax};
+  return checkedRay(Ray{vec3(o, "origin"), vec3(d, "direction"), tmin, tmax});  // (refused as a batch refuses it)
 }
 
 PyInstance instanceOf(const py::object& self, const PyScene& s, uint32_t id) {

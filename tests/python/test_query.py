@@ -260,6 +260,14 @@ def test_bad_rays_raise_like_vff_query():
         inst.occluded_ray((np.nan, 0, 5), (0, 0, -1))
     with pytest.raises(ValueError, match="^ray: tmin is greater than tmax$"):
         q.visibility_ray((0, 0, 5), (0, 0, -1), 2.0, 1.0)
+    # A Scene refuses them too, in its batches and its one-ray calls.
+    scene = vff.Scene()
+    scene.add(q, translation=(1, 2, 3))
+    scene.commit()
+    with pytest.raises(ValueError, match="^ray 33000: the direction is zero$"):
+        scene.intersect(o, bad_d)
+    with pytest.raises(ValueError, match="^ray: the direction is zero$"):
+        scene.occluded_ray((0, 0, 5), (0, 0, 0))
     # out= keeps its answers when the call is refused; the good rays alone are answered.
     h = q.intersect(o, d)
     keep = h.t.copy()
