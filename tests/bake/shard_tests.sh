@@ -161,7 +161,7 @@ test_inspect_counts_only_the_range() {
   expect_out '"texels": 20992,'
 }
 
-# Parts merge only with the same vff.source.geometryHash (12012), which drops exactly the triangles
+# Parts merge only with the same vff.source.geometryHash (12013), which drops exactly the triangles
 # of zero area (spec/format.md section 9, "the mesh as baked"): a repeated position, exactly
 # collinear vertices; a sliver of nonzero area is kept.
 test_geometry_hash_drops_exactly_zero_area_triangles() {
@@ -189,9 +189,9 @@ test_geometry_hash_drops_exactly_zero_area_triangles() {
   bake "$WORK/t.obj" -o "$WORK/a.vff" "${small[@]}" --center 0 0 0 --radius 3 --map-range 0:41
   bake "$WORK/zero.obj" -o "$WORK/b.vff" "${small[@]}" --center 0 0 0 --radius 3 --map-range 41:82
   bake "$WORK/sliver.obj" -o "$WORK/c.vff" "${small[@]}" --center 0 0 0 --radius 3 --map-range 41:82
-  refused 3 "c.vff: merge-geometry (12012)" "$WORK/a.vff" "$WORK/c.vff"
+  refused 3 "c.vff: merge-geometry (12013)" "$WORK/a.vff" "$WORK/c.vff"
   # the same geometry from another file is another bake (META vff.source.name), not other geometry
-  refused 3 "b.vff: merge-meta (12016): different bake: META vff.source" "$WORK/a.vff" "$WORK/b.vff"
+  refused 3 "b.vff: merge-meta (12017): different bake: META vff.source" "$WORK/a.vff" "$WORK/b.vff"
 }
 
 # ---- Usage errors ------------------------------------------------------------------------------------
@@ -260,11 +260,11 @@ test_merge_refuses_gaps_and_overlaps() {
   part b 50:82
   part c 40:82
   part d 41:82
-  refused 3 "b.vff: merge-gap (12017): gap: maps 41:50 are in no part" "$WORK/b.vff" "$WORK/a.vff"
-  refused 3 "a.vff: merge-gap (12017): gap: maps 41:82 of the field's 82 are in no part" "$WORK/a.vff"
-  refused 3 "d.vff: merge-gap (12017): gap: maps 0:41 are in no part" "$WORK/d.vff"
-  refused 3 "c.vff: merge-overlap (12018): overlap: its maps 40:82 overlap" "$WORK/a.vff" "$WORK/c.vff"
-  refused 3 "d.vff: merge-overlap (12018): overlap: its maps 41:82 overlap" "$WORK/a.vff" "$WORK/d.vff" "$WORK/d.vff"
+  refused 3 "b.vff: merge-gap (12018): gap: maps 41:50 are in no part" "$WORK/b.vff" "$WORK/a.vff"
+  refused 3 "a.vff: merge-gap (12018): gap: maps 41:82 of the field's 82 are in no part" "$WORK/a.vff"
+  refused 3 "d.vff: merge-gap (12018): gap: maps 0:41 are in no part" "$WORK/d.vff"
+  refused 3 "c.vff: merge-overlap (12019): overlap: its maps 40:82 overlap" "$WORK/a.vff" "$WORK/c.vff"
+  refused 3 "d.vff: merge-overlap (12019): overlap: its maps 41:82 overlap" "$WORK/a.vff" "$WORK/d.vff" "$WORK/d.vff"
   bake --merge "$WORK/d.vff" "$WORK/a.vff" -o "$WORK/ok.vff" -q
   expect_rc 0
 }
@@ -275,24 +275,24 @@ test_merge_refuses_other_geometry_and_options() {
   part a 0:41
   bake "$WORK/sphere.obj" -o "$WORK/sphere.vff" "${small[@]}" --map-range 41:82
   expect_rc 0
-  refused 3 "sphere.vff: merge-geometry (12012): different geometry: vff.source.geometryHash" "$WORK/a.vff" "$WORK/sphere.vff"
+  refused 3 "sphere.vff: merge-geometry (12013): different geometry: vff.source.geometryHash" "$WORK/a.vff" "$WORK/sphere.vff"
   part zstd 41:82 --codec zstd
-  refused 3 "zstd.vff: merge-block-options (12015): different options: codec" "$WORK/a.vff" "$WORK/zstd.vff"
+  refused 3 "zstd.vff: merge-block-options (12016): different options: codec" "$WORK/a.vff" "$WORK/zstd.vff"
   part normals 41:82 --normals
-  refused 3 "normals.vff: merge-options (12014): different options:" "$WORK/a.vff" "$WORK/normals.vff"
+  refused 3 "normals.vff: merge-options (12015): different options:" "$WORK/a.vff" "$WORK/normals.vff"
   part u16 41:82 --encoding unorm16-diameter
-  refused 3 "u16.vff: merge-options (12014): different options: encoding" "$WORK/a.vff" "$WORK/u16.vff"
+  refused 3 "u16.vff: merge-options (12015): different options: encoding" "$WORK/a.vff" "$WORK/u16.vff"
   bake "$WORK/knot.obj" -o "$WORK/fib.vff" -q -m 16 --positions fibonacci -n 82 --map-range 41:82
-  refused 3 "fib.vff: merge-options (12014): different options:" "$WORK/a.vff" "$WORK/fib.vff"
+  refused 3 "fib.vff: merge-options (12015): different options:" "$WORK/a.vff" "$WORK/fib.vff"
   part g 41:82 --maps-per-block 4
-  refused 3 "g.vff: merge-block-options (12015): different options: mapsPerBlock" "$WORK/a.vff" "$WORK/g.vff"
+  refused 3 "g.vff: merge-block-options (12016): different options: mapsPerBlock" "$WORK/a.vff" "$WORK/g.vff"
   part layers 41:82 --gutter 2
-  refused 3 "layers.vff: merge-options (12014): different options: gutter" "$WORK/a.vff" "$WORK/layers.vff"
+  refused 3 "layers.vff: merge-options (12015): different options: gutter" "$WORK/a.vff" "$WORK/layers.vff"
   part sphere 41:82 --center 0 0 0 --radius 2
-  refused 3 "sphere.vff: merge-options (12014): different options: sphere" "$WORK/a.vff" "$WORK/sphere.vff"
+  refused 3 "sphere.vff: merge-options (12015): different options: sphere" "$WORK/a.vff" "$WORK/sphere.vff"
   cp "$WORK/knot.obj" "$WORK/renamed.obj"
   bake "$WORK/renamed.obj" -o "$WORK/renamed.vff" "${small[@]}" --map-range 41:82
-  refused 3 "renamed.vff: merge-meta (12016): different bake: META vff.source.name" "$WORK/a.vff" "$WORK/renamed.vff"
+  refused 3 "renamed.vff: merge-meta (12017): different bake: META vff.source.name" "$WORK/a.vff" "$WORK/renamed.vff"
 }
 
 test_merge_refuses_other_versions_and_bad_parts() {
@@ -300,7 +300,7 @@ test_merge_refuses_other_versions_and_bad_parts() {
   part a 0:41
   part b 41:82
   "$EDIT" "$WORK/b.vff" "$WORK/old.vff" /vff.generatorVersion '"0.0.1"' || fail "edit"
-  refused 3 "old.vff: merge-version (12013): different versions: baked by vff-bake \"0.0.1\"" "$WORK/a.vff" "$WORK/old.vff"
+  refused 3 "old.vff: merge-version (12014): different versions: baked by vff-bake \"0.0.1\"" "$WORK/a.vff" "$WORK/old.vff"
   "$EDIT" "$WORK/b.vff" "$WORK/v2.vff" /vff.partial/version 2 || fail "edit"
   refused 5 "v2.vff: partial-version (12004): partial result version 2; this vff-bake reads version 1" "$WORK/a.vff" "$WORK/v2.vff"
   "$EDIT" "$WORK/b.vff" "$WORK/count.vff" /vff.partial/mapCount 90 || fail "edit"

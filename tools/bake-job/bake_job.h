@@ -105,6 +105,9 @@ std::optional<MapRange> parseMapRange(const std::string& text);
 // A range that ends past the field's `mapCount` maps is a usage error (printed here, naming the
 // count); returns its exit code, else nothing.
 std::optional<int> checkMapRange(const MapRange& r, uint32_t mapCount);
+// One distance map of misses in the field's encoding: a partial result's filler (for bc4-diameter,
+// the BC4 blocks of all-miss codes). A filler's normal map is all zero bytes.
+std::vector<uint8_t> missMap(const FieldDesc& f);
 // The writer's options of a partial result whose whole bake writes with `whole`.
 WriteOptions partialWriteOptions(const WriteOptions& whole);
 // META of a partial result: the whole bake's META and "vff.partial".

@@ -64,7 +64,38 @@ std::optional<int> checkPartialKeys(const std::string& path, const nlohmann::jso
   return std::nullopt;
 }
 
-// Reads `path` as a partial result (rules 12002 to 12011, after the reader's own); returns the exit
+// Rule 12012: every map of `f` outside `r` is a filler, in both planes. Reads every block once; the
+// first map that is not names the rule (a corrupt block is the reader's error).
+std::optional<int> checkFillers(const std::string& path, const File& f, const MapRange& r) {
+  const std::vector<uint8_t> miss = missMap(f.field());
+  std::vector<uint8_t> block;
+  for (Plane plane : {Plane::kDistance, Plane::kNormal}) {
+    const PlaneInfo& info = f.plane(plane);
+    if (!info.present) continue;
+    for (uint32_t b = 0; b < info.blocks.size(); ++b) {
+      const BlockInfo& bi = info.blocks[b];
+      if (bi.firstMap >= r.begin && bi.firstMap + bi.mapCount <= r.end) continue;  // the range's maps only
+      block.resize(bi.rawSize);
+      if (Status st = f.decodeBlock(plane, b, block); !st) return cli::reportError(kProg, path, st.error());
+      for (uint32_t k = 0; k < bi.mapCount; ++k) {
+        const uint32_t map = bi.firstMap + k;
+        if (map >= r.begin && map < r.end) continue;
+        const auto bytes = std::span<const uint8_t>(block).subspan(size_t(k) * info.mapBytes, info.mapBytes);
+        const bool filler = plane == Plane::kDistance
+                                ? std::equal(bytes.begin(), bytes.end(), miss.begin(), miss.end())
+                                : std::all_of(bytes.begin(), bytes.end(), [](uint8_t x) { return x == 0; });
+        if (!filler)
+          return refuse(path, PartialRule::kFiller,
+                        std::string(plane == Plane::kDistance ? "distance" : "normal") + " map " + std::to_string(map) +
+                            " lies outside the map range " + rangeText(r) + " but is not a filler (" +
+                            (plane == Plane::kDistance ? "every texel a miss" : "every byte zero") + ")");
+      }
+    }
+  }
+  return std::nullopt;
+}
+
+// Reads `path` as a partial result (rules 12002 to 12012, after the reader's own); returns the exit
 // code of a refusal.
 std::optional<int> openPart(const std::string& path, std::vector<Part>* parts) {
   auto f = File::open(path);
@@ -95,6 +126,7 @@ std::optional<int> openPart(const std::string& path, std::vector<Part>* parts) {
     return refuse(path, PartialRule::kCodec, "\"vff.partial\" names an unknown codec '" + codec + "'");
   if (codec == codecName(Codec::kZstd) && p["zstdLevel"].get<int>() < 1)
     return refuse(path, PartialRule::kZstdLevel, "\"vff.partial\" has zstdLevel 0; zstd levels are 1 to 22");
+  if (auto rc = checkFillers(path, *f, r)) return rc;
   parts->push_back(Part{path, std::move(*f), std::move(meta), std::move(p), r});
   return std::nullopt;
 }

@@ -11,9 +11,8 @@
 
 namespace vff::bake_tool {
 
-namespace {
+namespace {}  // namespace
 
-// One distance map of misses in the field's encoding.
 std::vector<uint8_t> missMap(const FieldDesc& f) {
   const uint32_t m = f.mapResolution;
   std::vector<uint8_t> map(distanceMapBytes(f.distanceEncoding, m));
@@ -26,6 +25,8 @@ std::vector<uint8_t> missMap(const FieldDesc& f) {
     for (uint32_t i = 0; i < m; ++i) storeCode(f.distanceEncoding, map, m, i, j, missCode(f.distanceEncoding));
   return map;
 }
+
+namespace {
 
 // Writes `count` copies of `map` to plane `p`, a bounded run at a time.
 Status writeCopies(Writer& w, Plane p, const std::vector<uint8_t>& map, uint64_t count) {
@@ -64,8 +65,8 @@ std::optional<MapRange> parseMapRange(const std::string& text) {
 std::optional<int> checkMapRange(const MapRange& r, uint32_t mapCount) {
   if (r.end <= mapCount) return std::nullopt;
   cli::usageError(kProg, "--map-range " + std::to_string(r.begin) + ":" + std::to_string(r.end) +
-                             " is outside the field: it has " + std::to_string(mapCount) + " maps (0:" +
-                             std::to_string(mapCount) + " is the whole field)");
+                             " is outside the field: it has " + std::to_string(mapCount) +
+                             " maps (0:" + std::to_string(mapCount) + " is the whole field)");
   return cli::kExitUsage;
 }
 

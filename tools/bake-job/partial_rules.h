@@ -22,13 +22,14 @@ enum class PartialRule : uint16_t {
   kRange = 12009,          // partial-range: mapBegin < mapEnd <= mapCount
   kCodec = 12010,          // partial-codec: "codec" is "stored" or "zstd"
   kZstdLevel = 12011,      // partial-zstd-level: zstdLevel >= 1 when codec is "zstd"
-  kGeometry = 12012,       // merge-geometry: the first part's vff.source.geometryHash
-  kVersionOfBake = 12013,  // merge-version: the first part's vff.generatorVersion
-  kFieldOptions = 12014,   // merge-options: the first part's FDSC and LAYT limits
-  kBlockOptions = 12015,   // merge-block-options: the first part's codec, zstdLevel, mapsPerBlock
-  kMeta = 12016,           // merge-meta: the first part's META without "vff.partial"
-  kGap = 12017,            // merge-gap: the sorted ranges leave no map out
-  kOverlap = 12018,        // merge-overlap: no map is in two parts
+  kFiller = 12012,         // partial-filler: every map outside the range is a filler
+  kGeometry = 12013,       // merge-geometry: the first part's vff.source.geometryHash
+  kVersionOfBake = 12014,  // merge-version: the first part's vff.generatorVersion
+  kFieldOptions = 12015,   // merge-options: the first part's FDSC and LAYT limits
+  kBlockOptions = 12016,   // merge-block-options: the first part's codec, zstdLevel, mapsPerBlock
+  kMeta = 12017,           // merge-meta: the first part's META without "vff.partial"
+  kGap = 12018,            // merge-gap: the sorted ranges leave no map out
+  kOverlap = 12019,        // merge-overlap: no map is in two parts
 };
 
 struct PartialRuleInfo {
@@ -50,6 +51,7 @@ inline constexpr PartialRuleInfo kPartialRules[] = {
     {PartialRule::kRange, "partial-range", cli::kExitInvalidFile},
     {PartialRule::kCodec, "partial-codec", cli::kExitUnsupported},
     {PartialRule::kZstdLevel, "partial-zstd-level", cli::kExitInvalidFile},
+    {PartialRule::kFiller, "partial-filler", cli::kExitInvalidFile},
     {PartialRule::kGeometry, "merge-geometry", cli::kExitInvalidFile},
     {PartialRule::kVersionOfBake, "merge-version", cli::kExitInvalidFile},
     {PartialRule::kFieldOptions, "merge-options", cli::kExitInvalidFile},

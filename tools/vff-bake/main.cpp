@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
                "one around the active voxels' bounding box).\n"
                "One field across tasks: --map-range BEGIN:END bakes those maps into a partial result; --merge\n"
                "PART... -o OUT assembles the parts into the whole bake's bytes (spec/partial.md). Merge refusals\n"
-               "print the rule as NAME (ID), 12001-12018: gaps, overlaps, other geometry, options or version, a\n"
+               "print the rule as NAME (ID), 12001-12019: gaps, overlaps, other geometry, options or version, a\n"
                "malformed or corrupt part: exit 3; a part of another vff.partial version or block codec: exit 5;\n"
                "-o naming a part: exit 1.\n" +
                vff::cli::exitCodeHelp()};

@@ -136,7 +136,9 @@ struct SetSpec {
   int failingPart = 0;  // 1-based: the part the refusal names
 };
 
-void setPartial(json& m, const char* key, json v) { m["vff.partial"][key] = std::move(v); }
+void setPartial(json& m, const char* key, json v) {
+  m["vff.partial"][key] = std::move(v);
+}
 
 std::vector<SetSpec> sets() {
   const Bake zn = withNormals(baseBake());
@@ -154,35 +156,51 @@ std::vector<SetSpec> sets() {
       {"stored-two-parts", {{{0, 3}}, {{3, 6}}}},
       {"stored-three-shuffled", {{{4, 6}}, {{0, 1}}, {{1, 4}}}},
       {"zstd-normals-blocks", {{{5, 6}, zn}, {{0, 5}, zn}}},
-      {"12002-partial-missing", {{{0, 3}}, {{3, 6}, baseBake(), [](json& m) { m.erase("vff.partial"); }}},
-       R::kNotPartial, 2},
-      {"12003-partial-object", {{{0, 3}}, {{3, 6}, baseBake(), [](json& m) { m["vff.partial"] = "3:6"; }}},
-       R::kNotObject, 2},
+      {"12002-partial-missing",
+       {{{0, 3}}, {{3, 6}, baseBake(), [](json& m) { m.erase("vff.partial"); }}},
+       R::kNotPartial,
+       2},
+      {"12003-partial-object",
+       {{{0, 3}}, {{3, 6}, baseBake(), [](json& m) { m["vff.partial"] = "3:6"; }}},
+       R::kNotObject,
+       2},
       {"12004-partial-version", {{{0, 3}}, {{3, 6}, baseBake(), ed("version", 2)}}, R::kVersion, 2},
       {"12005-partial-key-missing",
-       {{{0, 3}}, {{3, 6}, baseBake(), [](json& m) { m["vff.partial"].erase("mapsPerBlock"); }}}, R::kKeyMissing, 2},
+       {{{0, 3}}, {{3, 6}, baseBake(), [](json& m) { m["vff.partial"].erase("mapsPerBlock"); }}},
+       R::kKeyMissing,
+       2},
       {"12006-partial-key-type", {{{0, 3}}, {{3, 6}, baseBake(), ed("codec", 7)}}, R::kKeyType, 2},
       {"12006-partial-key-type-first-part",
-       {{{0, 3}, baseBake(), ed("mapEnd", "3")}, {{3, 6}, baseBake(), ed("mapCount", 7)}}, R::kKeyType, 1},
+       {{{0, 3}, baseBake(), ed("mapEnd", "3")}, {{3, 6}, baseBake(), ed("mapCount", 7)}},
+       R::kKeyType,
+       1},
       {"12007-partial-key-unknown", {{{0, 3}}, {{3, 6}, baseBake(), ed("filter", "none")}}, R::kKeyUnknown, 2},
       {"12008-partial-map-count", {{{0, 3}}, {{3, 6}, baseBake(), ed("mapCount", 7)}}, R::kMapCount, 2},
       {"12009-partial-range", {{{0, 3}}, {{3, 6}, baseBake(), ed("mapEnd", 7)}}, R::kRange, 2},
       {"12010-partial-codec", {{{0, 3}}, {{3, 6}, baseBake(), ed("codec", "lz4")}}, R::kCodec, 2},
       {"12011-partial-zstd-level", {{{0, 3}, level0}, {{3, 6}, level0}}, R::kZstdLevel, 1},
-      {"12012-merge-geometry",
+      // maps 2:6 written, "vff.partial" saying 3:6: map 2 is a field's map where a filler must be
+      {"12012-partial-filler", {{{0, 3}}, {{2, 6}, baseBake(), ed("mapBegin", 3)}}, R::kFiller, 2},
+      {"12013-merge-geometry",
        {{{0, 3}}, {{3, 6}, baseBake(), [](json& m) { m["vff.source"]["geometryHash"] = "fedcba9876543210"; }}},
-       R::kGeometry, 2},
-      {"12012-merge-geometry-before-gap",
+       R::kGeometry,
+       2},
+      {"12013-merge-geometry-before-gap",
        {{{0, 2}}, {{3, 6}, baseBake(), [](json& m) { m["vff.source"]["geometryHash"] = "fedcba9876543210"; }}},
-       R::kGeometry, 2},
-      {"12013-merge-version", {{{0, 3}}, {{3, 6}, baseBake(), [](json& m) { m["vff.generatorVersion"] = "2"; }}},
-       R::kVersionOfBake, 2},
-      {"12014-merge-options", {{{0, 3}}, {{3, 6}, wider}}, R::kFieldOptions, 2},
-      {"12015-merge-block-options", {{{0, 3}}, {{3, 6}, blocks}}, R::kBlockOptions, 2},
-      {"12016-merge-meta", {{{0, 3}}, {{3, 6}, baseBake(), [](json& m) { m["vff.source"]["name"] = "other"; }}},
-       R::kMeta, 2},
-      {"12017-merge-gap", {{{4, 6}}, {{0, 3}}}, R::kGap, 1},
-      {"12018-merge-overlap", {{{3, 6}}, {{0, 4}}}, R::kOverlap, 1},
+       R::kGeometry,
+       2},
+      {"12014-merge-version",
+       {{{0, 3}}, {{3, 6}, baseBake(), [](json& m) { m["vff.generatorVersion"] = "2"; }}},
+       R::kVersionOfBake,
+       2},
+      {"12015-merge-options", {{{0, 3}}, {{3, 6}, wider}}, R::kFieldOptions, 2},
+      {"12016-merge-block-options", {{{0, 3}}, {{3, 6}, blocks}}, R::kBlockOptions, 2},
+      {"12017-merge-meta",
+       {{{0, 3}}, {{3, 6}, baseBake(), [](json& m) { m["vff.source"]["name"] = "other"; }}},
+       R::kMeta,
+       2},
+      {"12018-merge-gap", {{{4, 6}}, {{0, 3}}}, R::kGap, 1},
+      {"12019-merge-overlap", {{{3, 6}}, {{0, 4}}}, R::kOverlap, 1},
   };
 }
 
