@@ -100,6 +100,17 @@ TEST(SceneDescription, WriterRefusesWhatTheReaderRefuses) {
   auto text = formatSceneDescription(s);
   ASSERT_FALSE(text);
   EXPECT_EQ(text.error().code, Code::kSceneFieldIndex);
+  // A name that JSON cannot hold is refused, not thrown.
+  s.instances[0].field = 0;
+  s.fields[0].name = "\xC3\x28";
+  auto utf8 = formatSceneDescription(s);
+  ASSERT_FALSE(utf8);
+  EXPECT_EQ(utf8.error().message, "scene: fields[0]: a string that is not UTF-8");
+  s.fields[0].name = "ok";
+  s.instances[0].scale = 0;
+  auto scale = formatSceneDescription(s);
+  ASSERT_FALSE(scale);
+  EXPECT_EQ(scale.error().code, Code::kSceneValue);
   EXPECT_NE(text.error().message.find("instances[0].field"), std::string::npos) << text.error().message;
 }
 

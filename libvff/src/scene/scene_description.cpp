@@ -317,7 +317,14 @@ Result<SceneDescription> readSceneDescription(const std::string& path) {
 
 Result<std::string> formatSceneDescription(const SceneDescription& scene) {
   // Checked by the reader's own rules on the text produced, so the writer cannot write what the
-  // reader refuses.
+  // reader refuses. Strings are checked first: JSON holds UTF-8 only.
+  for (size_t i = 0; i < scene.fields.size(); ++i)
+    for (const std::string* v : {&scene.fields[i].uri, &scene.fields[i].name})
+      if (!validUtf8(*v)) return valueError("scene", "fields[" + std::to_string(i) + "]", "a string that is not UTF-8");
+  for (size_t i = 0; i < scene.instances.size(); ++i)
+    if (!validUtf8(scene.instances[i].name))
+      return valueError("scene", "instances[" + std::to_string(i) + "].name", "a string that is not UTF-8");
+  if (!validUtf8(scene.generator)) return valueError("scene", "asset.generator", "a string that is not UTF-8");
   std::string s = "{\n  \"asset\": {\"format\": \"vff-scene\", \"version\": 1";
   if (!scene.generator.empty()) s += ", \"generator\": " + json(scene.generator).dump();
   s += "},\n  \"fields\": [";
