@@ -95,15 +95,19 @@ std::optional<std::string> unknownMember(const Checker& c, const json& o, const 
   return std::nullopt;
 }
 
-// Checks an options object's names and value types (section 4); `path` names it.
+// Checks an options object's names, then its value types (section 4: every name before any type);
+// `path` names it.
 std::optional<std::string> checkOptions(const Checker& c, const json& o, const std::string& path) {
   for (const auto& [k, v] : o.items()) {
     std::string p = path;
     appendJsonPathKey(p, k);
-    auto kind = bakeOptionKinds().find(k);
-    if (kind == bakeOptionKinds().end())
+    if (!bakeOptionKinds().count(k))
       return c.fail(kRuleUnknownOption, p, "not a vff-bake option a library sets (spec/library.md section 4)");
-    switch (kind->second) {
+  }
+  for (const auto& [k, v] : o.items()) {
+    std::string p = path;
+    appendJsonPathKey(p, k);
+    switch (bakeOptionKinds().at(k)) {
       case OptionKind::kFlag:
         if (!v.is_boolean()) return c.fail(kRuleOptionType, p, "must be true or false, not " + shown(v));
         break;

@@ -99,6 +99,7 @@ INVALID = {
     (13009, "flag-string"): ('{"vffLibrary": 1, "entries": [{"mesh": "tetra.obj", "options": {"normals": "yes"}}]}\n', "entries[0].options.normals"),
     (13009, "center-two-numbers"): ('{"vffLibrary": 1, "defaults": {"center": [0, 0]}, "entries": []}\n', "defaults.center"),
     (13009, "value-array"): ('{"vffLibrary": 1, "entries": [{"mesh": "tetra.obj", "options": {"map-size": [8]}}]}\n', 'entries[0].options["map-size"]'),
+    (13008, "names-before-types"): ('{"vffLibrary": 1, "defaults": {"count": [], "zz": 1}, "entries": []}\n', "defaults.zz"),
     (13010, "empty-mesh"): ('{"vffLibrary": 1, "entries": [{"mesh": "", "output": "a.vff"}]}\n', "entries[0].mesh"),
     (13011, "split-triangles"): ('{"vffLibrary": 1, "entries": [{"mesh": "s.gltf", "split": "triangles"}]}\n', "entries[0].split"),
     (13012, "output-parent"): ('{"vffLibrary": 1, "entries": [{"mesh": "tetra.obj", "output": "a/../../b.vff"}]}\n', "entries[0].output"),
