@@ -4,12 +4,14 @@
 // the parts (seeds: make_merge_seeds.sh). They are written to a private temporary folder and merged
 // into an output there. Whatever the parts:
 //   * mergeParts returns (no exception: vff-bake would report it as an internal error);
-//   * it returns 0, the output exists, the validator finds no error in it and it opens; or it
+//   * it returns 0, the output exists, the validator finds no error in it, it opens, and each of
+//     its maps is, in both planes, the map of the one part whose range holds it; or it
 //     returns a documented exit code (1..5), printed a message "vff-bake: error: ..." (never an
 //     internal error), and left no file behind: no output, no temporary.
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -22,6 +24,8 @@
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "bake_job.h"
 #include "vff/vff.h"
@@ -80,6 +84,42 @@ int mergeLogged(const vff::bake_tool::Options& o, const fs::path& log) {
   return rc;
 }
 
+std::vector<uint8_t> readBytes(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+bool sameMap(const vff::File& a, const vff::File& b, vff::Plane p, uint32_t k) {
+  auto x = a.mapData(p, k), y = b.mapData(p, k);
+  return x && y && x->size() == y->size() && std::equal(x->begin(), x->end(), y->begin());
+}
+
+// Each map of the merged file is its part's map; every map lies in exactly one part's range.
+void checkMaps(const std::vector<uint8_t>& merged, const std::vector<std::string>& parts, const std::string& messages) {
+  vff::Result<vff::File> whole = vff::File::openMemory(merged);
+  if (!whole) fail("the merged file does not open", whole.error().toString() + "\n" + messages);
+  std::vector<uint32_t> cover(whole->field().mapCount, 0);
+  for (const std::string& path : parts) {
+    const std::vector<uint8_t> bytes = readBytes(path);
+    vff::Result<vff::File> part = vff::File::openMemory(bytes);
+    if (!part) fail("a part of a merge that succeeded does not open", part.error().toString());
+    const nlohmann::json meta = nlohmann::json::parse(part->metadata(), nullptr, false);
+    if (!meta.is_object() || !meta.contains("vff.partial")) fail("a part of a merge that succeeded is not partial", path);
+    const uint64_t begin = meta["vff.partial"].value("mapBegin", uint64_t{0});
+    const uint64_t end = meta["vff.partial"].value("mapEnd", uint64_t{0});
+    if (part->field().mapCount != cover.size() || end > cover.size() || begin >= end)
+      fail("a part's range does not fit the merged field", path);
+    for (auto k = uint32_t(begin); k < end; ++k) {
+      ++cover[k];
+      for (vff::Plane p : {vff::Plane::kDistance, vff::Plane::kNormal})
+        if (whole->plane(p).present && !sameMap(*whole, *part, p, k))
+          fail("a merged map differs from its part's", path + " map " + std::to_string(k));
+    }
+  }
+  for (uint32_t c : cover)
+    if (c != 1) fail("the parts' ranges do not cover the field once", messages);
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -114,12 +154,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       std::string_view(reinterpret_cast<const char*>(data), size).find("internal error") == std::string_view::npos)
     fail("an internal error", messages);
   if (rc == 0) {
-    std::ifstream in(out, std::ios::binary);
-    const std::vector<uint8_t> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    const std::vector<uint8_t> bytes = readBytes(out);
     if (bytes.empty()) fail("the merge succeeded without an output", messages);
     const vff::Report report = vff::validate(bytes);
     if (!report.valid()) fail("the merged file does not validate", messages);
-    if (!vff::File::openMemory(bytes)) fail("the merged file does not open", messages);
+    checkMaps(bytes, o.merge, messages);
     mine.insert(out);
   } else {
     if (rc < 1 || rc > 5) fail("an exit code that is not documented", std::to_string(rc) + "\n" + messages);
