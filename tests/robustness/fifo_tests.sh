@@ -49,6 +49,12 @@ test_inspect_refuses_fifo() {
   expect_out '"message": "'"$WORK"'/field.vff: not a regular file"'
 }
 
+test_inspect_help_says_so() {
+  run "$VFF_INSPECT" --help
+  expect_rc 0
+  expect_out "a regular file (a named pipe or folder is refused, exit 2), or - (standard input, read whole)"
+}
+
 test_inspect_refuses_folder() {
   mkdir "$WORK/field.vff"
   refused vff-inspect "$WORK/field.vff" "$VFF_INSPECT" "$WORK/field.vff"
@@ -75,6 +81,14 @@ test_query_reads_fifo_rays() {
   wait "$writer" || fail "the writer of the FIFO failed or was never read"
   expect_rc 0
   cmp -s "$WORK/out" "$WORK/expected" || { show; fail "the answers from the FIFO differ from the file's"; }
+}
+
+# --help says both: the field is a regular file, a named pipe of rays is read as a stream.
+test_query_help_says_so() {
+  run "$VFF_QUERY" --help
+  expect_rc 0
+  expect_out "the .vff field to query (a regular file)"
+  expect_out "a named pipe is read as a stream"
 }
 
 test_convert_refuses_fifo() {

@@ -68,7 +68,10 @@ int run(int argc, char** argv) {
       kProg};
   app.footer(cli::exitCodeHelp());
   cli::addCommonOptions(app, kProg, o.common);
-  app.add_option("file", o.input, "the .vff file to inspect (- reads standard input)")->required();
+  app.add_option("file", o.input,
+                 "the .vff file to inspect: a regular file (a named pipe or folder is refused, exit 2), or - "
+                 "(standard input, read whole)")
+      ->required();
   app.add_flag("--validate", o.validate,
                "run the full validator and print every issue (severity, ID, name, section, offset, message); "
                "exit 3 if any issue is an error");

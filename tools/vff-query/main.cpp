@@ -69,14 +69,15 @@ namespace {
 
 void addOptions(CLI::App& app, Options& o) {
   cli::addVersionFlag(app, kProg);
-  app.add_option("field", o.field, "the .vff field to query")->required();
+  app.add_option("field", o.field, "the .vff field to query (a regular file)")->required();
   app.add_option("--ray", o.rays, "a ray: origin x y z, direction x y z (repeatable)")
       ->expected(6)
       ->allow_extra_args(false)
       ->option_text("OX OY OZ DX DY DZ");
   app.add_option("-i,--input", o.input,
                  "rays from a file: a .npy float32 array (N, 6) or (N, 8) (ox oy oz dx dy dz [tmin tmax]), or text "
-                 "lines, CSV or JSON (- or nothing: standard input, when no --ray is given)");
+                 "lines, CSV or JSON (- or nothing: standard input, when no --ray is given; a named pipe is read "
+                 "as a stream, like standard input)");
   app.add_option("-o,--output", o.output, "where the answers go (- : standard output; a file is written atomically)")
       ->capture_default_str();
   app.add_option("--format", o.format, "answers as csv, jsonl or npy (default: npy for an output named *.npy, else csv)")
