@@ -47,6 +47,13 @@ test_help() {
   for opt in --format --validate --preview --maps --histogram-bins --version; do expect_out "$opt"; done
 }
 
+# A count of one takes the singular ("1 block", not "1 blocks").
+test_counts_take_their_number() {
+  inspect "$FIXTURES/small.vff"
+  expect_rc 0
+  expect_out "           1 block, 10 maps per block (last block 10), codecs: stored 1; filters: none 1"
+}
+
 test_version() {
   inspect --version
   expect_rc 0

@@ -65,9 +65,9 @@ void printPlane(std::FILE* out, const char* name, const json& p) {
   for (const auto& [filter, count] : p["filters"].items())
     filters += (filters.empty() ? "" : ", ") + filter + " " + std::to_string(count.get<uint64_t>());
   std::fprintf(out,
-               "           %" PRIu64 " blocks, %" PRIu64 " maps per block (last block %" PRIu64
-               "), codecs: %s; filters: %s\n",
-               u64(p["blockCount"]), u64(p["mapsPerBlock"]), u64(p["lastBlockMaps"]), codecs.c_str(), filters.c_str());
+               "           %s, %" PRIu64 " maps per block (last block %" PRIu64 "), codecs: %s; filters: %s\n",
+               cli::count(u64(p["blockCount"]), "block").c_str(), u64(p["mapsPerBlock"]), u64(p["lastBlockMaps"]),
+               codecs.c_str(), filters.c_str());
   // Per-block stored sizes: every one for a few blocks, else the spread (JSON lists them all).
   std::vector<uint64_t> sizes;
   for (const auto& b : p["blocks"]) sizes.push_back(u64(b["storedBytes"]));
