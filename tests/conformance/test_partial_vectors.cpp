@@ -3,12 +3,10 @@
 // so a set added without rebuilding still runs. vff-bake --merge of a valid set writes the bytes of
 // its expected.vff (XXH3-64 and size as manifest.json records them); of an invalid set, it exits
 // with the rule's code, prints "PART: NAME (ID)" of the one rule the folder's name starts with, and
-// writes nothing.
+// writes nothing. vff-inspect reports every valid partial with its range (schema-checked).
 #include <gtest/gtest.h>
 #include <unistd.h>
 #include <xxhash.h>
-
-#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cstdio>
@@ -16,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <string>
 #include <vector>
@@ -32,7 +31,9 @@ std::string readText(const fs::path& p) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-json manifest() { return json::parse(readText(kDir / "manifest.json"), nullptr, false); }
+json manifest() {
+  return json::parse(readText(kDir / "manifest.json"), nullptr, false);
+}
 
 std::string hex64(const std::string& b) {
   char s[17];
@@ -101,8 +102,8 @@ TEST_P(MergeSet, MergesOrRefusesWithItsId) {
   // The folder's name starts with the ID the manifest gives, and the tool names exactly that rule.
   const std::string id = std::to_string(set["id"].get<int>());
   EXPECT_EQ(name.substr(0, id.size() + 1), id + "-");
-  const std::string tag = (dir / set["refused"].get<std::string>()).string() + ": " + set["name"].get<std::string>() +
-                          " (" + id + "): ";
+  const std::string tag =
+      (dir / set["refused"].get<std::string>()).string() + ": " + set["name"].get<std::string>() + " (" + id + "): ";
   EXPECT_NE(err.find(tag), std::string::npos) << "expected \"" << tag << "\" in:\n" << err;
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << "one refusal, one line:\n" << err;
   EXPECT_FALSE(fs::exists(out)) << "a refused merge wrote its output";
@@ -124,12 +125,46 @@ TEST(PartialVectors, ManifestMatchesFoldersAndCoversEveryFileRule) {
   int valid = 0;
   for (const auto& [name, set] : m["sets"].items()) {
     EXPECT_TRUE(std::count(folders.begin(), folders.end(), name)) << name << " has no folder";
-    if (set["exit"] == 0) ++valid;
-    else ids.insert(set["id"].get<int>());
+    if (set["exit"] == 0)
+      ++valid;
+    else
+      ids.insert(set["id"].get<int>());
   }
   EXPECT_EQ(folders.size(), m["sets"].size());
   EXPECT_GE(valid, 3);
   for (int id = 12002; id <= 12019; ++id) EXPECT_TRUE(ids.count(id)) << "no invalid set raises " << id;
+}
+
+// vff-inspect's JSON report of every valid partial gives its range, counts only the range's maps and
+// conforms to spec/inspect-schema.json; the merged whole fields report "partial": null.
+TEST(PartialVectors, InspectReportsEveryValidPartial) {
+  const json m = manifest();
+  ASSERT_TRUE(m.is_object());
+  Scratch scratch;
+  const fs::path report = scratch.dir / "report.json", log = scratch.dir / "log";
+  auto inspect = [&](const fs::path& file) {
+    const int rc = run(std::string("\"") + VFF_INSPECT + "\" --format json \"" + file.string() + "\" >\"" +
+                           report.string() + "\" 2>\"" + log.string() + "\" && \"" + VFF_SCHEMA_CHECK + "\" \"" +
+                           VFF_INSPECT_SCHEMA + "\" \"" + report.string() + "\"",
+                       scratch.dir / "schema-log");
+    EXPECT_EQ(rc, 0) << file << ": " << readText(log) << readText(scratch.dir / "schema-log");
+    return json::parse(readText(report), nullptr, false);
+  };
+  ASSERT_GE(m["partials"].size(), 6u);
+  for (const auto& [name, r] : m["partials"].items()) {
+    const json doc = inspect(kDir / name);
+    ASSERT_TRUE(doc.is_object()) << name;
+    const uint64_t maps = r["mapEnd"].get<uint64_t>() - r["mapBegin"].get<uint64_t>();
+    EXPECT_EQ(doc["partial"],
+              (json{{"mapBegin", r["mapBegin"]}, {"mapEnd", r["mapEnd"]}, {"mapCount", r["mapCount"]}, {"maps", maps}}))
+        << name;
+    const uint64_t m2 = doc["field"]["mapResolution"].get<uint64_t>() * doc["field"]["mapResolution"].get<uint64_t>();
+    EXPECT_EQ(doc["statistics"]["texels"].get<uint64_t>(), maps * m2) << name;
+  }
+  for (const auto& [name, set] : m["sets"].items()) {
+    if (set["exit"] != 0) continue;
+    EXPECT_TRUE(inspect(kDir / "merge" / name / "expected.vff")["partial"].is_null()) << name;
+  }
 }
 
 // The committed vectors are what the generator makes now. A different libzstd may compress
