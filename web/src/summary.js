@@ -54,7 +54,7 @@ function planeLines(file, name, p) {
   const out = [
     `  ${rpad(name, 8)} ${bytes(raw)} raw, ${p.mapBytes} bytes per map`,
     `           stored ${bytes(stored)}, compression ratio ${fixed((raw / stored), 3)} (raw/stored)`,
-    `           ${p.blockCount} blocks, ${p.mapsPerBlock} maps per block (last block ${last}), codecs: ${count((b) => (b.codec ? 'zstd' : 'stored'))}; filters: ${count((b) => (b.filter ? 'hits-med' : 'none'))}`,
+    `           ${p.blockCount} block${p.blockCount === 1 ? '' : 's'}, ${p.mapsPerBlock} maps per block (last block ${last}), codecs: ${count((b) => (b.codec ? 'zstd' : 'stored'))}; filters: ${count((b) => (b.filter ? 'hits-med' : 'none'))}`,
   ];
   const sizes = p.blocks.map((b) => b.storedSize);
   if (sizes.length <= 32) out.push(`           block stored bytes: ${sizes.map((s, i) => (i === 0 ? '' : i % 8 === 0 ? ',\n                                ' : ', ') + s).join('')}`);
