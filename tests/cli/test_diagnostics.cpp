@@ -32,6 +32,15 @@ TEST(Diagnostics, NameThePathOnce) {
             "vff-bake: error: m.glb: mesh-empty (10004): the mesh has no triangles");
   EXPECT_EQ(vff::cli::formatDiagnostic("vff-bake", "error", "", makeError(Code::kIoOpen, "m.glb: gone")),
             "vff-bake: error: io-open (1001): m.glb: gone");
+  // A JSON reader's LINE:COLUMN after the path joins the place; a path followed by other text after
+  // its colon stays whole.
+  EXPECT_EQ(vff::cli::formatDiagnostic("vff-bake", "error", "s.json",
+                                       makeError(Code::kSceneJson, "s.json:2:14: fields[0]: syntax error")),
+            "vff-bake: error: s.json:2:14: scene-json (11001): fields[0]: syntax error");
+  EXPECT_EQ(vff::cli::formatDiagnostic("vff-bake", "error", "s.json", makeError(Code::kSceneJson, "s.json:2x: odd")),
+            "vff-bake: error: s.json: scene-json (11001): s.json:2x: odd");
+  EXPECT_EQ(vff::cli::formatDiagnostic("vff-bake", "error", "s.json", makeError(Code::kSceneJson, "s.json:2:: odd")),
+            "vff-bake: error: s.json: scene-json (11001): s.json:2:: odd");
 }
 
 TEST(Diagnostics, CountsTakeTheirNumber) {

@@ -50,9 +50,43 @@ std::string versionString(std::string_view prog) {
          std::to_string(kVersionMajor) + "." + std::to_string(kVersionMinor) + ")";
 }
 
+namespace {
+
+// The length of "LINE:COLUMN" at the start of `s` (the place a JSON reader gives after the file
+// name, spec/scene.md section 1), or 0.
+size_t lineColumnLength(std::string_view s) {
+  size_t i = 0, parts = 0;
+  while (parts < 2) {
+    const size_t start = i;
+    while (i < s.size() && s[i] >= '0' && s[i] <= '9') ++i;
+    if (i == start) return 0;
+    if (++parts < 2) {
+      if (i >= s.size() || s[i] != ':') return 0;
+      ++i;
+    }
+  }
+  return i;
+}
+
+}  // namespace
+
 std::string formatDiagnostic(std::string_view prog, std::string_view severity, std::string_view file,
                              const Error& error) {
+  // libvff and the baker name the file in their messages ("P: not a regular file", a JSON reader's
+  // "P:LINE:COLUMN: ..."), for callers that print only the message; the diagnostic names it once,
+  // in its place, with the line and column when the message has them.
+  std::string_view message = error.message;
   std::string place(file);
+  if (!file.empty() && message.size() > file.size() + 2 && message.starts_with(file)) {
+    const std::string_view rest = message.substr(file.size());
+    if (rest.starts_with(": ")) {
+      message.remove_prefix(file.size() + 2);
+    } else if (const size_t n = rest.size() > 1 && rest[0] == ':' ? lineColumnLength(rest.substr(1)) : 0;
+               n > 0 && rest.substr(1 + n).starts_with(": ")) {
+      place += rest.substr(0, 1 + n);
+      message.remove_prefix(file.size() + 1 + n + 2);
+    }
+  }
   if (error.offset != kNoOffset) place += "@" + hex(error.offset);
   if (error.section != 0) {
     if (!place.empty()) place += ' ';
@@ -61,12 +95,6 @@ std::string formatDiagnostic(std::string_view prog, std::string_view severity, s
   std::string s = std::string(prog) + ": " + std::string(severity) + ": ";
   if (!place.empty()) s += place + ": ";
   s += codeName(error.code);
-  // libvff and the baker name the file in their messages ("P: not a regular file"), for callers
-  // that print only the message; the diagnostic names it once, in its place.
-  std::string_view message = error.message;
-  if (!file.empty() && message.size() > file.size() + 2 && message.starts_with(file) &&
-      message.substr(file.size(), 2) == ": ")
-    message.remove_prefix(file.size() + 2);
   s += " (" + std::to_string(static_cast<uint32_t>(error.code)) + "): ";
   s += message;
   return s;
