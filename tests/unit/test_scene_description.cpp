@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <utility>
 
 #include "vff/scene_description.h"
 #include "vff/strict_json.h"
@@ -222,14 +223,58 @@ TEST(SceneDescription, MinorVersionIsANonNegativeInteger) {
     return parseSceneDescription(R"({"asset":{"format":"vff-scene","version":1,"minorVersion":)" + minor +
                                      R"(},"fields":[],"instances":[]})", "m.json");
   };
-  EXPECT_TRUE(with("0"));
-  EXPECT_TRUE(with("7"));
-  EXPECT_TRUE(with("2.0"));  // an integer by value, as JSON Schema counts them
-  for (const char* bad : {"-1", "\"1\"", "1.5", "null"}) {
+  for (const char* good : {"0", "7", "-0", "18446744073709551615"}) EXPECT_TRUE(with(good)) << good;
+  // An integer is written without a fraction or an exponent (spec/scene.md section 1), unlike JSON
+  // Schema's integers by value; one beyond 64 bits is out of range, refused the same way.
+  const std::pair<const char*, const char*> bad[] = {{"-1", "-1"}, {"\"1\"", "\"1\""}, {"1.5", "1.5"},
+                                                     {"null", "null"}, {"2.0", "2.0"}, {"2e1", "20.0"},
+                                                     {"18446744073709551616", "1.8446744073709552e+19"},
+                                                     {"-9223372036854775808", "-9223372036854775808"}};
+  for (const auto& [text, shownAs] : bad) {
+    auto r = with(text);
+    ASSERT_FALSE(r) << text;
+    EXPECT_EQ(r.error().code, Code::kSceneValue) << text;
+    EXPECT_EQ(r.error().message, std::string("m.json: asset.minorVersion: expected a non-negative integer, got ") + shownAs);
+  }
+}
+
+TEST(SceneDescription, VersionIsTheInteger1AsWritten) {
+  const auto with = [](const std::string& version) {
+    return parseSceneDescription(R"({"asset":{"format":"vff-scene","version":)" + version +
+                                     R"(},"fields":[],"instances":[]})", "v.json");
+  };
+  EXPECT_TRUE(with("1"));
+  for (const char* bad : {"1.0", "1e0", "\"1\"", "-1", "18446744073709551617"}) {
+    auto r = with(bad);
+    ASSERT_FALSE(r) << bad;
+    EXPECT_EQ(r.error().code, Code::kSceneVersion) << bad;
+  }
+  EXPECT_EQ(with("1.0").error().message, "v.json: asset.version: is 1.0; this reader implements version 1");
+}
+
+// `field` is an integer as written (no fraction, no exponent, within 64 bits), then an index.
+TEST(SceneDescription, FieldIsAnIntegerAsWrittenThenAnIndex) {
+  const auto with = [](const std::string& field) {
+    return parseSceneDescription(R"({"asset":{"format":"vff-scene","version":1},"fields":[{"uri":"a.vff"},)"
+                                 R"({"uri":"b.vff"}],"instances":[{"field":)" + field + "}]}", "f.json");
+  };
+  const std::pair<const char*, uint32_t> good[] = {{"1", 1}, {"0", 0}, {"-0", 0}};
+  for (const auto& [text, index] : good) {
+    auto r = with(text);
+    ASSERT_TRUE(r) << text << ": " << r.error().toString();
+    EXPECT_EQ(r->instances[0].field, index) << text;
+  }
+  for (const char* bad : {"1.0", "0e5", "1e30", "18446744073709551616", "-9223372036854775809", "true"}) {
     auto r = with(bad);
     ASSERT_FALSE(r) << bad;
     EXPECT_EQ(r.error().code, Code::kSceneValue) << bad;
-    EXPECT_EQ(r.error().message, std::string("m.json: asset.minorVersion: expected a non-negative integer, got ") + bad);
+    EXPECT_EQ(r.error().message.rfind("f.json: instances[0].field: expected an integer, got ", 0), 0u) << r.error().message;
+  }
+  for (const char* out : {"2", "-1", "18446744073709551615", "-9223372036854775808"}) {
+    auto r = with(out);
+    ASSERT_FALSE(r) << out;
+    EXPECT_EQ(r.error().code, Code::kSceneFieldIndex) << out;
+    EXPECT_EQ(r.error().message, std::string("f.json: instances[0].field: index ") + out + " is not one of the 2 fields");
   }
 }
 

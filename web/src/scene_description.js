@@ -18,6 +18,10 @@ export const SCENE_CODE_NAMES = Object.freeze({
 /** How deep objects and arrays may nest (spec/scene.md section 1, rule 3). */
 export const MAX_JSON_DEPTH = 64;
 
+// The range of an integer (spec/scene.md section 1): readers hold integers in 64 bits.
+const INT64_MIN = -(2n ** 63n);
+const UINT64_MAX = 2n ** 64n - 1n;
+
 /** A scene description that breaks a rule: `id` is the rule's ID, `codeName` its name. */
 export class SceneError extends Error {
   constructor(id, message) {
@@ -42,7 +46,8 @@ const isPlainKey = (k) => /^[A-Za-z_][A-Za-z0-9_]*$/.test(k);
 const keySegment = (k) => (isPlainKey(k) ? `.${k}` : `[${JSON.stringify(k)}]`);
 const joinPath = (segments) => segments.join('').replace(/^\./, '');
 
-/** A JSON value with the kind of number it was written as kept: numbers become {num: value}. */
+/** A JSON value with the kind of number it was written as kept: numbers become {num: value}, and
+ * integers {num: value, int: exact value as a BigInt}. */
 class Parser {
   constructor(bytes) {
     this.b = bytes;
@@ -142,6 +147,12 @@ class Parser {
     this.i += m[0].length;
     const num = Number(m[0]);
     if (!Number.isFinite(num)) this.fail(`the number ${m[0]} is not representable as a finite binary64`, start);
+    // An integer is written without a fraction or an exponent and held in 64 bits (spec/scene.md
+    // section 1); `int` keeps its exact value, since a binary64 cannot (2^64 - 1 rounds to 2^64).
+    if (m[2] === undefined && m[3] === undefined) {
+      const int = BigInt(m[0]);
+      if (int >= INT64_MIN && int <= UINT64_MAX) return { num: num + 0, int };  // + 0: -0 is the integer 0
+    }
     return { num };
   }
 
@@ -205,7 +216,7 @@ function place(bytes, at) {
 
 /**
  * Checks and parses one JSON text by the rules of spec/scene.md section 1. Objects become Maps,
- * numbers {num}. Throws {line, column, path, message} (a plain object) on the first problem.
+ * numbers {num} (integers {num, int}). Throws {line, column, path, message} (a plain object) on the first problem.
  */
 export function parseStrictJson(bytes) {
   const p = new Parser(bytes);
@@ -222,10 +233,14 @@ export function parseStrictJson(bytes) {
 
 const isNumber = (v) => v !== null && typeof v === 'object' && 'num' in v;
 const isObject = (v) => v instanceof Map;
-const isInteger = (v) => isNumber(v) && Number.isInteger(v.num);
+const isInteger = (v) => isNumber(v) && 'int' in v;
 
 /** A value as messages quote it, cut short. */
 function shown(v) {
+  if (isInteger(v)) return String(v.int);  // exactly as written, as libvff quotes it
+  // A number written with a fraction or an exponent but integral in value: "1.0", as libvff quotes
+  // it, so that "is 1.0; this reader implements version 1" does not read as a contradiction.
+  if (isNumber(v) && Number.isInteger(v.num) && Math.abs(v.num) < 1e15) return `${v.num + 0}.0`;
   const plain = (x) => (x instanceof Map ? Object.fromEntries([...x].map(([k, y]) => [k, plain(y)]))
     : Array.isArray(x) ? x.map(plain) : isNumber(x) ? x.num : x);
   const s = JSON.stringify(plain(v));
@@ -307,10 +322,10 @@ export function readSceneDescription(bytes, name) {
   if (asset.get('format') !== 'vff-scene') fail(11002, 'asset.format', `is ${shown(asset.get('format'))}, not "vff-scene"`);
   if (!asset.has('version')) missing('asset.version');
   const version = asset.get('version');
-  if (!isInteger(version) || version.num !== 1) fail(11002, 'asset.version', `is ${shown(version)}; this reader implements version 1`);
+  if (!isInteger(version) || version.int !== 1n) fail(11002, 'asset.version', `is ${shown(version)}; this reader implements version 1`);
   if (asset.has('minorVersion')) {
     const m = asset.get('minorVersion');
-    if (!isInteger(m) || m.num < 0) value('asset.minorVersion', `expected a non-negative integer, got ${shown(m)}`);
+    if (!isInteger(m) || m.int < 0n) value('asset.minorVersion', `expected a non-negative integer, got ${shown(m)}`);
   }
   const generator = optionalString(asset, 'generator', 'asset');
   for (const key of ['fields', 'instances']) {
@@ -348,7 +363,7 @@ export function readSceneDescription(bytes, name) {
     if (!inst.has('field')) missing(`${where}.field`);
     const field = inst.get('field');
     if (!isInteger(field)) value(`${where}.field`, `expected an integer, got ${shown(field)}`);
-    if (field.num < 0 || field.num >= fields.length) {
+    if (field.int < 0n || field.int >= BigInt(fields.length)) {
       fail(11005, `${where}.field`, `index ${shown(field)} is not one of the ${fields.length} fields`);
     }
     const instName = optionalString(inst, 'name', where);

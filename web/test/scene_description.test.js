@@ -96,3 +96,28 @@ test('JSON text problems carry line, column and path', () => {
   assert.match(problem(`${'['.repeat(65)}${']'.repeat(65)}`), /^1:65: .*nest deeper than 64/);
   assert.equal(problem(Uint8Array.from([0xef, 0xbb, 0xbf, 0x7b, 0x7d])), 'accepted');
 });
+
+// An integer is written without a fraction or an exponent and held in 64 bits (spec/scene.md
+// section 1); the messages quote it as written, as libvff does.
+test('integers are integers as written, within 64 bits', () => {
+  const read = (field, asset = '"version": 1') => {
+    const text = `{"asset": {"format": "vff-scene", ${asset}}, "fields": [{"uri": "a.vff"}, {"uri": "b.vff"}], "instances": [{"field": ${field}}]}`;
+    try {
+      return readSceneDescription(new TextEncoder().encode(text), 's.json').instances[0].field;
+    } catch (e) {
+      assert.ok(e instanceof SceneError, String(e));
+      return `${e.id} ${e.detail}`;
+    }
+  };
+  assert.ok(Object.is(read('-0'), 0));
+  assert.equal(read('1'), 1);
+  assert.equal(read('1.0'), '11003 s.json: instances[0].field: expected an integer, got 1.0');
+  assert.equal(read('0e5'), '11003 s.json: instances[0].field: expected an integer, got 0.0');
+  assert.match(read('18446744073709551616'), /^11003 s\.json: instances\[0\]\.field: expected an integer/);
+  assert.match(read('-9223372036854775809'), /^11003 s\.json: instances\[0\]\.field: expected an integer/);
+  assert.equal(read('18446744073709551615'), '11005 s.json: instances[0].field: index 18446744073709551615 is not one of the 2 fields');
+  assert.equal(read('-9223372036854775808'), '11005 s.json: instances[0].field: index -9223372036854775808 is not one of the 2 fields');
+  assert.equal(read('0', '"version": 1.0'), '11002 s.json: asset.version: is 1.0; this reader implements version 1');
+  assert.equal(read('0', '"version": 1, "minorVersion": 2e1'), '11003 s.json: asset.minorVersion: expected a non-negative integer, got 20.0');
+  assert.equal(read('0', '"version": 1, "minorVersion": 18446744073709551615'), 0);
+});

@@ -5,6 +5,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <optional>
@@ -38,12 +39,18 @@ Error missing(const std::string& name, const std::string& where) {
   return valueError(name, where, "a required member is missing");
 }
 
-// Integers are JSON numbers whose binary64 value is an integer (1, 1.0 and 1e0 alike, as JSON Schema).
-bool isInteger(const json& v) {
-  if (v.is_number_integer()) return true;
-  if (!v.is_number_float()) return false;
-  const double d = v.get<double>();
-  return std::isfinite(d) && std::trunc(d) == d;
+// An integer is a number written without a fraction or an exponent (spec/scene.md section 1, as
+// library manifests count them): the parser keeps those as int64 or uint64 (-0 as the integer 0). An
+// integer text beyond 64 bits reaches us as a float, refused like 1.0: out of every range an
+// integer member has.
+bool isInteger(const json& v) { return v.is_number_integer() || v.is_number_unsigned(); }
+
+// An integer's value where it is non-negative; nothing for a negative integer.
+std::optional<uint64_t> nonNegative(const json& v) {
+  if (v.is_number_unsigned()) return v.get<uint64_t>();
+  const int64_t i = v.get<int64_t>();
+  if (i < 0) return std::nullopt;
+  return uint64_t(i);
 }
 
 // A number's binary32 value (round to nearest), or nothing where it rounds to infinity: magnitudes
@@ -180,11 +187,11 @@ Result<SceneInstance> parseInstance(const json& i, size_t fieldCount, const std:
   if (!i.contains("field")) return missing(name, where + ".field");
   const json& fv = i["field"];
   if (!isInteger(fv)) return valueError(name, where + ".field", "expected an integer, got " + shown(fv));
-  const double field = fv.get<double>();
-  if (field < 0 || field >= double(fieldCount))
+  const std::optional<uint64_t> field = nonNegative(fv);
+  if (!field || *field >= fieldCount)
     return sceneError(Code::kSceneFieldIndex, name, where + ".field",
                       "index " + shown(fv) + " is not one of the " + std::to_string(fieldCount) + " fields");
-  out.field = uint32_t(field);
+  out.field = uint32_t(*field);
   auto n = optionalString(i, "name", name, where);
   if (!n) return std::move(n).error();
   out.name = std::move(*n);
@@ -220,11 +227,11 @@ Result<std::string> parseAsset(const json& doc, const std::string& name) {
     return sceneError(Code::kSceneVersion, name, "asset.format", "is " + shown(asset["format"]) + ", not \"vff-scene\"");
   if (!asset.contains("version")) return missing(name, "asset.version");
   const json& v = asset["version"];
-  if (!isInteger(v) || v.get<double>() != kSceneDescriptionVersion)
+  if (!isInteger(v) || nonNegative(v) != uint64_t(kSceneDescriptionVersion))
     return sceneError(Code::kSceneVersion, name, "asset.version", "is " + shown(v) + "; this reader implements version 1");
   if (asset.contains("minorVersion")) {
     const json& m = asset["minorVersion"];
-    if (!isInteger(m) || m.get<double>() < 0)
+    if (!isInteger(m) || !nonNegative(m))
       return valueError(name, "asset.minorVersion", "expected a non-negative integer, got " + shown(m));
   }
   return optionalString(asset, "generator", name, "asset");

@@ -64,6 +64,11 @@ INVALID = {
         "version-string": scene([], []).replace('"version": 1', '"version": "1"'),
         "version-1.5": scene([], []).replace('"version": 1', '"version": 1.5'),
         "version-before-fields": '{"asset": {"format": "vff-scene", "version": 2}}\n',
+        # An integer is written without a fraction or an exponent (spec/scene.md section 1).
+        "version-1.0": scene([], []).replace('"version": 1', '"version": 1.0'),
+        "version-exponent": scene([], []).replace('"version": 1', '"version": 1e0'),
+        "integers-by-value": scene(['{"uri": "a.vff"}', '{"uri": "b.vff"}'], [inst('"field": 1.0'), inst('"field": 0e5')]
+                                   ).replace('"version": 1', '"version": 1.0, "minorVersion": 2e1'),
     },
     11003: {
         "asset-missing": '{"fields": [], "instances": []}\n',
@@ -73,6 +78,9 @@ INVALID = {
         "minor-version-negative": scene([], []).replace('"version": 1', '"version": 1, "minorVersion": -1'),
         "minor-version-string": scene([], []).replace('"version": 1', '"version": 1, "minorVersion": "1"'),
         "minor-version-fraction": scene([], []).replace('"version": 1', '"version": 1, "minorVersion": 0.5'),
+        "minor-version-2.0": scene([], []).replace('"version": 1', '"version": 1, "minorVersion": 2.0'),
+        "minor-version-exponent": scene([], []).replace('"version": 1', '"version": 1, "minorVersion": 2e1'),
+        "minor-version-beyond-64-bits": scene([], []).replace('"version": 1', '"version": 1, "minorVersion": 18446744073709551616'),
         "generator-not-a-string": scene([], []).replace('"version": 1', '"version": 1, "generator": 3'),
         "fields-missing": HEAD + '"instances": []}\n',
         "fields-not-an-array": HEAD + '"fields": {}, "instances": []}\n',
@@ -85,6 +93,14 @@ INVALID = {
         "instance-not-an-object": scene(ONE_FIELD, ["0"]),
         "instance-field-missing": scene(ONE_FIELD, [inst('"name": "x"')]),
         "instance-field-fraction": scene(ONE_FIELD, [inst('"field": 0.5')]),
+        "instance-field-0.0": scene(ONE_FIELD, [inst('"field": 0.0')]),
+        "instance-field-exponent": scene(ONE_FIELD, [inst('"field": 0e5')]),
+        "instance-field-huge-exponent": scene(ONE_FIELD, [inst('"field": 1e30')]),
+        "instance-field-beyond-64-bits": scene(ONE_FIELD, [inst('"field": 18446744073709551616')]),
+        "instance-field-below-64-bits": scene(ONE_FIELD, [inst('"field": -9223372036854775809')]),
+        "minor-version-before-field": scene(['{"uri": "a.vff"}', '{"uri": "b.vff"}'], [inst('"field": 1.0')]
+                                            ).replace('"version": 1', '"version": 1, "minorVersion": 2e1'),
+        "instance-field-by-value": scene(['{"uri": "a.vff"}', '{"uri": "b.vff"}'], [inst('"field": 1.0'), inst('"field": 0e5')]),
         "instance-field-string": scene(ONE_FIELD, [inst('"field": "0"')]),
         "instance-name-not-a-string": scene(ONE_FIELD, [inst('"field": 0, "name": 1')]),
         "translation-two-numbers": scene(ONE_FIELD, [inst('"field": 0, "translation": [0, 0]')]),
@@ -125,7 +141,8 @@ INVALID = {
         "index-past-the-end": scene(ONE_FIELD, [inst('"field": 1')]),
         "index-negative": scene(ONE_FIELD, [inst('"field": -1')]),
         "index-without-fields": scene([], [inst('"field": 0')]),
-        "index-huge": scene(ONE_FIELD, [inst('"field": 1e30')]),
+        "index-huge": scene(ONE_FIELD, [inst('"field": 18446744073709551615')]),
+        "index-most-negative": scene(ONE_FIELD, [inst('"field": -9223372036854775808')]),
         "index-in-second-instance": scene(ONE_FIELD, [inst('"field": 0'), inst('"field": 2')]),
         "index-before-translation": scene(ONE_FIELD, [inst('"field": 1, "translation": [1e39, 0, 0]')]),
     },
@@ -155,8 +172,8 @@ VALID = {
         ['{"uri": "a.vff", "future": {"x": [1e308]}, "source": {"k": {"k": 1}}}'],
         [inst('"field": 0, "extras": {"big": 1e308, "small": 1e-400, "deep": ' + "[" * 60 + "]" * 60 + '}, "later": true')],
         ', "extras": {"k": 1}, "later": [1, 2]').replace('"version": 1', '"version": 1, "minorVersion": 7, "generator": "hand", "x": null'),
-    "integers-by-value": scene(['{"uri": "a.vff"}', '{"uri": "b.vff"}'], [inst('"field": 1.0'), inst('"field": 0e5')]
-                               ).replace('"version": 1', '"version": 1.0, "minorVersion": 2e1'),
+    "integers-at-the-edges": scene(['{"uri": "a.vff"}', '{"uri": "b.vff"}'], [inst('"field": -0'), inst('"field": 1')]
+                                   ).replace('"version": 1', '"version": 1, "minorVersion": 18446744073709551615'),
     "nesting-depth-64": scene([], [], ', "extras": ' + "[" * 63 + "]" * 63),
     "windows-drive-lookalike": scene(['{"uri": "./C:/a.vff"}', '{"uri": "dir/C:a.vff"}'], []),
 }
