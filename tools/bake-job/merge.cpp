@@ -295,7 +295,8 @@ int mergeParts(const Options& o, const MergeHooks& hooks) {
                               {"seconds", secondsSince(t0)}};
     std::printf("%s\n", summary.dump(2).c_str());
   } else if (!o.quiet) {
-    std::fprintf(stderr, "%s: merged %zu parts, %u maps -> %s\n", kProg, parts.size(), first.file.field().mapCount,
+    std::fprintf(stderr, "%s: merged %s, %s -> %s\n", kProg, cli::count(parts.size(), "part").c_str(),
+                 cli::count(first.file.field().mapCount, "map").c_str(),
                  o.output.c_str());
   }
   return cli::kExitSuccess;

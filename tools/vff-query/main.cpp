@@ -495,9 +495,9 @@ std::optional<int> printTiming(const Options& o, const Run& r, const std::option
     batch = std::min(batch, sec(b0, Clock::now()));
   }
   std::fprintf(stderr,
-               "vff-query: timing: %zu rays, %u threads, %s: field %.4f s, read %.4f s, query and write %.4f s, total %.4f s "
+               "vff-query: timing: %s, %s, %s: field %.4f s, read %.4f s, query and write %.4f s, total %.4f s "
                "(%.1f Mrays/s); batch, answers kept, warm: %.4f s (%.1f Mrays/s); batch alone, warm: %.4f s (%.1f Mrays/s)\n",
-               src.size, r.threads, o.interpolated ? "interpolated" : "nearest", sec(at.open, at.read), sec(at.read, at.query),
+               cli::count(src.size, "ray").c_str(), cli::count(r.threads, "thread").c_str(), o.interpolated ? "interpolated" : "nearest", sec(at.open, at.read), sec(at.read, at.query),
                sec(at.query, at.end), sec(at.open, at.end), n / std::max(1e-9, sec(at.open, at.end)), keptBatch,
                n / std::max(1e-9, keptBatch), batch, n / std::max(1e-9, batch));
   return std::nullopt;
