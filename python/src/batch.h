@@ -155,30 +155,35 @@ inline RayOrigin rayOriginOf(const std::string& name) {
   throw py::value_error("ray_origin: expected 'on-object' or 'off-object', got '" + name + "'");
 }
 
-// (threads is taken as any integer so that a negative one is a ValueError naming it, not pybind11's
-// "incompatible function arguments".)
+// Runs work(first, rays) over the batch's chunks on its threads, without the GIL; each worker
+// turns its chunks into rays in a buffer of its own.
+template <class Work>
+void parallel(const RayBatch& b, Work work) {
+  py::gil_scoped_release unlocked;
+  std::vector<std::vector<Ray>> buffers(vff::parallel::workerCount(b.n, kChunk, b.threads));
+  vff::parallel::parallelForWorkers(b.n, kChunk, b.threads, [&](unsigned w, size_t first, size_t end) {
+    std::vector<Ray>& rays = buffers[w];
+    rays.resize(std::min(kChunk, b.n));
+    b.fill(first, end - first, rays.data());
+    work(first, std::span<const Ray>(rays.data(), end - first));
+  });
+}
+
 // Raises a ValueError for the first bad ray of the batch ("ray 12: the direction is zero"), before
 // anything is answered (an out= array keeps its answers). A pass over the rays of its own, on the
 // batch's threads without the GIL: the answers would be lost anyway, and a pass that only reads
 // the arrays adds little to one that also answers them.
 inline void checkRays(const RayBatch& b) {
   std::atomic<size_t> firstBad{SIZE_MAX};
-  {
-    py::gil_scoped_release unlocked;
-    std::vector<std::vector<Ray>> buffers(vff::parallel::workerCount(b.n, kChunk, b.threads));
-    vff::parallel::parallelForWorkers(b.n, kChunk, b.threads, [&](unsigned w, size_t first, size_t end) {
-      std::vector<Ray>& rays = buffers[w];
-      rays.resize(std::min(kChunk, b.n));
-      b.fill(first, end - first, rays.data());
-      for (size_t k = 0; k < end - first; ++k) {
-        if (rayIsGood(rays[k])) continue;
-        size_t seen = firstBad.load(std::memory_order_relaxed);
-        while (first + k < seen && !firstBad.compare_exchange_weak(seen, first + k, std::memory_order_relaxed)) {
-        }
-        break;
+  parallel(b, [&](size_t first, std::span<const Ray> rays) {
+    for (size_t k = 0; k < rays.size(); ++k) {
+      if (rayIsGood(rays[k])) continue;
+      size_t seen = firstBad.load(std::memory_order_relaxed);
+      while (first + k < seen && !firstBad.compare_exchange_weak(seen, first + k, std::memory_order_relaxed)) {
       }
-    });
-  }
+      break;
+    }
+  });
   const size_t bad = firstBad.load();
   if (bad == SIZE_MAX) return;
   Ray r;
@@ -186,6 +191,8 @@ inline void checkRays(const RayBatch& b) {
   throw py::value_error("ray " + std::to_string(bad) + ": " + rayProblem(r).value_or("refused"));
 }
 
+// (threads is taken as any integer so that a negative one is a ValueError naming it, not pybind11's
+// "incompatible function arguments".)
 inline RayBatch batchOf(const py::object& origins, const py::object& directions, const py::object& tmin,
                  const py::object& tmax, bool interpolated, float intraBias, const std::string& rayOrigin, int64_t threads) {
   if (threads < 0 || threads > int64_t(UINT32_MAX))
@@ -209,20 +216,6 @@ inline RayBatch batchOf(const py::object& origins, const py::object& directions,
   b.threads = vff::parallel::resolveThreads(unsigned(threads));
   checkRays(b);
   return b;
-}
-
-// Runs work(first, rays) over the batch's chunks on its threads, without the GIL; each worker
-// turns its chunks into rays in a buffer of its own.
-template <class Work>
-void parallel(const RayBatch& b, Work work) {
-  py::gil_scoped_release unlocked;
-  std::vector<std::vector<Ray>> buffers(vff::parallel::workerCount(b.n, kChunk, b.threads));
-  vff::parallel::parallelForWorkers(b.n, kChunk, b.threads, [&](unsigned w, size_t first, size_t end) {
-    std::vector<Ray>& rays = buffers[w];
-    rays.resize(std::min(kChunk, b.n));
-    b.fill(first, end - first, rays.data());
-    work(first, std::span<const Ray>(rays.data(), end - first));
-  });
 }
 
 // A target's batch call for the chunk of rays that starts at ray `first` of the batch: the
