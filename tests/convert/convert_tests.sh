@@ -317,12 +317,13 @@ test_exr_without_field_is_invalid_input() {
 
 test_bad_field_attribute_is_invalid_input() {
   local text
-  for text in '{not json' '{"format":"vff-convert-exr/1"}' '{"format":"other"}'; do
+  for text in '{not json' '{"format":"vff-convert-exr/1"}' '{"format":"other"}' '{"format":5}' '[1]'; do
     "$CHECK" plain-exr "$WORK/bad.exr" "$text" || fail "cannot write bad.exr"
     convert "$WORK/bad.exr" --to vff "$WORK/x.vff"
     expect_rc 3
     expect_err "bad.exr"
     expect_err "vff.field"
+    if grep -q "internal error" "$WORK/err"; then fail "internal error for $text"; fi
   done
   # A well-formed description whose parts are missing.
   field "$WORK/a.vff" unorm8-diameter

@@ -73,7 +73,7 @@ Status parseFieldJson(const std::string& text, const char* formatName, const std
   const auto badField = [&](const std::string& what) { return makeError(Code::kMetadataJson, where + ": " + what); };
   const json j = json::parse(text, nullptr, false);
   if (j.is_discarded() || !j.is_object()) return badField("is not a JSON object");
-  if (j.value("format", std::string()) != formatName)
+  if (!j.contains("format") || !j["format"].is_string() || j["format"].get<std::string>() != formatName)
     return badField(std::string("format is not \"") + formatName + "\"");
   try {
     const json& f = j.at("field");
