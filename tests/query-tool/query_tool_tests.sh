@@ -290,6 +290,10 @@ test_bad_lines_name_line_and_column() {
   query "$f" <"$WORK/in"
   expect_rc 3
   expect_err_re '<stdin>:1:[0-9]+: invalid JSON'
+  printf '[1e400,0,0,0,0,1]\n' >"$WORK/in"
+  query "$f" <"$WORK/in"
+  expect_rc 3
+  expect_err "<stdin>:1:1: invalid JSON: a number is beyond the binary64 range"
 }
 
 # Text input that is not quite text: a UTF-8 byte order mark is skipped (the rays answer as

@@ -92,6 +92,9 @@ std::optional<LineError> parseJson(std::string_view line, Ray* ray) {
     const size_t colon = what.find("syntax error");
     return LineError{0, e.byte ? e.byte : 1,
                      "invalid JSON: " + shown(colon == std::string::npos ? what : what.substr(colon), 200)};
+  } catch (const nlohmann::json::out_of_range&) {
+    // nlohmann refuses a number beyond binary64 (1e400) after the parse, with no place.
+    return LineError{0, 1, "invalid JSON: a number is beyond the binary64 range"};
   }
   auto numbers = [](const nlohmann::json& a, size_t count, const char* name, float* v) -> std::optional<std::string> {
     if (!a.is_array() || a.size() != count) return std::string(name) + " must be an array of " + std::to_string(count) + " numbers";
