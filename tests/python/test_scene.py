@@ -1,4 +1,5 @@
 """vff.Scene and vff.load_scene: batches against the loop over the scene's instances."""
+import os
 import json
 
 import numpy as np
@@ -228,6 +229,19 @@ def test_scene_errors_are_scene_errors(tmp_path):
     assert (e.value.code, e.value.name) == (11001, "scene-json")
     assert e.value.message.startswith("%s:2:13: fields[0]: syntax error" % path), e.value.message
     assert str(e.value).startswith("scene-json (11001): ")
+
+
+def test_scene_description_must_be_a_regular_file(tmp_path):
+    # A named pipe is refused at once (io-open), as File.open refuses it, instead of waiting for a
+    # writer (a regression hangs until ctest's limit).
+    fifo = tmp_path / "pipe.vffscene.json"
+    os.mkfifo(fifo)
+    with pytest.raises(vff.IoError) as e:
+        vff.load_scene(str(fifo))
+    assert e.value.code == 1001 and e.value.message == "%s: not a regular file" % fifo
+    with pytest.raises(vff.IoError) as e:
+        vff.load_scene(str(tmp_path))
+    assert e.value.code == 1001
 
 
 def test_scene_vectors_invalid():

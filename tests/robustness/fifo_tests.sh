@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # fifo_tests.sh - every tool given a named pipe (mkfifo) where it reads a file.
 #
-# The rule (docs/robustness.md, "Inputs that are not regular files"): a field, a mesh, a level set or
-# a part to merge must be a regular file; anything else (a FIFO, a folder, a device) is refused
+# The rule (docs/robustness.md, "Inputs that are not regular files"): a field, a mesh, a level set,
+# a part to merge or a library manifest must be a regular file; anything else (a FIFO, a folder, a device) is refused
 # before it is read, exit 2, "PATH: ... io-open (1001): not a regular file". A FIFO opened for
 # reading waits for a writer, so a tool that opened one the plain way would hang: every command here
 # runs under `timeout`, and a hang fails as exit 124 instead of stalling the suite. vff-query's rays
@@ -10,11 +10,11 @@
 #
 # Every function named test_* is one ctest case (tests/robustness/CMakeLists.txt); `bash
 # fifo_tests.sh test_NAME` runs one. The environment says where things are:
-#   VFF_INSPECT VFF_QUERY VFF_CONVERT VFF_COMPRESS VFF_BAKE   the tools
+#   VFF_INSPECT VFF_QUERY VFF_CONVERT VFF_COMPRESS VFF_BAKE VFF_LIBRARY   the tools
 #   FIELD   a valid .vff (a conformance vector)
 #   WORK    a scratch folder of this test (emptied first)
 set -euo pipefail
-: "${VFF_INSPECT:?}" "${VFF_QUERY:?}" "${VFF_CONVERT:?}" "${VFF_COMPRESS:?}" "${VFF_BAKE:?}" "${FIELD:?}" "${WORK:?}"
+: "${VFF_INSPECT:?}" "${VFF_QUERY:?}" "${VFF_CONVERT:?}" "${VFF_COMPRESS:?}" "${VFF_BAKE:?}" "${VFF_LIBRARY:?}" "${FIELD:?}" "${WORK:?}"
 
 source "$(dirname "${BASH_SOURCE[0]}")/../common/cli_harness.sh"
 
@@ -113,6 +113,11 @@ test_bake_refuses_fifo() {
   refused vff-bake "$WORK/mesh.glb" "$VFF_BAKE" "$WORK/mesh.glb" --split mesh -o "$WORK/outdir/s.vffscene.json" -m 4
   mkfifo "$WORK/part.vff"
   refused vff-bake "$WORK/part.vff" "$VFF_BAKE" --merge "$WORK/part.vff" -o "$WORK/outdir/o.vff"
+}
+
+test_library_refuses_fifo_manifest() {
+  mkfifo "$WORK/library.json"
+  refused vff-library "$WORK/library.json" "$VFF_LIBRARY" bake "$WORK/library.json" --out "$WORK/outdir"
 }
 
 run_test "$1"

@@ -221,6 +221,12 @@ std::optional<std::string> checkEntry(const Checker& c, const json& j, const std
 
 std::optional<std::string> readManifest(const std::string& path, const std::string& outDir,
                                         std::vector<Entry>* entries, int* rc) {
+  // A named pipe or a folder is refused, not waited on.
+  if (Status st = cli::checkRegularFile(path); !st) {
+    *rc = cli::kExitIo;
+    const std::string line = cli::formatDiagnostic(kProg, "error", path, st.error());
+    return line.substr(line.find(path));  // "PATH: io-open (1001): ...", as the other tools say it
+  }
   std::ifstream in(path, std::ios::binary);
   std::stringstream text;
   if (in) text << in.rdbuf();

@@ -1,6 +1,8 @@
 // scene_description.cpp - reading and writing scene descriptions (spec/scene.md).
 #include "vff/scene_description.h"
 
+#include "platform/mapped_file.h"
+
 #include <unistd.h>
 
 #include <charconv>
@@ -314,12 +316,11 @@ Result<SceneDescription> parseSceneDescription(std::string_view text, const std:
 }
 
 Result<SceneDescription> readSceneDescription(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return makeError(Code::kIoOpen, path + ": cannot be opened");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) return makeError(Code::kIoRead, path + ": cannot be read");
-  return parseSceneDescription(ss.str(), path);
+  // As File::open: a named pipe or a folder is refused (io-open) instead of waited on.
+  detail::MappedFile file;
+  if (Status st = file.open(path, false); !st) return st.error();
+  const std::span<const uint8_t> b = file.bytes();
+  return parseSceneDescription(std::string_view(reinterpret_cast<const char*>(b.data()), b.size()), path);
 }
 
 Result<std::string> formatSceneDescription(const SceneDescription& scene) {
