@@ -5,8 +5,8 @@
 //   2  a .npy matrix (readNpyMatrix).
 // Ray lines: every ray read passes rayIsGood (a bad one is reported instead); a reported line and
 // column lie inside the input; their messages are printable ASCII (bytes outside it are shown as
-// \xHH). .npy: a matrix read has 6 or 8 columns and exactly its data bytes, checkRay and rayIsGood
-// agree on each of its rows, and npyMatrixBytes of what was read reads back equal.
+// \xHH). .npy: a matrix read has exactly its data bytes, checkRay and rayIsGood agree on each row
+// of a matrix of 6 or 8 columns, and npyMatrixBytes of what was read reads back equal.
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -60,10 +60,11 @@ void npy(std::span<const uint8_t> bytes) {
     checkMessage(*e, {reinterpret_cast<const char*>(bytes.data()), bytes.size()}, false);
     return;
   }
-  if ((m.cols != 6 && m.cols != 8) || m.data.size() != m.rows * m.cols * 4) fail("a matrix of the wrong size", "");
+  if (m.data.size() != m.rows * m.cols * 4) fail("a matrix of the wrong size", "");
   std::vector<float> values(m.rows * m.cols);
   if (!values.empty()) std::memcpy(values.data(), m.data.data(), m.data.size());
-  for (uint64_t r = 0; r < m.rows; ++r) {
+  // (Rays only of 6 or 8 columns: vff-query refuses other shapes after reading.)
+  for (uint64_t r = 0; r < m.rows && (m.cols == 6 || m.cols == 8); ++r) {
     const float* v = values.data() + r * m.cols;
     vff::Ray ray{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}, 0.0f, std::numeric_limits<float>::infinity()};
     if (m.cols == 8) ray.tmin = v[6], ray.tmax = v[7];
