@@ -93,6 +93,25 @@ TEST(SceneDescription, WriterTextReadsBackToTheSameValues) {
   EXPECT_EQ(*again, *text);
 }
 
+TEST(SceneDescription, NegativeZeroReadsBackNegative) {
+  // "-0" is the integer 0 to a JSON reader; the writer gives a negative zero a fraction, so that the
+  // text reads back to the same bits and formats to the same bytes (found by the scene fuzz target).
+  auto s = parseSceneDescription(kExample, "ex.json");
+  ASSERT_TRUE(s);
+  s->instances[0].translation.y = -0.0f;
+  s->instances[0].rotation = {-0.0f, 0.0f, 0.0f, 1.0f};
+  auto text = formatSceneDescription(*s);
+  ASSERT_TRUE(text) << text.error().toString();
+  EXPECT_NE(text->find("\"translation\": [-2, -0.0, 0.5]"), std::string::npos) << *text;
+  auto back = parseSceneDescription(*text, "back.json");
+  ASSERT_TRUE(back) << back.error().toString();
+  EXPECT_TRUE(std::signbit(back->instances[0].translation.y));
+  EXPECT_TRUE(std::signbit(back->instances[0].rotation[0]));
+  auto again = formatSceneDescription(*back);
+  ASSERT_TRUE(again);
+  EXPECT_EQ(*again, *text);
+}
+
 TEST(SceneDescription, WriterRefusesWhatTheReaderRefuses) {
   SceneDescription s;
   s.fields.push_back({"a.vff", "", ""});

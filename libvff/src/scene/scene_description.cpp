@@ -239,8 +239,10 @@ Result<std::string> parseAsset(const json& doc, const std::string& name) {
   return optionalString(asset, "generator", name, "asset");
 }
 
-// The shortest text that reads back as the same float.
+// The shortest text that reads back as the same float. A negative zero keeps a fraction: "-0" is
+// the integer 0 to a JSON reader, and would come back as +0.
 std::string floatText(float v) {
+  if (v == 0.0f && std::signbit(v)) return "-0.0";
   char buf[32];
   auto r = std::to_chars(buf, buf + sizeof buf, v);
   return std::string(buf, r.ptr);
