@@ -338,7 +338,8 @@ raw = open(work + "/ok.npy", "rb").read()
 n = struct.unpack("<H", raw[8:10])[0]
 for name, text in [("nobrace", "{'descr': '<f4', 'fortran_order': False, 'shape': (1, 6) "),
                    ("extra", "{'descr': '<f4', 'fortran_order': False, 'shape': (1, 6), 'x': 1}"),
-                   ("twice", "{'descr': '<f4', 'descr': '<f4', 'fortran_order': False, 'shape': (1, 6)}")]:
+                   ("twice", "{'descr': '<f4', 'descr': '<f4', 'fortran_order': False, 'shape': (1, 6)}"),
+                   ("bel", "{'descr': '<f\x07', 'fortran_order': False, 'shape': (1, 6)}")]:
     open(work + "/" + name + ".npy", "wb").write(raw[:10] + (text.ljust(n - 1) + "\n").encode() + raw[10 + n:])
 PY
   query "$f" -i "$WORK/ok.npy"
@@ -352,6 +353,11 @@ PY
   query "$f" -i "$WORK/twice.npy"
   expect_rc 3
   expect_err "names 'descr' twice"
+  # A header value is shown as the ray lines show bytes: never raw control characters.
+  query "$f" -i "$WORK/bel.npy"
+  expect_rc 3
+  expect_err "expected dtype float32 ('<f4'), found '<f\\x07'"
+  if grep -q $'\a' "$WORK/err"; then fail "a raw BEL reached the message"; fi
 }
 
 test_bad_npy_names_expected() {
@@ -387,6 +393,12 @@ test_errors_and_exit_codes() {
   expect_err "--ray number 1: the direction is zero"
   query "$VECTORS/bit1-stored.vff" --ray 0 0 5 0 0 -1 -i "$WORK/x.csv"
   expect_rc 1
+  query "$VECTORS/bit1-stored.vff" --ray 0 0 5 0 0 -1 --tmin nan
+  expect_rc 1
+  expect_err "--tmin is not a number (nan)"
+  query "$VECTORS/bit1-stored.vff" --ray 0 0 5 0 0 -1 --tmax nan
+  expect_rc 1
+  expect_err "--tmax is not a number (nan)"
   query "$VECTORS/bit1-stored.vff" -i "$WORK/none.csv"
   expect_rc 2
   expect_err "$WORK/none.csv"

@@ -16,6 +16,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -265,6 +266,10 @@ std::optional<int> parseCommandLine(int argc, char** argv, Options& o) {
   if (auto rc = cli::parse(app, kProg, argc, argv)) return *rc;
   if (!o.rays.empty() && !o.input.empty()) {
     cli::usageError(kProg, "--ray and --input exclude each other");
+    return cli::kExitUsage;
+  }
+  if (std::isnan(o.tmin) || std::isnan(o.tmax)) {
+    cli::usageError(kProg, std::isnan(o.tmin) ? "--tmin is not a number (nan)" : "--tmax is not a number (nan)");
     return cli::kExitUsage;
   }
   if (o.tmin > o.tmax) {

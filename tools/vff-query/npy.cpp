@@ -1,5 +1,6 @@
 // npy.cpp - reading and writing the .npy files of npy.h (the format of numpy.lib.format).
 #include "npy.h"
+#include "rays.h"
 
 #include <bit>
 #include <cstring>
@@ -121,15 +122,15 @@ std::optional<std::string> readNpyMatrix(std::span<const uint8_t> bytes, NpyMatr
   const auto order = dictValue(header, "'fortran_order'");
   const auto shapeText = dictValue(header, "'shape'");
   if (!descr || !order || !shapeText) return "the .npy header lacks descr, fortran_order or shape";
-  if (*descr != "'<f4'") return "expected dtype float32 ('<f4'), found " + std::string(*descr);
-  if (*order != "False") return "expected a C-order array, found fortran_order " + std::string(*order);
+  if (*descr != "'<f4'") return "expected dtype float32 ('<f4'), found " + shown(*descr);
+  if (*order != "False") return "expected a C-order array, found fortran_order " + shown(*order);
   const auto shape = parseShape(*shapeText);
-  if (!shape) return "expected a 2-D array of shape (N, 6) or (N, 8), found shape " + std::string(*shapeText);
+  if (!shape) return "expected a 2-D array of shape (N, 6) or (N, 8), found shape " + shown(*shapeText);
   const uint64_t dataBytes = shape->first * shape->second * 4;
   const size_t dataStart = start + headerLen;
   if (dataBytes != bytes.size() - dataStart)
     return "the data holds " + std::to_string(bytes.size() - dataStart) + " bytes, the shape " +
-           std::string(*shapeText) + " needs " + std::to_string(dataBytes);
+           shown(*shapeText) + " needs " + std::to_string(dataBytes);
   out->rows = shape->first;
   out->cols = shape->second;
   out->data = bytes.subspan(dataStart);

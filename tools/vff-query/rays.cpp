@@ -13,23 +13,7 @@
 
 namespace vff::query_tool {
 
-namespace {
-
-bool isBlank(char c) { return c == ' ' || c == '\t'; }
-
-// The 6 or 8 numbers of a ray into `ray`.
-void assign(Ray* ray, const float* v, size_t n) {
-  ray->origin = {v[0], v[1], v[2]};
-  ray->direction = {v[3], v[4], v[5]};
-  if (n == 8) {
-    ray->tmin = v[6];
-    ray->tmax = v[7];
-  }
-}
-
-// Bytes of the input as a message may show them: printable ASCII as is, every other byte as \xHH
-// (a terminal must not receive raw binary), cut after `limit` bytes.
-std::string shown(std::string_view bytes, size_t limit = 40) {
+std::string shown(std::string_view bytes, size_t limit) {
   std::string out;
   for (size_t k = 0; k < bytes.size() && k < limit; ++k) {
     const unsigned char c = static_cast<unsigned char>(bytes[k]);
@@ -43,6 +27,20 @@ std::string shown(std::string_view bytes, size_t limit = 40) {
   }
   if (bytes.size() > limit) out += "...";
   return out;
+}
+
+namespace {
+
+bool isBlank(char c) { return c == ' ' || c == '\t'; }
+
+// The 6 or 8 numbers of a ray into `ray`.
+void assign(Ray* ray, const float* v, size_t n) {
+  ray->origin = {v[0], v[1], v[2]};
+  ray->direction = {v[3], v[4], v[5]};
+  if (n == 8) {
+    ray->tmin = v[6];
+    ray->tmax = v[7];
+  }
 }
 
 // A CSV line. columns[i]: the 1-based column where number i starts.

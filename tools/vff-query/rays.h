@@ -36,6 +36,10 @@ struct ParsedRays {
 };
 
 // Reads text lines of rays (see above). Stops at the first bad line.
+// Bytes of the input as a message may show them: printable ASCII as is, every other byte (and " and
+// \) as \xHH, since a terminal must not receive raw binary; cut after `limit` bytes.
+std::string shown(std::string_view bytes, size_t limit = 40);
+
 ParsedRays parseRayLines(std::string_view text, float tmin, float tmax);
 
 // Checks one ray: finite origin and direction, a non-zero direction, tmin <= tmax, no NaN bound.
