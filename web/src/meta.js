@@ -98,16 +98,64 @@ export function checkJsonText(b) {
   return null;
 }
 
+// The raw texts of the numbers that are members of the top-level "vff.partial" object (the last
+// such member wins, as in JSON.parse), and whether any number of the text lies beyond binary64. The
+// text is one valid JSON text (rule 8001 passed). JSON.parse keeps neither `3` apart from `3.0` nor
+// fails on `1e400`, where vff-inspect's parser (nlohmann-json) does both.
+function partialNumberTexts(text) {
+  let raw = {}, overflow = false, expectKey = false;
+  const stack = [], keyAt = [];
+  for (let i = 0; i < text.length;) {
+    const c = text[i];
+    if (c === '"') {
+      let j = i + 1;
+      while (text[j] !== '"') j += text[j] === '\\' ? 2 : 1;
+      if (expectKey) {
+        keyAt[stack.length - 1] = JSON.parse(text.slice(i, j + 1));
+        if (stack.length === 1 && keyAt[0] === 'vff.partial') raw = {};
+        expectKey = false;
+      }
+      i = j + 1;
+    } else if (c === '{' || c === '[') {
+      stack.push(c);
+      expectKey = c === '{';
+      ++i;
+    } else if (c === '}' || c === ']') {
+      stack.pop();
+      ++i;
+    } else if (c === ',') {
+      expectKey = stack[stack.length - 1] === '{';
+      ++i;
+    } else if (c === '-' || (c >= '0' && c <= '9')) {
+      let j = i + 1;
+      while (j < text.length && '0123456789eE+-.'.includes(text[j])) ++j;
+      const t = text.slice(i, j);
+      if (!Number.isFinite(Number(t))) overflow = true;
+      if (stack.length === 2 && stack[0] === '{' && stack[1] === '{' && keyAt[0] === 'vff.partial') raw[keyAt[1]] = t;
+      i = j;
+    } else {
+      ++i;
+    }
+  }
+  return { raw, overflow };
+}
+
 /**
  * A partial result (spec/partial.md: META has "vff.partial"): null for a whole field, else
  * {mapBegin, mapEnd, mapCount, maps} as vff-inspect --format json reports it ("partial"), with
  * mapBegin, mapEnd and maps null when "vff.partial" gives no range mapBegin < mapEnd <= mapCount =
- * the field's mapCount. `meta` is the parsed META object (or null), `fieldMapCount` FDSC mapCount.
+ * the field's mapCount. `meta` is the parsed META object (or null), `fieldMapCount` FDSC mapCount,
+ * `text` META's text: given, the bounds count only when written as integers (`3`, not `3.0`, `3e0`
+ * or `-0`), and a META with a number beyond binary64 is no partial result, as vff-inspect reads it.
  */
-export function partialRange(meta, fieldMapCount) {
+export function partialRange(meta, fieldMapCount, text = undefined) {
   if (!meta || typeof meta !== 'object' || !Object.hasOwn(meta, 'vff.partial')) return null;
+  const numbers = text === undefined ? null : partialNumberTexts(text);
+  if (numbers?.overflow) return null;
   const p = meta['vff.partial'];
-  const u32 = (k) => p && typeof p === 'object' && !Array.isArray(p) && Number.isInteger(p[k]) && p[k] >= 0 && p[k] <= 0xffffffff;
+  const written = (k) => numbers === null || /^(0|[1-9][0-9]*)$/.test(numbers.raw[k] ?? '');
+  const u32 = (k) => p && typeof p === 'object' && !Array.isArray(p) && Number.isInteger(p[k]) && p[k] >= 0 &&
+    p[k] <= 0xffffffff && written(k);
   if (u32('mapBegin') && u32('mapEnd') && u32('mapCount')) {
     const { mapBegin, mapEnd, mapCount } = p;
     if (mapBegin < mapEnd && mapEnd <= mapCount && mapCount === fieldMapCount) {

@@ -108,7 +108,7 @@ function histogramLines(file, partial) {
 /** The summary of an opened file, named `name`, line for line as vff-inspect prints it. */
 export function summary(file, name) {
   const h = file.header, f = file.field, L = file.layout;
-  const partial = partialRange(file.metadata?.value ?? null, f.mapCount);
+  const partial = partialRange(file.metadata?.value ?? null, f.mapCount, file.metadata?.text);
   const out = [
     `file:        ${name}`,
     `format:      vff ${h.versionMajor}.${h.versionMinor}, ${bytes(h.fileSize)}`,

@@ -16,7 +16,7 @@ const manifest = JSON.parse(readFileSync(join(dir, 'manifest.json'), 'utf8'));
 await initVff();
 const inspect = process.env.VFF_INSPECT;
 const open = (rel) => openVff(new Uint8Array(readFileSync(join(dir, rel))));
-const partialOf = (file) => partialRange(file.metadata?.value ?? null, file.field.mapCount);
+const partialOf = (file) => partialRange(file.metadata?.value ?? null, file.field.mapCount, file.metadata?.text);
 
 test('the manifest lists every part of every valid set', () => {
   const onDisk = [];
@@ -55,4 +55,20 @@ test('whole fields are not partial; a vff.partial without a valid range still is
   assert.deepEqual(partialOf(open('merge/12009-partial-range/p2.vff')), none);
   assert.deepEqual(partialOf(open('merge/12003-partial-object/p2.vff')), none);
   assert.equal(partialOf(open('merge/12002-partial-missing/p2.vff')), null);
+});
+
+test('bounds count as vff-inspect reads them: integers as written, no number beyond binary64', () => {
+  const range = (text) => partialRange(JSON.parse(text), 6, text);
+  const part = (b, e, c, extra = '') => `{"a":[1,{"mapBegin":9.5}],${extra}"vff.partial":{"codec":"zstd","mapBegin":${b},"mapCount":${c},"mapEnd":${e},"x":"\\"mapBegin\\":7"}}`;
+  const none = { mapBegin: null, mapEnd: null, mapCount: 6, maps: null };
+  assert.deepEqual(range(part('2', '4', '6')), { mapBegin: 2, mapEnd: 4, mapCount: 6, maps: 2 });
+  assert.deepEqual(range(part('2.0', '4', '6')), none);
+  assert.deepEqual(range(part('2', '4e0', '6')), none);
+  assert.deepEqual(range(part('-0', '4', '6')), none);
+  assert.deepEqual(range(part('0', '4', '6')), { mapBegin: 0, mapEnd: 4, mapCount: 6, maps: 4 });
+  // nlohmann-json refuses the whole text over one number beyond binary64: no partial result.
+  assert.equal(range(part('2', '4', '6', '"big":1e400,')), null);
+  assert.deepEqual(range(part('2', '4', '6', '"tiny":1e-400,')), { mapBegin: 2, mapEnd: 4, mapCount: 6, maps: 2 });
+  // Without the text (a caller holding only the parsed value) the values decide.
+  assert.deepEqual(partialRange(JSON.parse(part('2.0', '4', '6')), 6), { mapBegin: 2, mapEnd: 4, mapCount: 6, maps: 2 });
 });
