@@ -1,7 +1,7 @@
 // scene_experiment.cpp - the paper's Fig. 6 setting: a room traced exactly and several moving
 // objects, each through its own field, against the fully exact render.
 //
-// The room (a floor and two walls, 10 x 10, 5 high) is made here. The objects are the --mesh
+// The room (a floor and two walls, 5 high, open to the right) is made here. The objects are the --mesh
 // (the bunny by default) and every --object mesh or, without --object, four procedural shapes
 // (torus-knot, bowl, box, rod); each is scaled to a bounding radius of 1 and moves along a scripted
 // path around the room's centre (turning about y; even ones rest on the floor, odd ones float and
@@ -64,7 +64,10 @@ RTCScene meshScene(RTCDevice device, const vff::bake::Mesh& m) {
   return s;
 }
 
-// The room: floor y = 0, back wall z = -5, left wall x = -5.
+// The room: floor y = 0, back wall z = -5, left wall x = -5. Open to the right, where the floor and
+// the back wall run on past the camera's view, so that no pixel sees outside the room.
+constexpr float kRoomRight = 12.0f;
+
 vff::bake::Mesh roomMesh() {
   vff::bake::Mesh m;
   auto quad = [&](Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
@@ -72,8 +75,8 @@ vff::bake::Mesh roomMesh() {
     for (Vec3 p : {a, b, c, d}) m.positions.insert(m.positions.end(), {p.x, p.y, p.z});
     m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
   };
-  quad({-5, 0, -5}, {-5, 0, 5}, {5, 0, 5}, {5, 0, -5});
-  quad({-5, 0, -5}, {5, 0, -5}, {5, 5, -5}, {-5, 5, -5});
+  quad({-5, 0, -5}, {-5, 0, 5}, {kRoomRight, 0, 5}, {kRoomRight, 0, -5});
+  quad({-5, 0, -5}, {kRoomRight, 0, -5}, {kRoomRight, 5, -5}, {-5, 5, -5});
   quad({-5, 0, -5}, {-5, 5, -5}, {-5, 5, 5}, {-5, 0, 5});
   return m;
 }
