@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "input_files.h"
 #include "vff/vff.h"
 
 namespace {
@@ -110,23 +111,14 @@ std::string outcome(const std::vector<uint8_t>& bytes, vff::ChecksumPolicy polic
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<fs::path> files;
-  for (int a = 1; a < argc; ++a) {
-    const fs::path p = argv[a];
-    if (fs::is_directory(p)) {
-      for (const auto& e : fs::recursive_directory_iterator(p))
-        if (e.is_regular_file()) files.push_back(e.path());
-    } else if (fs::is_regular_file(p)) {
-      files.push_back(p);
-    } else {
-      std::fprintf(stderr, "vff_fuzz_first_error: %s: no such file or folder\n", p.c_str());
-      return 2;
-    }
+  std::string missing;
+  const std::vector<fs::path> files = vff::fuzz::inputFiles(argc, argv, &missing);
+  if (!missing.empty()) {
+    std::fprintf(stderr, "vff_fuzz_first_error: %s: no such file or folder\n", missing.c_str());
+    return 2;
   }
-  std::sort(files.begin(), files.end());
   for (const fs::path& p : files) {
-    std::ifstream in(p, std::ios::binary);
-    const std::vector<uint8_t> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    const std::vector<uint8_t> bytes = vff::fuzz::fileBytes(p);
     std::printf("%s", p.c_str());
     for (vff::ChecksumPolicy c : {vff::ChecksumPolicy::kVerifyAll, vff::ChecksumPolicy::kLazy, vff::ChecksumPolicy::kNone})
       std::printf("\t%s", outcome(bytes, c).c_str());
