@@ -218,9 +218,11 @@ Result<std::vector<GltfObject>> loadGltfObjects(const std::string& path, const G
       bakedMatrix[12] = bakedMatrix[13] = bakedMatrix[14] = 0;
       place.translation = {float(n.world[12]), float(n.world[13]), float(n.world[14])};
     }
-    const bool shared = options.split == GltfSplit::kMesh && similar;
+    const bool ownFrame = options.split == GltfSplit::kMesh && options.ownFrame;
+    if (ownFrame && !similar) bakedMatrix = detail::identity();
+    const bool shared = options.split == GltfSplit::kMesh && (similar || ownFrame);
     if (shared && sharedObject.count(n.mesh)) {
-      objects[sharedObject[n.mesh]].placements.push_back(place);
+      if (similar) objects[sharedObject[n.mesh]].placements.push_back(place);
       continue;
     }
     GltfObject obj;
@@ -235,7 +237,7 @@ Result<std::vector<GltfObject>> loadGltfObjects(const std::string& path, const G
     Status s = checkMesh(&*geometry, what);
     if (!s) return std::move(s).error();
     obj.geometry = std::move(*geometry);
-    obj.placements.push_back(place);
+    if (similar || !ownFrame) obj.placements.push_back(place);
     if (shared) sharedObject[n.mesh] = objects.size();
     objects.push_back(std::move(obj));
   }

@@ -3,6 +3,7 @@
 #include "gltf_writer.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -51,6 +52,27 @@ void GltfDoc::addMeshNode(const nlohmann::json& primitive, const float translati
                            {"scale", {scale[0], scale[1], scale[2]}}});
   json["scenes"] = {{{"nodes", {0}}}};
   json["scene"] = 0;
+}
+
+int addMesh(GltfDoc& doc, const Mesh& mesh, const std::string& name) {
+  const size_t n = mesh.vertexCount(), ni = mesh.indices.size();
+  nlohmann::json prim = {
+      {"attributes", {{"POSITION", doc.addAccessor(doc.addView(mesh.positions.data(), n * 12, 0), kFloat, false, n, "VEC3")}}}};
+  // glTF wants a POSITION accessor's min and max.
+  std::array<float, 3> lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
+  for (size_t i = 0; i < mesh.positions.size(); ++i) {
+    lo[i % 3] = std::min(lo[i % 3], mesh.positions[i]);
+    hi[i % 3] = std::max(hi[i % 3], mesh.positions[i]);
+  }
+  doc.json["accessors"].back()["min"] = lo;
+  doc.json["accessors"].back()["max"] = hi;
+  if (mesh.normals.size() == mesh.positions.size())
+    prim["attributes"]["NORMAL"] = doc.addAccessor(doc.addView(mesh.normals.data(), n * 12, 0), kFloat, false, n, "VEC3");
+  prim["indices"] = doc.addAccessor(doc.addView(mesh.indices.data(), ni * 4, 0), kUInt, false, ni, "SCALAR");
+  nlohmann::json m = {{"primitives", {prim}}};
+  if (!name.empty()) m["name"] = name;
+  doc.json["meshes"].push_back(m);
+  return int(doc.json["meshes"].size()) - 1;
 }
 
 bool save(const GltfDoc& doc, const std::string& path, bool glb) {

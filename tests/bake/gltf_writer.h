@@ -47,8 +47,13 @@ GltfDoc makeGltf(const Mesh& mesh, const Quantization& q);
 double quantizationError(const Mesh& mesh, const Quantization& q);
 
 // Draco (KHR_draco_mesh_compression) with lossless float attributes: edgebreaker (reorders the
-// vertices) or sequential (keeps them in order).
-GltfDoc makeDracoGltf(const Mesh& mesh, bool sequential);
+// vertices) or sequential (keeps them in order); with positionBits > 0, positions quantized to that
+// many bits by Draco's encoder (the decoded vertices then move slightly).
+GltfDoc makeDracoGltf(const Mesh& mesh, bool sequential, int positionBits = 0);
+
+// Appends `mesh` as a mesh of one primitive (float positions, normals when it has them, 32-bit
+// indices) named `name`, without a node; returns its index.
+int addMesh(GltfDoc& doc, const Mesh& mesh, const std::string& name);
 
 // EXT_meshopt_compression: vertex and index codecs, the filters named, and an uncompressed
 // fallback buffer without a uri.

@@ -19,7 +19,7 @@ int addFloat3(draco::Mesh* dm, draco::GeometryAttribute::Type type, const std::v
 
 }  // namespace
 
-GltfDoc makeDracoGltf(const Mesh& mesh, bool sequential) {
+GltfDoc makeDracoGltf(const Mesh& mesh, bool sequential, int positionBits) {
   draco::Mesh dm;
   dm.set_num_points(uint32_t(mesh.vertexCount()));
   const int pos = addFloat3(&dm, draco::GeometryAttribute::POSITION, mesh.positions);
@@ -29,6 +29,7 @@ GltfDoc makeDracoGltf(const Mesh& mesh, bool sequential) {
                 draco::PointIndex(mesh.indices[t + 2])});
   draco::Encoder enc;
   enc.SetEncodingMethod(sequential ? draco::MESH_SEQUENTIAL_ENCODING : draco::MESH_EDGEBREAKER_ENCODING);
+  if (positionBits > 0) enc.SetAttributeQuantization(draco::GeometryAttribute::POSITION, positionBits);
   draco::EncoderBuffer out;
   if (!enc.EncodeMeshToBuffer(dm, &out).ok()) return {};
   GltfDoc doc;

@@ -32,6 +32,7 @@ struct Options {
   std::string grid;  // .vdb input: the level set grid to bake (empty: the first)
   int scene = -1;     // glTF input: the scene to bake (-1: the file's default scene)
   std::string split;  // glTF input: "mesh" or "node": a field each and a scene description
+  bool externalFields = false;  // glTF input, .glb output: the fields beside the .glb, referenced by uri
   cli::EnumOption<PositionScheme> positions{"--positions", vff::kPositionSchemes, PositionScheme::kOctaHemi2};
   uint32_t count = 0;  // 0: the scheme's default
   uint32_t mapSize = 64;
@@ -73,6 +74,8 @@ WriteOptions writeOptions(const Options& o);
 // The input is an OpenVDB file, a glTF file (by its extension).
 bool isVdbPath(const std::string& p);
 bool isGltfPath(const std::string& p);
+// The output is a glTF binary (by its extension): a glTF input then gets its fields attached.
+bool isGlbPath(const std::string& p);
 
 // ---- What both bakes share (common.cpp) ---------------------------------------------------------
 // Seconds since `t0`.

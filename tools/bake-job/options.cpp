@@ -23,7 +23,10 @@ uint32_t defaultCount(PositionScheme s) {
 void addOptions(CLI::App& app, Options& o) {
   cli::addVersionFlag(app, kProg);
   app.add_option("mesh", o.mesh, "input mesh, or OpenVDB level set (.vdb); none with --merge");
-  app.add_option("-o,--output", o.output, "output .vff file (written atomically)");
+  app.add_option("-o,--output", o.output,
+                 "output .vff file (written atomically); for a glTF input, a .glb: the input asset with a field "
+                 "attached to each mesh of the scene (the glTF extension VFF_visibility_field), each baked in its "
+                 "mesh's own frame, the same bytes --split mesh writes for it");
   app.add_option("--grid", o.grid, ".vdb input: name of the level set grid to bake (default: the first level set by name)");
   app.add_option("--scene", o.scene, "glTF input: the scene to bake (default: the file's default scene)")
       ->check(CLI::NonNegativeNumber);
@@ -32,6 +35,9 @@ void addOptions(CLI::App& app, Options& o) {
                  "into its own field, and write a scene description (spec/scene.md) to -o, which must end in "
                  ".json; the fields go beside it as STEM.meshI.vff / STEM.nodeJ.vff")
       ->check(CLI::IsMember({"mesh", "node"}));
+  app.add_flag("--external-fields", o.externalFields,
+               "glTF input, -o X.glb: write the fields beside the .glb as X.meshI.vff, referenced by uri, rather "
+               "than inside it");
   o.positions.add(app, "positional-sample scheme")->capture_default_str();
   app.add_option("-n,--count", o.count,
                  "scheme parameter: octa-hemi2 n (maps = 2(2n^2+2n+1), default 32 = 4226 maps), "
@@ -96,6 +102,17 @@ std::optional<std::string> checkOptions(const Options& o) {
   }
   if (!isGltfPath(o.mesh) && (o.scene >= 0 || !o.split.empty()))
     return std::string(o.scene >= 0 ? "--scene" : "--split") + " applies to a glTF input (.gltf, .glb) only";
+  if (o.externalFields && !(isGltfPath(o.mesh) && isGlbPath(o.output)))
+    return "--external-fields applies to a glTF input baked into a .glb output (-o X.glb)";
+  if (isGltfPath(o.mesh) && isGlbPath(o.output)) {
+    if (o.split == "node")
+      return "--split node places a field per node; a .glb output attaches a field to each mesh (--split mesh or "
+             "none), in the mesh's own frame";
+    if (!o.center.empty()) return "a .glb output bakes each mesh in its own sphere: --center/--radius do not apply";
+    if (o.benchmark) return "--benchmark measures one mesh; it does not apply to a .glb output";
+    if (!o.mapRange.empty()) return "a .glb output carries whole fields; --map-range does not apply";
+    return std::nullopt;
+  }
   if (!o.split.empty()) {
     const std::string& out = o.output;
     if (out.size() < 6 || out.compare(out.size() - 5, 5, ".json") != 0)
@@ -139,5 +156,6 @@ bool hasExtension(const std::string& p, const std::string& ext) {
 
 bool isVdbPath(const std::string& p) { return hasExtension(p, ".vdb"); }
 bool isGltfPath(const std::string& p) { return hasExtension(p, ".gltf") || hasExtension(p, ".glb"); }
+bool isGlbPath(const std::string& p) { return hasExtension(p, ".glb"); }
 
 }  // namespace vff::bake_tool

@@ -6,10 +6,13 @@
 
 #include <sys/types.h>
 
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "bake_job.h"
+#include "vff/bake/gltf.h"
 
 namespace vff::bake_tool {
 
@@ -32,6 +35,42 @@ int bakeFromMesh(const Options& o, bake::BakeOptions bo, WriteOptions wo);      
 int bakeFromLevelSet(const Options& o, bake::BakeOptions bo, WriteOptions wo);  // levelset_bake.cpp
 // --split: a field per mesh or node of a glTF scene and a scene description (split_bake.cpp).
 int bakeGltfSplit(const Options& o, bake::BakeOptions bo, WriteOptions wo);
+// glTF input, -o X.glb: a field per mesh attached to the asset (VFF_visibility_field), or beside it
+// with --external-fields (glb_bake.cpp).
+int bakeGltfGlb(const Options& o, bake::BakeOptions bo, WriteOptions wo);
+
+// ---- A set of outputs put in place as one unit (split_bake.cpp, shared with glb_bake.cpp) ------
+// Each output is written to a temporary beside it (.NAME.tmp-PID-0, the names interrupt.cpp knows);
+// only when all of them are complete are they renamed into place, the fields first and the
+// description (or .glb) last, with SIGINT, SIGTERM and SIGHUP held back until the renames are done.
+struct Planned {
+  std::string path;       // the field's file
+  std::string temporary;  // where this run writes it until the whole set is complete
+  FieldDesc field;
+  uint64_t payload = 0;
+};
+// This run's temporary of `path`: DIR/.NAME.tmp-PID-0.
+std::string temporaryOf(const std::string& path);
+// Removes what a run killed outright left of `path`: its finished temporaries and the Writer's
+// temporaries of those, whose process no longer exists.
+void removeStaleSplitTemporaries(const std::string& path);
+void removeAll(const std::vector<std::string>& paths);
+// Writes `bytes` to `path` (a new file or replacing one of this process's), synced when `sync`.
+Status writeText(const std::string& path, std::string_view bytes, bool sync);
+// Every output must be a file the set can replace: a folder in the way fails before any baking
+// (kIoWrite, exit 2). Returns the exit code then.
+std::optional<int> checkOutputs(const std::vector<Planned>& plan, const std::string& output);
+// Bakes `obj` into plan.temporary with the META of a field of one glTF object; *written gains the
+// temporary; *entry: its --json summary. On a failure every temporary of *written is removed and
+// the exit code returned.
+std::optional<int> bakeObject(const Options& o, bake::BakeOptions bo, const WriteOptions& wo, const bake::GltfObject& obj,
+                              const bake::MeshInfo& info, const Planned& plan, std::vector<std::string>* written,
+                              nlohmann::json* entry);
+// Renames the complete new set into place, `output` (from `outputTemporary`) last, and removes the
+// fields of an earlier description at `output` that the new set does not replace (STEM: `output`
+// without its extension). Returns the exit code of a failure.
+std::optional<int> commitSet(const std::vector<Planned>& plan, const std::string& output,
+                             const std::string& outputTemporary, const std::string& stem, bool sync);
 
 // ---- Shared by the mesh bakes (mesh_bake.cpp) ----------------------------------------------------
 // META of a field baked from `mesh` (read from o.mesh); `clipped`: a user sphere cuts it; `gltf`:

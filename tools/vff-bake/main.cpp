@@ -5,10 +5,11 @@
 //   vff-bake mesh.obj --benchmark           Embree's raw throughput on the bake's rays vs the bake
 //   vff-bake shape.vdb -o f.vff [--grid NAME]   from an OpenVDB level set (vff/bake/levelset.h)
 //   vff-bake scene.glb --split mesh -o s.vffscene.json   a field per mesh and a scene description
+//   vff-bake scene.gltf -o out.glb          a field per mesh inside the asset (VFF_visibility_field)
 //   vff-bake mesh.obj -o p0.vff --map-range 0:2113      a partial result: maps [0, 2113) only
 //   vff-bake --merge p1.vff p0.vff -o field.vff         the partial results assembled (spec/partial.md)
 //
-// options.cpp reads the command line, mesh_bake.cpp, split_bake.cpp and levelset_bake.cpp bake, common.cpp holds
+// options.cpp reads the command line, mesh_bake.cpp, split_bake.cpp, glb_bake.cpp and levelset_bake.cpp bake, common.cpp holds
 // what the two bakes share, partial.cpp and merge.cpp the partial results (bake_job.h, bake.h).
 #include "bake.h"
 #include "cli.h"
@@ -25,7 +26,10 @@ int main(int argc, char** argv) {
                "PART... -o OUT assembles the parts into the whole bake's bytes (spec/partial.md). Merge refusals\n"
                "print the rule as NAME (ID), 12001-12019: gaps, overlaps, other geometry, options or version, a\n"
                "malformed or corrupt part: exit 3; a part of another vff.partial version or block codec: exit 5;\n"
-               "-o naming a part: exit 1.\n" +
+               "-o naming a part: exit 1.\n"
+               "glTF input with -o X.glb: the asset as one .glb with a field attached to each mesh of the scene (the\n"
+               "glTF extension VFF_visibility_field), each baked in the mesh's own frame: the bytes --split mesh\n"
+               "writes for it; --external-fields writes them beside it as X.meshI.vff, referenced by uri.\n" +
                vff::cli::exitCodeHelp()};
   addOptions(app, o);
   if (auto rc = vff::cli::parse(app, kProg, argc, argv)) return *rc;
@@ -41,6 +45,7 @@ int main(int argc, char** argv) {
     return vff::cli::kExitUsage;
   }
   if (isVdbPath(o.mesh)) return bakeFromLevelSet(o, bakeOptions(o), writeOptions(o));
+  if (isGltfPath(o.mesh) && isGlbPath(o.output)) return bakeGltfGlb(o, bakeOptions(o), writeOptions(o));
   if (!o.split.empty()) return bakeGltfSplit(o, bakeOptions(o), writeOptions(o));
   return bakeFromMesh(o, bakeOptions(o), writeOptions(o));
 }

@@ -21,6 +21,7 @@
 #include <filesystem>
 #include <optional>
 #include <regex>
+#include <string_view>
 #include <system_error>
 
 #include "bake.h"
@@ -50,6 +51,8 @@ std::string fieldPath(const std::string& stem, const bake::GltfObject& obj, bake
   if (obj.node >= 0) p += ".node" + std::to_string(obj.node);
   return p + ".vff";
 }
+
+}  // namespace
 
 // This run's temporary of `path`: DIR/.NAME.tmp-PID-0, the pattern of the Writer's temporaries, so
 // that removeStaleTemporaries(path) removes it once this process is gone (killed outright).
@@ -85,8 +88,7 @@ void removeAll(const std::vector<std::string>& paths) {
 
 Error ioError(const std::string& what) { return makeError(Code::kIoWrite, what + ": " + std::strerror(errno)); }
 
-// Writes `text` to `path` (a new file or replacing one of this process's), synced when `sync`.
-Status writeText(const std::string& path, const std::string& text, bool sync) {
+Status writeText(const std::string& path, std::string_view text, bool sync) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
   if (fd < 0) return ioError(path + ": cannot be created");
   size_t done = 0;
@@ -115,6 +117,8 @@ void syncFolder(const std::string& path) {
   ::fsync(d);
   ::close(d);
 }
+
+namespace {
 
 // SIGINT, SIGTERM and SIGHUP while the new set is renamed into place: noted, not acted on, so that
 // the renames are never cut short (from whichever thread takes the signal). finish() re-arms
@@ -176,15 +180,8 @@ std::vector<std::string> staleFields(const std::string& output, const std::strin
   return stale;
 }
 
-struct Planned {
-  std::string path;       // the field's file
-  std::string temporary;  // where this run writes it until the whole set is complete
-  FieldDesc field;
-  uint64_t payload = 0;
-};
+}  // namespace
 
-// Renames the complete new set into place, the description last, and removes the old fields it no
-// longer names. Returns the exit code of a failure.
 std::optional<int> commitSet(const std::vector<Planned>& plan, const std::string& output,
                              const std::string& outputTemporary, const std::string& stem, bool sync) {
   std::vector<std::string> newPaths, temporaries;
@@ -216,8 +213,6 @@ std::optional<int> commitSet(const std::vector<Planned>& plan, const std::string
   return std::nullopt;
 }
 
-// Every output of the plan must be a file it can replace: a folder in the way fails now, before
-// any baking (kIoWrite, exit 2), not half way through putting the new set in place.
 std::optional<int> checkOutputs(const std::vector<Planned>& plan, const std::string& output) {
   std::vector<std::string> paths = {output};
   for (const Planned& p : plan) paths.push_back(p.path);
@@ -230,7 +225,47 @@ std::optional<int> checkOutputs(const std::vector<Planned>& plan, const std::str
   return std::nullopt;
 }
 
-}  // namespace
+std::optional<int> bakeObject(const Options& o, bake::BakeOptions bo, const WriteOptions& wo, const bake::GltfObject& obj,
+                              const bake::MeshInfo& info, const Planned& plan, std::vector<std::string>* written,
+                              nlohmann::json* entry) {
+  const std::string& out = plan.path;
+  const std::string& tmp = plan.temporary;
+  nlohmann::json where = {{"scene", info.gltfScene}, {"mesh", obj.mesh}};
+  if (obj.node >= 0) where["node"] = obj.node;
+  WriteOptions fwo = wo;
+  fwo.metadataJson = meshMetadata(o, bo, obj.geometry, info, false, where);
+  removeStaleSplitTemporaries(out);
+  auto writer = Writer::create(tmp, plan.field, fwo);
+  if (!writer) {
+    removeAll(*written);
+    return cli::reportError(kProg, out, writer.error());
+  }
+  // The Writer renames its own temporary to `tmp` when it finishes: both go on an interrupt.
+  written->push_back(tmp);
+  removeTemporaryOnSignal(tmp, *written);
+  auto embree = bake::Scene::create(obj.geometry, o.threads);
+  if (!embree) {
+    removeAll(*written);
+    return cli::reportError(kProg, o.mesh, embree.error());
+  }
+  cli::Progress progress(kProg, !o.quiet && !o.json && isatty(2), uint64_t(o.mapSize) * o.mapSize);
+  bo.progress = [&](uint64_t d, uint64_t t) { progress.update(d, t); };
+  auto baked = bake::bakeField(*embree, bo);
+  if (!baked) {
+    removeAll(*written);
+    return cli::reportError(kProg, o.mesh, baked.error());
+  }
+  double writeSeconds = 0;
+  uint64_t fileBytes = 0;
+  if (auto rc = writeBaked(o, tmp, *writer, *baked, &writeSeconds, &fileBytes)) {
+    removeAll(*written);
+    return *rc;
+  }
+  *entry = bakeSummary(bo, plan.field, baked->stats, plan.payload, baked->stats.seconds);
+  entry->update({{"output", out}, {"name", obj.name}, {"mesh", obj.mesh}, {"instances", obj.placements.size()},
+                 {"triangles", obj.geometry.triangleCount()}, {"fileBytes", fileBytes}});
+  return std::nullopt;
+}
 
 int bakeGltfSplit(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
   const bake::GltfSplit split = o.split == "node" ? bake::GltfSplit::kNode : bake::GltfSplit::kMesh;
@@ -260,38 +295,8 @@ int bakeGltfSplit(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
   for (size_t i = 0; i < objects->size(); ++i) {
     const bake::GltfObject& obj = (*objects)[i];
     const std::string& out = plan[i].path;
-    const std::string& tmp = plan[i].temporary;
-    nlohmann::json where = {{"scene", info.gltfScene}, {"mesh", obj.mesh}};
-    if (obj.node >= 0) where["node"] = obj.node;
-    WriteOptions fwo = wo;
-    fwo.metadataJson = meshMetadata(o, bo, obj.geometry, info, false, where);
-    removeStaleSplitTemporaries(out);
-    auto writer = Writer::create(tmp, plan[i].field, fwo);
-    if (!writer) {
-      removeAll(written);
-      return cli::reportError(kProg, out, writer.error());
-    }
-    // The Writer renames its own temporary to `tmp` when it finishes: both go on an interrupt.
-    written.push_back(tmp);
-    removeTemporaryOnSignal(tmp, written);
-    auto embree = bake::Scene::create(obj.geometry, o.threads);
-    if (!embree) {
-      removeAll(written);
-      return cli::reportError(kProg, o.mesh, embree.error());
-    }
-    cli::Progress progress(kProg, !o.quiet && !o.json && isatty(2), uint64_t(o.mapSize) * o.mapSize);
-    bo.progress = [&](uint64_t d, uint64_t t) { progress.update(d, t); };
-    auto baked = bake::bakeField(*embree, bo);
-    if (!baked) {
-      removeAll(written);
-      return cli::reportError(kProg, o.mesh, baked.error());
-    }
-    double writeSeconds = 0;
-    uint64_t fileBytes = 0;
-    if (auto rc = writeBaked(o, tmp, *writer, *baked, &writeSeconds, &fileBytes)) {
-      removeAll(written);
-      return *rc;
-    }
+    nlohmann::json entry;
+    if (auto rc = bakeObject(o, bo, wo, obj, info, plan[i], &written, &entry)) return *rc;
 
     SceneField f;
     f.uri = encodeSceneUri(baseName(out));  // a file name the reader resolves back (spec/scene.md 3)
@@ -309,9 +314,6 @@ int bakeGltfSplit(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
       inst.scale = pl.scale;
       scene.instances.push_back(std::move(inst));
     }
-    nlohmann::json entry = bakeSummary(bo, plan[i].field, baked->stats, plan[i].payload, baked->stats.seconds);
-    entry.update({{"output", out}, {"name", obj.name}, {"mesh", obj.mesh}, {"instances", obj.placements.size()},
-                  {"triangles", obj.geometry.triangleCount()}, {"fileBytes", fileBytes}});
     report.push_back(entry);
     if (!o.quiet && !o.json)
       std::fprintf(stderr, "%s: %s: object %zu/%zu (mesh %d%s, %s, %s) -> %s\n", kProg, o.mesh.c_str(), i + 1,

@@ -44,6 +44,10 @@ struct GltfObject {
 struct GltfObjectOptions {
   GltfSplit split = GltfSplit::kMesh;
   int scene = -1;  // -1: the file's default scene, else scene 0 (as MeshLoadOptions::gltfScene)
+  // kMesh only: every mesh one object in its own frame (node -1), also a mesh whose nodes are not
+  // similarities; their placements are left out (a field inside a glTF mesh, VFF_visibility_field,
+  // is always in its mesh's frame). An object's placements may then be empty.
+  bool ownFrame = false;
 };
 
 // The objects of one scene of a .gltf/.glb file, in order of first use by a depth-first walk of the
