@@ -17,6 +17,17 @@ need_chromium() {
   VFF_CHROMIUM_PATH="$(command -v "${VFF_CHROMIUM:-chromium}")" || skip "no chromium (apt-get install chromium)"
   export VFF_CHROMIUM_PATH
 }
+need_gltf() {
+  need_node
+  local m
+  for m in @gltf-transform/core @gltf-transform/functions gltf-validator draco3dgltf meshoptimizer three; do
+    [[ -d $WEB/node_modules/$m ]] || skip "no $m in $WEB/node_modules: run scripts/setup.sh (npm ci in web/)"
+  done
+}
+need_bake_scene() {
+  [[ -x ${VFF_BAKE:-} ]] || skip "vff-bake is not built (needs Embree)"
+  [[ -x ${VFF_PROCEDURAL_MESH:-} ]] || skip "vff-procedural-mesh is not built"
+}
 node_test() {
   (cd "$WEB" && node --test "$@") >"$WORK/out" 2>"$WORK/err"
   RC=$?
@@ -63,6 +74,29 @@ test_browser_render() {
   [[ -x ${VFF_BAKE:-} ]] || skip "vff-bake is not built (needs Embree)"
   [[ -f /usr/share/glmark2/models/bunny.obj ]] || skip "no /usr/share/glmark2/models/bunny.obj (apt-get install glmark2-data)"
   VFF_WORK="$WORK" node_test test/browser/render.browser.js
+}
+
+# glTF extension VFF_visibility_field: the JS reader on spec/conformance/gltf and on assets made
+# with glTF-Transform, one case per rule, the match (exact, close, mismatch), quantized positions.
+test_node_gltf_fields() { need_gltf; node_test test/gltf_fields.test.js; }
+
+# The glTF-Transform extension: round trip, dedup, prune, draco, meshopt, quantize; unregistered readers.
+test_node_gltf_transform() { need_gltf; node_test test/gltf_transform.test.js; }
+
+# vff-bake's .glb (the sample scene; suzanne and spot when shared/meshes has them) passes
+# glTF-Validator with no error or warning; the JS reader matches every field exactly.
+test_node_gltf_bake() {
+  need_gltf
+  need_bake_scene
+  VFF_WORK="$WORK" node_test test/gltf_bake.test.js
+}
+
+# In headless Chromium: three.js's GLTFLoader loads vff-bake's .glb and draws the meshes.
+test_browser_gltf_three() {
+  need_chromium
+  need_gltf
+  need_bake_scene
+  VFF_WORK="$WORK" node_test test/browser/gltf_three.browser.js
 }
 
 run_test "$1"
