@@ -96,4 +96,22 @@ inline constexpr uint64_t kMaxPreviewPixels = uint64_t{1} << 26;
 // Errors: kIoWrite (nothing is left at `path`), a map read error, kInvalidArgument (too large).
 Result<PreviewGeometry> writePreview(const File& file, const std::string& path, uint32_t maps);
 
+// ---- glTF assets (gltf.cpp) -----------------------------------------------------------------------
+// A glTF input: a name ending in .gltf or .glb (any case), or a regular file starting with the GLB
+// magic "glTF".
+bool isGltfInput(const std::string& path);
+
+struct GltfInspectOptions {
+  bool json = false;         // --format json
+  uint32_t histogramBins = 16;
+  std::string extractDir;    // --extract: write each valid field's payload there instead of the report
+};
+
+// vff-inspect on a glTF asset: the report of its VFF_visibility_field fields (each payload's summary
+// as for a .vff file) and every problem of the extension's rules, or with extractDir the payloads
+// written to DIR/STEM.meshI.vff (atomically, their bytes unchanged), one path per line. Returns the
+// exit code: 3 for an error problem (2 when every error is a uri file that cannot be read), 5 in a
+// build without the baker.
+int inspectGltf(const std::string& path, const GltfInspectOptions& options);
+
 }  // namespace vff::inspect

@@ -6,6 +6,8 @@
 //   vff-inspect bunny.vff --validate               also every problem the validator finds (exit 3 if any error)
 //   vff-inspect bunny.vff --preview maps.png --maps 100
 //   cat bunny.vff | vff-inspect -
+//   vff-inspect scene.glb [--format json]          the fields a glTF asset's meshes carry (gltf.cpp)
+//   vff-inspect scene.glb --extract DIR            their payloads as DIR/scene.meshI.vff
 #include <cerrno>
 #include <cinttypes>
 #include <cstring>
@@ -29,6 +31,7 @@ struct Options {
   std::string preview;
   uint32_t previewMaps = 64;
   uint32_t histogramBins = 16;
+  std::string extract;
 };
 
 // The exit code for a failed validation: 2 when the file could not even be read, 3 otherwise.
@@ -47,6 +50,31 @@ void printDocument(const json& doc, cli::OutputFormat format) {
     inspect::printText(doc, stdout);
 }
 
+// A glTF input is listed by gltf.cpp (its exit code); --extract is for nothing else. Nothing for
+// a .vff input, which run() goes on with.
+std::optional<int> inspectGltf(const CLI::App& app, const Options& o) {
+  if (!inspect::isGltfInput(o.input)) {
+    if (!app.count("--extract")) return std::nullopt;
+    cli::usageError(kProg, "--extract applies to a glTF input (.gltf, .glb), not to " +
+                               (o.input == "-" ? std::string("standard input") : o.input));
+    return cli::kExitUsage;
+  }
+  // What reads or draws one .vff file's maps has no meaning for an asset of several fields.
+  std::string refused;
+  if (app.count("--preview")) refused += "--preview";
+  if (app.count("--maps")) refused += std::string(refused.empty() ? "" : ", ") + "--maps";
+  if (!refused.empty()) {
+    cli::usageError(kProg, refused + ": not for a glTF input (" + o.input +
+                               "); --extract writes its fields out as .vff files, which take them");
+    return cli::kExitUsage;
+  }
+  if (o.extract == "-") {
+    cli::usageError(kProg, "--extract needs a folder (the fields are not written to standard output)");
+    return cli::kExitUsage;
+  }
+  return inspect::inspectGltf(o.input, {o.common.format == cli::OutputFormat::kJson, o.histogramBins, o.extract});
+}
+
 int run(int argc, char** argv);
 
 }  // namespace
@@ -63,18 +91,30 @@ int run(int argc, char** argv) {
       "Inspects a precomputed 4D visibility field (.vff): header, sections, field description,\n"
       "payload sizes, packed layout, hit ratio, distance histogram and metadata.\n"
       "Data goes to stdout, diagnostics to stderr.\n\n"
+      "A glTF asset (.gltf, .glb, or a file with the GLB magic) is listed instead by the fields its meshes\n"
+      "carry (the extension VFF_visibility_field): per field its mesh, source, bytes, geometryHash, how\n"
+      "it matches the mesh as shipped (exact, close or mismatch, with the bound difference and tau), the\n"
+      "nodes it answers for, and its payload's summary in one line; then every problem as\n"
+      "FILE: PATH: name (ID): message. Exit 3 on an error (2 when the only errors are uri files that\n"
+      "cannot be read). --extract DIR writes each valid field's payload to DIR/STEM.meshI.vff.\n\n"
       "  vff-inspect field.vff --validate\n"
-      "  vff-inspect field.vff --format json --preview maps.png --maps 100\n",
+      "  vff-inspect field.vff --format json --preview maps.png --maps 100\n"
+      "  vff-inspect scene.glb --extract fields/\n",
       kProg};
   app.footer(cli::exitCodeHelp());
   cli::addCommonOptions(app, kProg, o.common);
   app.add_option("file", o.input,
                  "the .vff file to inspect: a regular file (a named pipe or folder is refused, exit 2), or - "
-                 "(standard input, read whole)")
+                 "(standard input, read whole); or a glTF asset (.gltf, .glb) whose meshes carry fields")
       ->required();
+  app.add_option("--extract", o.extract,
+                 "glTF input only: write the payload of each valid field to DIR/STEM.meshI.vff (STEM: the input's "
+                 "name without .glb/.gltf; each written atomically, its bytes unchanged) and print one path per "
+                 "line; DIR must exist")
+      ->option_text("DIR");
   app.add_flag("--validate", o.validate,
                "run the full validator and print every issue (severity, ID, name, section, offset, message); "
-               "exit 3 if any issue is an error");
+               "exit 3 if any issue is an error (a glTF input is always checked so)");
   CLI::Option* preview =
       app.add_option("--preview", o.preview,
                      "write a PNG contact sheet of the first maps: grey = distance (near = bright), misses dark blue, "
@@ -88,6 +128,7 @@ int run(int argc, char** argv) {
       ->check(CLI::Range(1u, 4096u))
       ->option_text("K (default 16)");
   if (auto rc = cli::parse(app, kProg, argc, argv)) return *rc;
+  if (auto gltfRc = inspectGltf(app, o)) return *gltfRc;
   if (o.preview == "-") {
     cli::usageError(kProg, "--preview needs a file name (a PNG is not written to standard output)");
     return cli::kExitUsage;
@@ -100,6 +141,10 @@ int run(int argc, char** argv) {
     auto bytes = cli::readStdin();
     if (!bytes) return cli::reportError(kProg, label, bytes.error());
     stdinBytes = std::move(*bytes);
+    if (stdinBytes.size() >= 4 && std::memcmp(stdinBytes.data(), "glTF", 4) == 0) {
+      cli::usageError(kProg, "a glTF asset is read from a file (its buffers may be files beside it), not from standard input");
+      return cli::kExitUsage;
+    }
   }
   auto openInput = [&](const ReadOptions& ro) {
     return o.input == "-" ? File::openMemory(stdinBytes, ro) : File::open(o.input, ro);
