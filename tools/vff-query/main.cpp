@@ -4,6 +4,7 @@
 //   vff-query bunny.vff < rays.csv --format jsonl            CSV or JSON lines on stdin
 //   vff-query bunny.vff -i rays.npy -o hits.npy              (N, 6) or (N, 8) float32 in, (N, 12) out
 //   vff-query bunny.vff -i rays.csv --interpolated --visibility --rotate 0 1 0 0.5 --translate 2 0 0
+//   vff-query scene.glb --mesh 2 --ray 0 0 5 0 0 -1          mesh 2's field of a glTF asset (mesh space)
 //
 // Every answer is the C++ batch query's (FieldQuery or Instance), split over threads in chunks;
 // the answers do not depend on the thread count. A .npy input is read whole (file_bytes.h) and
@@ -26,6 +27,7 @@
 
 #include "cli.h"
 #include "file_bytes.h"
+#include "gltf_field.h"
 #include "npy.h"
 #include "platform/parallel.h"
 #include "rays.h"
@@ -41,6 +43,7 @@ constexpr size_t kChunk = 4096;  // rays per batch call on one thread (its rays 
 
 struct Options {
   std::string field;
+  int mesh = -1;  // --mesh: the mesh of a glTF asset whose field answers
   std::vector<std::vector<float>> rays;
   std::string input;
   std::string output = "-";
@@ -70,7 +73,15 @@ namespace {
 
 void addOptions(CLI::App& app, Options& o) {
   cli::addVersionFlag(app, kProg);
-  app.add_option("field", o.field, "the .vff field to query (a regular file)")->required();
+  app.add_option("field", o.field,
+                 "the .vff field to query (a regular file), or a glTF asset (.gltf, .glb) whose meshes carry fields "
+                 "(VFF_visibility_field; see --mesh)")
+      ->required();
+  app.add_option("--mesh", o.mesh,
+                 "glTF input: answer with the field of mesh I (rays in the mesh's own space; --rotate, --translate "
+                 "and --scale still place it); needed when several meshes carry one")
+      ->check(CLI::NonNegativeNumber)
+      ->option_text("I");
   app.add_option("--ray", o.rays, "a ray: origin x y z, direction x y z (repeatable)")
       ->expected(6)
       ->allow_extra_args(false)
@@ -258,8 +269,11 @@ std::optional<int> parseCommandLine(int argc, char** argv, Options& o) {
       "spec/geometry.md 7.3, 0 for every miss and every other hit; sample, i, j: the map and texel that\n"
       "answered, -1 without a lookup; --no-sites: left out;\n"
       "--columns: those named, in that order).\n\n"
+      "A glTF asset answers with one mesh's field (--mesh): a field with an error or whose geometry does not\n"
+      "match its mesh is refused (exit 3), a mesh without a field is a usage error naming those with one.\n\n"
       "  vff-query field.vff --ray 0 0 5 0 0 -1\n"
-      "  vff-query field.vff -i rays.npy -o hits.npy --interpolated\n",
+      "  vff-query field.vff -i rays.npy -o hits.npy --interpolated\n"
+      "  vff-query scene.glb --mesh 1 --ray 0 0 5 0 0 -1\n",
       kProg};
   app.footer(cli::exitCodeHelp());
   addOptions(app, o);
@@ -471,11 +485,13 @@ struct Stages {
 // of them; and the batch calls alone, each chunk's answers dropped (a bound no caller reaches: its
 // answers never leave the cache). Intersect only: no lookup sites, no visibility. The field as a
 // library caller (and the Python module) opens it: File::open's mapping, not this tool's copy.
-std::optional<int> printTiming(const Options& o, const Run& r, const std::optional<Instance>& inst, const Stages& at) {
+// (A glTF asset's field, `payload`, has no file of its own to map: it is opened from its bytes.)
+std::optional<int> printTiming(const Options& o, const Run& r, const std::optional<Instance>& inst, const Stages& at,
+                               std::span<const uint8_t> payload) {
   auto sec = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
   const RaySource& src = r.in.src;
   const double n = double(src.size) / 1e6;
-  auto mappedFile = File::open(o.field, readOptions(o));
+  auto mappedFile = payload.empty() ? File::open(o.field, readOptions(o)) : File::openMemory(payload, readOptions(o));
   if (!mappedFile) return cli::reportError(kProg, o.field, mappedFile.error());
   auto mapped = FieldQuery::fromFile(*mappedFile);
   if (!mapped) return cli::reportError(kProg, o.field, mapped.error());
@@ -517,9 +533,21 @@ int run(int argc, char** argv) {
   // own (file_bytes.h), which the File and the query borrow.
   Stages at;
   at.open = Clock::now();
-  auto fieldBytes = FileBytes::read(o.field);
-  if (!fieldBytes) return cli::reportError(kProg, o.field, fieldBytes.error());
-  auto file = File::openMemory(fieldBytes->bytes(), readOptions(o));
+  const bool gltf = isGltfInput(o.field);
+  if (!gltf && o.mesh >= 0) {
+    cli::usageError(kProg, "--mesh chooses a field of a glTF asset (.gltf, .glb), not of " + o.field);
+    return cli::kExitUsage;
+  }
+  std::optional<FileBytes> fieldBytes;
+  std::vector<uint8_t> payload;  // a glTF asset's field: the .vff bytes of the chosen mesh's
+  if (gltf) {
+    if (auto rc = gltfFieldBytes(o.field, o.mesh, &payload)) return *rc;
+  } else {
+    auto read = FileBytes::read(o.field);
+    if (!read) return cli::reportError(kProg, o.field, read.error());
+    fieldBytes.emplace(std::move(*read));
+  }
+  auto file = File::openMemory(gltf ? std::span<const uint8_t>(payload) : fieldBytes->bytes(), readOptions(o));
   if (!file) return cli::reportError(kProg, o.field, file.error());
   auto q = FieldQuery::fromFile(*file);
   if (!q) return cli::reportError(kProg, o.field, q.error());
@@ -544,7 +572,7 @@ int run(int argc, char** argv) {
     return *rc;
   at.end = Clock::now();
   if (o.timing)
-    if (auto rc = printTiming(o, r, inst, at)) return *rc;
+    if (auto rc = printTiming(o, r, inst, at, payload)) return *rc;
   if (in.badInput) {
     cli::printError(kProg, *in.badInput);
     return cli::kExitInvalidFile;
