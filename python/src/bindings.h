@@ -28,6 +28,7 @@ void bindQuery(pybind11::module_& m);
 void bindBake(pybind11::module_& m);
 void bindRewrite(pybind11::module_& m);
 void bindScene(pybind11::module_& m);
+void bindGltf(pybind11::module_& m);
 
 // The integer argument `name` (a Python int, or anything with __index__), checked against [lo, hi]:
 // a TypeError for a non-integer and a ValueError naming the argument and its range otherwise

@@ -16,4 +16,5 @@ PYBIND11_MODULE(_vff, m) {
   vff::python::bindScene(m);
   vff::python::bindBake(m);
   vff::python::bindRewrite(m);
+  vff::python::bindGltf(m);
 }

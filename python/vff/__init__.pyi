@@ -23,6 +23,10 @@ class SceneError(Error): ...
 class InvalidArgumentError(Error, ValueError): ...
 class UnsupportedError(Error): ...
 class OperationError(Error, RuntimeError): ...
+class GltfError(Error):
+    """A glTF asset's field that may not be used: code is the rule's ID (14001 to 14103 of
+    spec/gltf/VFF_visibility_field/README.md), name its name, path the JSON pointer of the place."""
+    path: str
 
 class Problem(NamedTuple):
     id: int
@@ -189,3 +193,65 @@ def decompress(src: str, dst: str) -> File: ...
 def convert(src: str, dst: str, *, codec: str = "stored", zstd_level: int = 19, maps_per_block: int = 0,
             target: Optional[str] = None, max_texture_size: Optional[int] = None, max_layers: Optional[int] = None,
             gutter: Optional[int] = None) -> File: ...
+
+class GltfField:
+    """The field one mesh of a glTF asset carries (the extension VFF_visibility_field)."""
+    mesh: int
+    """The mesh's index."""
+    name: str
+    """The mesh's name ("" without one)."""
+    path: str
+    """The JSON pointer of the extension object ("/meshes/0/extensions/VFF_visibility_field")."""
+    buffer_view: Optional[int]
+    """The payload's bufferView, or None (a uri)."""
+    uri: Optional[str]
+    """The payload's uri as written, or None (a bufferView)."""
+    geometry_hash: str
+    """The geometryHash the extension declares: 16 lowercase hex digits."""
+    min: Tuple[float, float, float]
+    """The bounds' minimum the extension declares (mesh space)."""
+    max: Tuple[float, float, float]
+    """The bounds' maximum the extension declares (mesh space)."""
+    mesh_geometry_hash: Optional[str]
+    """The geometry hash of the mesh's triangles as the asset ships them; None when not computed."""
+    match: Literal["exact", "close", "mismatch", "unchecked"]
+    """How the field matches its mesh: the hash (exact), the bounds within tau (close: used), neither
+    (mismatch: not used); unchecked when the field has an error or check_geometry was False."""
+    tolerance: float
+    """tau = 2R/255: how far a close match's bounds may lie from the declared ones."""
+    bounds_difference: float
+    """The largest of the six differences between the declared and the shipped bounds."""
+    valid: bool
+    """No error (rules 14004 to 14011) on the mesh."""
+    usable: bool
+    """Valid and matched exact or close: rays may be answered with it."""
+    nodes: list[dict[str, Any]]
+    """The nodes that use the mesh: {"node": int, "name": str, "answered": bool, "reason": str}; a
+    node that is not a similarity, skinned or morphed is not answered (reason says why)."""
+    bytes: bytes
+    """The payload, a complete .vff file (b"" when the field has an error)."""
+    def open(self, checksums: str = "all") -> File:
+        """The payload as a vff.File in memory; raises vff.GltfError when the field is not usable."""
+        ...
+
+class GltfFields:
+    """The fields of a glTF asset and the problems of the extension's rules (vff.read_gltf_fields)."""
+    path: str
+    """The asset's path as given."""
+    mesh_count: int
+    """Meshes in the asset."""
+    fields: list[GltfField]
+    """One per mesh carrying the extension, in mesh order."""
+    problems: list[dict[str, Any]]
+    """Every problem in check order: {"rule": int, "name": str, "severity": "error" | "warning" |
+    "note", "path": JSON pointer ("" for the file), "message": str}."""
+    has_error: bool
+    """Some problem is an error."""
+
+def read_gltf_fields(path: str, check_geometry: bool = True) -> GltfFields:
+    """Reads the fields of a glTF asset (.gltf or .glb) and checks them against the rules of
+    spec/gltf/VFF_visibility_field/README.md. Every rule, 14001 (not glTF 2.0) included, is a problem
+    in the result, not an exception; a file that cannot be opened or read raises vff.IoError (an
+    OSError). check_geometry: match each field against its mesh (else every match is "unchecked" and
+    no field is usable)."""
+    ...

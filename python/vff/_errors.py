@@ -64,6 +64,18 @@ class OperationError(Error, RuntimeError):
     """Any other failure (9003 bad state or cancelled, 9004 out of memory)."""
 
 
+class GltfError(Error):
+    """A field of a glTF asset that may not be used (the extension VFF_visibility_field,
+    spec/gltf/VFF_visibility_field/README.md): ``code`` is the rule's ID (14001 to 14103), ``name``
+    its name ("gltf-payload"), ``path`` the JSON pointer of the place in the asset."""
+
+    def __init__(self, code, name, section, offset, message, path=""):
+        self.path = path
+        super().__init__(code, name, section, offset, message)
+        if path:
+            self.args = ("%s: %s" % (path, self.args[0]),)
+
+
 def error_class(code):
     """The Error subclass that stands for a vff::Code."""
     if 1000 <= code < 2000:
@@ -72,6 +84,8 @@ def error_class(code):
         return InvalidFileError
     if 11000 <= code < 12000:
         return SceneError
+    if 14000 <= code < 15000:
+        return GltfError
     if code >= 10000:
         return MeshError
     if code in (9001, 9002):
