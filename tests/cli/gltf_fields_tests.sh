@@ -291,6 +291,34 @@ test_gltf_close_and_mismatch() {
   [[ -f $WORK/out.d/far.mesh0.vff ]] || fail "the mismatched field was not extracted"
 }
 
+# Fields beside the asset (vff-bake --external-fields), and a .gltf that carries none.
+test_gltf_external_fields() {
+  make_glb
+  mkdir "$WORK/ext" "$WORK/out.d"
+  "$VFF_BAKE" "$WORK/s.gltf" -o "$WORK/ext/e.glb" --external-fields "${BAKE_OPTIONS[@]}" >/dev/null 2>&1 ||
+    fail "vff-bake --external-fields"
+  inspect "$WORK/ext/e.glb"
+  expect_rc 0
+  expect_out_re '^  source:       uri e\.mesh0\.vff, [0-9]+ bytes'
+  expect_out "  match:        exact"
+  inspect "$WORK/ext/e.glb" --extract "$WORK/out.d"
+  expect_rc 0
+  cmp "$WORK/out.d/e.mesh0.vff" "$WORK/ext/e.mesh0.vff" || fail "the extracted payload is not the uri's file"
+  query "$WORK/ext/e.glb" --mesh 1 "${RAYS[@]}"
+  expect_rc 0
+  cp "$WORK/out" "$WORK/e.csv"
+  query "$WORK/ext/e.mesh1.vff" "${RAYS[@]}"
+  cmp "$WORK/e.csv" "$WORK/out" || fail "the uri field answers otherwise than its file"
+  # The sample scene itself: a .gltf whose meshes carry no field.
+  inspect "$WORK/s.gltf"
+  expect_rc 0
+  expect_out "meshes:      3 meshes, 0 with a field"
+  expect_out "problems:    none"
+  query "$WORK/s.gltf" --ray 0 0 3 0 0 -1
+  expect_rc 3
+  expect_err "no mesh carries a field"
+}
+
 # ---- vff-query -------------------------------------------------------------------------------------
 test_gltf_query_answers_as_extracted() {
   make_glb
