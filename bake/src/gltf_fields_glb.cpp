@@ -207,7 +207,7 @@ std::string gltfBufferData(const nlohmann::json& doc, size_t index, const std::s
   if (b.contains("uri")) {
     if (!b["uri"].is_string()) return "buffer " + std::to_string(index) + "'s uri is not a string";
     if (std::string e = readGltfUri(gltfPath, b["uri"].get<std::string>(), out); !e.empty())
-      return "buffer " + std::to_string(index) + "'s uri '" + b["uri"].get<std::string>() + "' " + e;
+      return "buffer " + std::to_string(index) + "'s uri '" + b["uri"].get<std::string>() + "': " + e;
   } else if (index == 0 && glb && glb->hasBin) {
     *out = glb->bin;
   } else {

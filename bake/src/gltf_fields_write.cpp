@@ -133,7 +133,7 @@ Result<std::vector<uint8_t>> packGlbWithFields(const std::string& input, const s
       std::string media;
       if (std::string e = detail::readGltfUri(input, uri, &data, &media); !e.empty())
         return makeError(detail::isDataUri(uri) ? Code::kMeshParse : Code::kIoOpen,
-                         input + ": image " + std::to_string(i) + "'s uri '" + uri + "' " + e);
+                         input + ": image " + std::to_string(i) + "'s uri '" + uri + "': " + e);
       if (!image.contains("mimeType")) image["mimeType"] = detail::isDataUri(uri) && !media.empty() ? media : imageMediaType(uri);
       image.erase("uri");
       image["bufferView"] = addView(data, 4);

@@ -290,6 +290,17 @@ assert gbin[v.get('byteOffset', 0):v.get('byteOffset', 0) + v['byteLength']] == 
 PY
 }
 
+test_missing_image_fails_before_baking() {
+  scene "$WORK/s.gltf" box torus-knot
+  rm "$WORK/s.png"
+  bake "$WORK/s.gltf" -o "$WORK/x.glb" -n 2 -m 8
+  expect_rc 2
+  expect_err "image 0's uri 's.png'"
+  [[ $(grep -c "mesh 1/2" "$WORK/err") -eq 0 ]] || fail "it baked before finding the image missing"
+  [[ ! -e $WORK/x.glb ]] || fail "x.glb written"
+  no_temporaries
+}
+
 test_split_node_with_glb_output_is_a_usage_error() {
   scene "$WORK/s.glb" box torus-knot
   bake "$WORK/s.glb" --split node -o "$WORK/x.glb" "${small[@]}"

@@ -88,6 +88,8 @@ int bakeGltfGlb(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
   }
   const std::vector<Planned> external = o.externalFields ? plan : std::vector<Planned>{};
   if (auto rc = checkOutputs(external, o.output)) return *rc;
+  // What the packing needs (every buffer and image the asset references) is there before any bake.
+  if (auto packable = bake::packGlbWithFields(o.mesh, {}); !packable) return cli::reportError(kProg, o.mesh, packable.error());
 
   std::vector<std::string> written;  // this run's temporaries, complete or being written
   std::vector<bake::GltfFieldPayload> payloads;
