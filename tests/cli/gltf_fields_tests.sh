@@ -10,9 +10,11 @@
 #   VFF_QUERY    the vff-query executable
 #   VFF_BAKE     the vff-bake executable
 #   MESHGEN      the vff-procedural-mesh executable (--gltf-scene writes the sample scene)
+#   SCHEMA_CHECK vff_cli_schema_check; GLTF_SCHEMA spec/inspect-gltf-schema.json, SCHEMA spec/inspect-schema.json
 #   WORK         a scratch folder of this test (emptied first)
 set -euo pipefail
 : "${VFF_INSPECT:?}" "${VFF_QUERY:?}" "${VFF_BAKE:?}" "${MESHGEN:?}" "${WORK:?}"
+: "${SCHEMA_CHECK:?}" "${GLTF_SCHEMA:?}" "${SCHEMA:?}"
 
 # ---- Helpers ---------------------------------------------------------------------------------------
 source "$(dirname "${BASH_SOURCE[0]}")/../common/cli_harness.sh"
@@ -128,18 +130,28 @@ test_gltf_json() {
   inspect "$WORK/x.glb" --format json
   expect_rc 0
   cp "$WORK/out" "$WORK/report.json"
+  "$SCHEMA_CHECK" "$GLTF_SCHEMA" "$WORK/report.json" || fail "the report does not match spec/inspect-gltf-schema.json"
+  # Each payload's report is the one of a .vff file (spec/inspect-schema.json), less file and tool.
+  python3 -c "
+import json, sys
+d = json.load(open(sys.argv[1]))
+for i, f in enumerate(d['fields']):
+    json.dump(dict(f['field'], file='x', tool=d['tool']), open(sys.argv[2] + str(i), 'w'))
+" "$WORK/report.json" "$WORK/payload"
+  "$SCHEMA_CHECK" "$SCHEMA" "$WORK/payload0" && "$SCHEMA_CHECK" "$SCHEMA" "$WORK/payload1" ||
+    fail "a payload's report does not match spec/inspect-schema.json"
   local hash
   hash=$(python3 -c "import json,sys; print(json.load(sys.stdin)['metadata']['vff.source']['geometryHash'])" \
     < <("$VFF_INSPECT" "$WORK/split/x.mesh0.vff" --format json))
   json_check "$WORK/report.json" "
-assert set(d) == {'file', 'meshes', 'fields', 'problems'}, sorted(d)
+assert set(d) == {'file', 'tool', 'meshes', 'fields', 'problems'}, sorted(d)
 assert d['file'].endswith('x.glb') and d['meshes'] == 3
 assert [f['mesh'] for f in d['fields']] == [0, 1] and [f['name'] for f in d['fields']] == ['box', 'knot']
 keys = {'mesh', 'name', 'path', 'bufferView', 'bytes', 'geometryHash', 'meshGeometryHash', 'match', 'tolerance',
-        'boundsDifference', 'valid', 'nodes', 'field'}
+        'boundsDifference', 'valid', 'usable', 'nodes', 'field'}
 for f in d['fields']:
     assert set(f) == keys, sorted(f)
-    assert f['valid'] and f['match'] == 'exact' and f['geometryHash'] == f['meshGeometryHash']
+    assert f['valid'] and f['usable'] and f['match'] == 'exact' and f['geometryHash'] == f['meshGeometryHash']
     assert f['path'] == '/meshes/%d/extensions/VFF_visibility_field' % f['mesh']
     assert f['boundsDifference'] == 0 and f['tolerance'] > 0
     assert f['field']['format']['fileSize'] == f['bytes']

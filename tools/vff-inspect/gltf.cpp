@@ -18,6 +18,7 @@
 
 #if VFF_INSPECT_HAS_BAKE
 #include "vff/bake/gltf_fields.h"
+#include "vff/version.h"
 #endif
 
 namespace vff::inspect {
@@ -110,6 +111,7 @@ json fieldJson(const GltfField& f, uint32_t histogramBins) {
   j["tolerance"] = matched ? json(f.tolerance) : json(nullptr);
   j["boundsDifference"] = matched ? json(f.boundsDifference) : json(nullptr);
   j["valid"] = f.valid;
+  j["usable"] = f.usable();
   json nodes = json::array();
   for (const auto& n : f.nodes)
     nodes.push_back({{"node", n.node}, {"name", n.name}, {"answered", n.answered}, {"reason", n.reason}});
@@ -121,6 +123,7 @@ json fieldJson(const GltfField& f, uint32_t histogramBins) {
 json reportJson(const std::string& label, const GltfFieldsReport& r, uint32_t histogramBins) {
   json doc;
   doc["file"] = label;
+  doc["tool"] = {{"name", kProg}, {"version", kLibraryVersion}};
   doc["meshes"] = r.meshCount;
   json fields = json::array();
   for (const GltfField& f : r.fields) fields.push_back(fieldJson(f, histogramBins));
