@@ -48,7 +48,9 @@ start = 28 + jl
 assert bt == 0x004E4942 and start % 64 == 0, 'BIN chunk at %d' % start
 assert 'VFF_visibility_field' in doc['extensionsUsed']
 assert 'VFF_visibility_field' not in doc.get('extensionsRequired', [])
-assert len(doc['buffers']) == 1 and 'uri' not in doc['buffers'][0]
+# One buffer with data, the binary chunk; any other is a meshopt fallback without data.
+assert all('uri' not in b for b in doc['buffers'])
+assert all('EXT_meshopt_compression' in b.get('extensions', {}) for b in doc['buffers'][1:])
 for m in doc['meshes']:
     if 'VFF_visibility_field' not in m.get('extensions', {}):
         continue
@@ -290,6 +292,21 @@ assert gbin[v.get('byteOffset', 0):v.get('byteOffset', 0) + v['byteLength']] == 
 PY
 }
 
+test_compressed_inputs_pack_and_match_exactly() {
+  # Draco and meshopt buffers (a meshopt fallback buffer has no data) survive the packing: the
+  # packed file's meshes still decode to the triangles the field was baked from.
+  for kind in draco meshopt meshopt-filters quantized; do
+    "$GLTF_WRITE" torus-knot $kind "$WORK/$kind.glb" || fail "$kind"
+    bake "$WORK/$kind.glb" -o "$WORK/$kind.f.glb" "${small[@]}"
+    expect_rc 0
+    report "$WORK/$kind.f.glb"
+    check "$WORK/$kind.f.glb" "[(f['valid'], f['match']) for f in r['fields']]" "[(True, 'exact')]"
+    check_layout "$WORK/$kind.f.glb"
+  done
+  # The quantized file's node undoes the quantization with a non-uniform scale: no field answers it.
+  check "$WORK/quantized.f.glb" "[(p['rule'], p['path']) for p in r['problems']]" "[(14104, '/nodes/0')]"
+}
+
 test_missing_image_fails_before_baking() {
   scene "$WORK/s.gltf" box torus-knot
   rm "$WORK/s.png"
@@ -299,6 +316,16 @@ test_missing_image_fails_before_baking() {
   [[ $(grep -c "mesh 1/2" "$WORK/err") -eq 0 ]] || fail "it baked before finding the image missing"
   [[ ! -e $WORK/x.glb ]] || fail "x.glb written"
   no_temporaries
+}
+
+test_external_field_names_are_percent_encoded() {
+  scene "$WORK/s.glb" box torus-knot
+  bake "$WORK/s.glb" -o "$WORK/my scene#1.glb" --external-fields "${small[@]}"
+  expect_rc 0
+  [[ -f "$WORK/my scene#1.mesh0.vff" ]] || fail "the field file"
+  report "$WORK/my scene#1.glb"
+  check "$WORK/my scene#1.glb" "[(f['uri'], f['usable']) for f in r['fields']]" \
+    "[('my%20scene%231.mesh0.vff', True), ('my%20scene%231.mesh1.vff', True)]"
 }
 
 test_split_node_with_glb_output_is_a_usage_error() {

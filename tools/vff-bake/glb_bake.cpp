@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -21,7 +22,6 @@
 #include "vff/bake/gltf.h"
 #include "vff/bake/gltf_fields.h"
 #include "vff/bake/mesh.h"
-#include "vff/scene_description.h"
 
 namespace vff::bake_tool {
 namespace {
@@ -38,6 +38,23 @@ void triangleBounds(const bake::Mesh& m, std::array<float, 3>* lo, std::array<fl
       (*lo)[k] = std::min((*lo)[k], m.positions[3 * size_t(v) + k]);
       (*hi)[k] = std::max((*hi)[k], m.positions[3 * size_t(v) + k]);
     }
+}
+
+// A file name as a glTF uri: every byte but letters, digits and "-._~" percent-encoded, which
+// every reader decodes back (spaces included, which some do not accept raw).
+std::string uriOf(const std::string& name) {
+  static const char* kHex = "0123456789ABCDEF";
+  std::string out;
+  for (unsigned char c : name) {
+    if (std::isalnum(c) || c == '-' || c == '.' || c == '_' || c == '~') {
+      out += char(c);
+    } else {
+      out += '%';
+      out += kHex[c >> 4];
+      out += kHex[c & 15];
+    }
+  }
+  return out;
 }
 
 Status readBytes(const std::string& path, std::vector<uint8_t>* out) {
@@ -103,7 +120,7 @@ int bakeGltfGlb(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
     p.geometryHash = cli::hexDigits64(bake::geometryHash(obj.geometry));
     triangleBounds(obj.geometry, &p.min, &p.max);
     if (o.externalFields) {
-      p.uri = encodeSceneUri(baseName(plan[i].path));
+      p.uri = uriOf(baseName(plan[i].path));
       entry["uri"] = p.uri;
     } else {
       if (Status s = readBytes(plan[i].temporary, &p.bytes); !s) {
