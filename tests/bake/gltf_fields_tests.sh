@@ -328,6 +328,42 @@ test_external_field_names_are_percent_encoded() {
     "[('my%20scene%231.mesh0.vff', True), ('my%20scene%231.mesh1.vff', True)]"
 }
 
+# An interrupted rebake over an earlier .glb (and its external fields): the old files stay as they
+# were, no temporary is left. SIG arrives once the first mesh is done, while the second is baked.
+interrupted_rebake() {  # SIG [--external-fields]
+  local sig=$1 pid
+  shift
+  scene "$WORK/s.glb" box torus-knot
+  mkdir "$WORK/set"
+  bake "$WORK/s.glb" -o "$WORK/set/x.glb" "$@" "${small[@]}"
+  expect_rc 0
+  cp -a "$WORK/set" "$WORK/snap"
+  set -m  # job control: the background bake does not start with SIGINT ignored
+  "$VFF_BAKE" "$WORK/s.glb" -o "$WORK/set/x.glb" "$@" -m 64 -j 1 2>"$WORK/rebake.err" &
+  pid=$!
+  set +m
+  for _ in $(seq 3000); do
+    grep -q "mesh 1/2 " "$WORK/rebake.err" && break
+    kill -0 "$pid" 2>/dev/null || break
+    sleep 0.01
+  done
+  grep -q "mesh 2/2 " "$WORK/rebake.err" && fail "the rebake finished before SIG$sig"
+  kill -s "$sig" "$pid" 2>/dev/null || true
+  RC=0
+  wait "$pid" || RC=$?
+  [[ $RC -eq $((128 + $(kill -l "$sig"))) ]] || { cat "$WORK/rebake.err" >&2; fail "exit status $RC, expected SIG$sig"; }
+  diff -r "$WORK/snap" "$WORK/set" || fail "SIG$sig changed the old outputs"
+  no_temporaries
+}
+
+test_interrupted_rebake_keeps_the_old_glb() {
+  interrupted_rebake INT
+}
+
+test_interrupted_rebake_keeps_the_old_external_fields() {
+  interrupted_rebake TERM --external-fields
+}
+
 test_split_node_with_glb_output_is_a_usage_error() {
   scene "$WORK/s.glb" box torus-knot
   bake "$WORK/s.glb" --split node -o "$WORK/x.glb" "${small[@]}"
