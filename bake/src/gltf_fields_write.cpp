@@ -115,9 +115,11 @@ Result<std::vector<uint8_t>> packGlbWithFields(const std::string& input, const s
   } else {
     doc["bufferViews"] = ojson::array();
   }
-  ojson& views = doc["bufferViews"];
+  // (ordered_json keeps members in a vector: a reference to one dies when a member is added, so
+  // the views are looked up each time.)
   const auto addView = [&](const std::vector<uint8_t>& data, size_t align) {
     padTo(&bin, align);
+    ojson& views = doc["bufferViews"];
     views.push_back({{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", data.size()}});
     bin.insert(bin.end(), data.begin(), data.end());
     return views.size() - 1;
@@ -181,7 +183,7 @@ Result<std::vector<uint8_t>> packGlbWithFields(const std::string& input, const s
     buffers[0]["byteLength"] = bin.size();
     doc["buffers"] = std::move(buffers);
   }
-  if (views.empty()) doc.erase("bufferViews");
+  if (doc["bufferViews"].empty()) doc.erase("bufferViews");
   return detail::joinGlb(doc.dump(), bin);
 }
 
