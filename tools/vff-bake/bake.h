@@ -1,7 +1,8 @@
 // bake.h - what vff-bake's parts share beyond one bake's options and output (tools/bake-job,
 // bake_job.h, which also holds --merge): the temporary files on a signal (interrupt.cpp), and the bakes,
-// from a mesh (mesh_bake.cpp), from an OpenVDB level set (levelset_bake.cpp) and per glTF mesh or
-// node (split_bake.cpp).
+// from a mesh (mesh_bake.cpp), from an OpenVDB level set (levelset_bake.cpp), per glTF mesh or
+// node (split_bake.cpp) and per glTF mesh into a .glb (glb_bake.cpp), the last two sharing how a
+// set of outputs is put in place.
 #pragma once
 
 #include <sys/types.h>
