@@ -103,7 +103,7 @@ int intMember(const nlohmann::json& o, const char* key) {
 }  // namespace
 
 Result<GltfMeshGeometry> meshGeometry(const tinygltf::Model& model, const std::string& path, int mesh) {
-  auto m = importGltfMeshes(model, path, {{mesh, identity()}});
+  auto m = importGltfMeshes(model, path, {{mesh, identity(), /*skipNonTriangles=*/true}});
   if (!m) return std::move(m).error();
   const std::string name = size_t(mesh) < model.meshes.size() ? model.meshes[size_t(mesh)].name : "";
   if (Status s = checkMesh(&*m, path + ": mesh " + std::to_string(mesh) + (name.empty() ? "" : " '" + name + "'")); !s)

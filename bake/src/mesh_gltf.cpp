@@ -34,12 +34,15 @@ class Importer {
  public:
   Importer(const tinygltf::Model& model, const std::string& path) : model_(model), path_(path) {}
 
-  Status mesh(const tinygltf::Mesh& mesh, const Mat4& world) {
+  Status mesh(const tinygltf::Mesh& mesh, const Mat4& world, bool skipNonTriangles) {
     for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
       const tinygltf::Primitive& p = mesh.primitives[pi];
       const std::string where = path_ + ": mesh '" + mesh.name + "' primitive " + std::to_string(pi);
       const int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
-      if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN)
+      const bool triangles =
+          mode == TINYGLTF_MODE_TRIANGLES || mode == TINYGLTF_MODE_TRIANGLE_STRIP || mode == TINYGLTF_MODE_TRIANGLE_FAN;
+      if (!triangles && skipNonTriangles) continue;
+      if (!triangles)
         return makeError(Code::kMeshUnsupported, where + " has mode " + std::to_string(mode) +
                                                      " (points or lines), not triangles");
       auto pos = p.attributes.find("POSITION");
@@ -256,7 +259,7 @@ Result<Mesh> importGltfMeshes(const tinygltf::Model& model, const std::string& p
   for (const GltfMeshRef& r : refs) {
     if (r.mesh < 0 || size_t(r.mesh) >= model.meshes.size())
       return makeError(Code::kMeshIndex, path + ": mesh index " + std::to_string(r.mesh) + " out of range");
-    Status s = imp.mesh(model.meshes[size_t(r.mesh)], r.matrix);
+    Status s = imp.mesh(model.meshes[size_t(r.mesh)], r.matrix, r.skipNonTriangles);
     if (!s) return std::move(s).error();
   }
   if (imp.allNormals_ && imp.normals_.size() == imp.out.positions.size()) imp.out.normals = std::move(imp.normals_);

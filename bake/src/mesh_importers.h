@@ -32,6 +32,9 @@ Result<std::shared_ptr<const tinygltf::Model>> parseGltf(const std::string& path
 struct GltfMeshRef {
   int mesh = -1;      // index into model.meshes
   GltfMatrix matrix;  // applied to its positions (normals: the inverse transpose)
+  // Points and lines primitives are skipped rather than refused: the glTF extension matches a field
+  // against a mesh's triangles only (spec/gltf/VFF_visibility_field, "Matching the geometry").
+  bool skipNonTriangles = false;
 };
 // The triangles of every primitive of the meshes `refs` name, each under its matrix, as one mesh
 // (mesh_gltf.cpp); not yet checked (checkMesh).

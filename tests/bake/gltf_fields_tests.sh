@@ -378,4 +378,12 @@ test_split_node_with_glb_output_is_a_usage_error() {
   expect_out "--external-fields"
 }
 
+test_glb_output_of_a_mesh_that_is_not_gltf_is_a_usage_error() {
+  printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n' >"$WORK/t.obj"
+  bake "$WORK/t.obj" -o "$WORK/t.glb" "${small[@]}"
+  expect_rc 1
+  expect_err "a .glb output carries the fields of a glTF input (.gltf, .glb); a field of 't.obj' is a .vff file"
+  [[ ! -e $WORK/t.glb ]] || fail "a refused bake wrote its output"
+}
+
 run_test "$1"

@@ -281,6 +281,23 @@ TEST_F(GltfFields, MeshWithoutTrianglesIs14011) {
   EXPECT_EQ(r->fields[0].match, GltfFieldMatch::kUnchecked);
 }
 
+// A points or lines primitive beside the triangles is not part of the match: the field is exact.
+TEST_F(GltfFields, PointsBesideTrianglesAreNotMatched) {
+  auto withPoints = [](json& d) {
+    json points = d["meshes"][0]["primitives"][0];
+    points["mode"] = 0;
+    points.erase("indices");
+    d["meshes"][0]["primitives"].push_back(points);
+  };
+  const std::string path = file("a.glb", ext(), true, withPoints);
+  auto r = readGltfFields(path);
+  ASSERT_TRUE(r.ok());
+  EXPECT_TRUE(r->problems.empty());
+  ASSERT_EQ(r->fields.size(), 1u);
+  EXPECT_EQ(r->fields[0].match, GltfFieldMatch::kExact);
+  EXPECT_EQ(r->fields[0].meshGeometryHash, hash_);
+}
+
 TEST_F(GltfFields, LaterMeshesAreStillCheckedAndNodesNoted) {
   auto edit = [&](json& d) {
     json second = d["meshes"][0];

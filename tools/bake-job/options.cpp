@@ -104,6 +104,9 @@ std::optional<std::string> checkOptions(const Options& o) {
     return std::string(o.scene >= 0 ? "--scene" : "--split") + " applies to a glTF input (.gltf, .glb) only";
   if (o.externalFields && !(isGltfPath(o.mesh) && isGlbPath(o.output)))
     return "--external-fields applies to a glTF input baked into a .glb output (-o X.glb)";
+  if (!isGltfPath(o.mesh) && isGlbPath(o.output))
+    return "a .glb output carries the fields of a glTF input (.gltf, .glb); a field of '" + baseName(o.mesh) +
+           "' is a .vff file (-o X.vff)";
   if (isGltfPath(o.mesh) && isGlbPath(o.output)) {
     if (o.split == "node")
       return "--split node places a field per node; a .glb output attaches a field to each mesh (--split mesh or "
