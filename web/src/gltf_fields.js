@@ -499,22 +499,31 @@ function extensionValueProblem(ext) {
  * @returns {Promise<{meshCount: number, fields: object[], problems: object[]}>}
  */
 export async function readGltfFields(data, options = {}) {
-  await initChecksums();
   const bytes = data instanceof Uint8Array ? data : new Uint8Array(data);
-  const { resolveUri = null, decodedGeometry = null, checkGeometry = true } = options;
-  const report = { meshCount: 0, fields: [], problems: [] };
-  const problem = (rule, path, message, extra = {}) =>
-    report.problems.push({ rule, name: GLTF_RULE_NAMES[rule], severity: SEVERITY[rule] ?? 'error', path, message, ...extra });
-
   let parsed;
   try {
     parsed = parseContainer(bytes);
   } catch (e) {
     if (!(e instanceof FileProblem)) throw e;
-    problem(14001, e.path, e.message);
+    const report = { meshCount: 0, fields: [], problems: [] };
+    report.problems.push({ rule: 14001, name: GLTF_RULE_NAMES[14001], severity: 'error', path: e.path, message: e.message });
     return report;
   }
-  const { json, bin, glb } = parsed;
+  return readParsedGltfFields(parsed, options);
+}
+
+/**
+ * readGltfFields on an asset already parsed (a loader's): `json` the glTF JSON, `bin` the .glb's BIN
+ * chunk (Uint8Array, or null), `glb` whether the asset came as a .glb (its buffer 0 without uri is
+ * the BIN chunk). Runs the rules from 14002 on; the same report.
+ * @param {{json: object, bin: Uint8Array|null, glb: boolean}} parsed
+ */
+export async function readParsedGltfFields({ json, bin = null, glb = false }, options = {}) {
+  await initChecksums();
+  const { resolveUri = null, decodedGeometry = null, checkGeometry = true } = options;
+  const report = { meshCount: 0, fields: [], problems: [] };
+  const problem = (rule, path, message, extra = {}) =>
+    report.problems.push({ rule, name: GLTF_RULE_NAMES[rule], severity: SEVERITY[rule] ?? 'error', path, message, ...extra });
   const meshes = arr(json.meshes);
   report.meshCount = meshes.length;
   if (arr(json.extensionsRequired).includes(GLTF_FIELD_EXTENSION)) {

@@ -1,9 +1,9 @@
 // gpu.js - uploads a decoded .vff for the GLSL ES query: distance (and normal) slices as
 // TEXTURE_2D_ARRAY (or TEXTURE_3D) layers within the limits the context reports, the field block
 // and the positions table (spec/format.md 10.4).
-import { computeLayout } from './layout.js';
-import { composeSlice } from './layout.js';
+import { computeLayout, composeSlice } from './layout.js';
 import { buildQueryTables } from './query_tables.js';
+import { fieldSlices, positionsTexture } from './field_textures.js';
 
 /** The limits of a WebGL2 context that a layout must respect. */
 export function contextLimits(gl) {
@@ -60,23 +60,19 @@ export function uploadField(gl, file, options = {}) {
   const chosen = chooseLayout(file, contextLimits(gl));
   if (chosen.error) return chosen;
   const L = chosen.layout, fd = file.field, e = fd.distanceEncoding, M = fd.mapResolution;
-  const is3d = L.target === 2;
-  const plane = (kind, texelBytes, fill) => ({ kind, texelBytes, fill, M, mapCount: fd.mapCount });
-  let fmt, width = L.sliceWidth, data;
-  if (e === 3) {
-    fmt = { internal: gl.R16UI, format: gl.RED_INTEGER, type: gl.UNSIGNED_SHORT };
-    data = (s) => { const b = composeSlice(L, plane('bytes', 2, 0xff), s, (k) => file.mapBytes('distance', k)); return new Uint16Array(b.buffer, b.byteOffset, b.length / 2); };
-  } else {
-    fmt = { internal: gl.R8UI, format: gl.RED_INTEGER, type: gl.UNSIGNED_BYTE };
-    if (e === 4) { width = L.sliceWidth / 8; data = (s) => composeSlice(L, plane('bit1', 1, 0), s, (k) => file.mapBytes('distance', k)); }
-    else if (e === 5) data = (s) => composeSlice(L, plane('bytes', 1, 0xff), s, (k) => file.codes(k));
-    else data = (s) => composeSlice(L, plane('bytes', 1, 0xff), s, (k) => file.mapBytes('distance', k));
-  }
+  const sl = fieldSlices(file, L);
+  const is3d = sl.is3d;
+  const FORMATS = {
+    r8ui: { internal: gl.R8UI, format: gl.RED_INTEGER, type: gl.UNSIGNED_BYTE },
+    r16ui: { internal: gl.R16UI, format: gl.RED_INTEGER, type: gl.UNSIGNED_SHORT },
+    rg16i: { internal: gl.RG16I, format: gl.RG_INTEGER, type: gl.SHORT },
+  };
   const defines = [];
   const rgtc = e === 5 && !options.bc4OnCpu ? gl.getExtension('EXT_texture_compression_rgtc') : null;
   gl.activeTexture(gl.TEXTURE0);
   if (rgtc) {
     defines.push('VFF_MAPS_BC4');
+    const plane = { kind: 'bc4', texelBytes: 1, fill: 0xff, M, mapCount: fd.mapCount };
     const t = gl.createTexture();
     gl.bindTexture(gl.TEXTURE_2D_ARRAY, t);
     gl.texParameteri(gl.TEXTURE_2D_ARRAY, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
@@ -84,29 +80,24 @@ export function uploadField(gl, file, options = {}) {
     gl.texStorage3D(gl.TEXTURE_2D_ARRAY, 1, rgtc.COMPRESSED_RED_RGTC1_EXT, L.sliceWidth, L.sliceHeight, L.sliceCount);
     for (let s = 0; s < L.sliceCount; ++s)
       gl.compressedTexSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, s, L.sliceWidth, L.sliceHeight, 1, rgtc.COMPRESSED_RED_RGTC1_EXT,
-        composeSlice(L, plane('bc4', 1, 0xff), s, (k) => file.mapBytes('distance', k)));
-  } else texture(gl, is3d, fmt, width, L.sliceHeight, L.sliceCount, data);
-  if (is3d) defines.push('VFF_MAPS_3D');
-  if (file.planes.normal) {
+        composeSlice(L, plane, s, (k) => file.mapBytes('distance', k)));
+  } else texture(gl, is3d, FORMATS[sl.maps.format], sl.maps.width, sl.maps.height, sl.maps.layers, sl.maps.slice);
+  defines.push(...sl.defines);
+  if (sl.normals) {
     gl.activeTexture(gl.TEXTURE1);
-    texture(gl, is3d, { internal: gl.RG16I, format: gl.RG_INTEGER, type: gl.SHORT }, L.sliceWidth, L.sliceHeight, L.sliceCount, (s) => {
-      const b = composeSlice(L, plane('bytes', 4, 0), s, (k) => file.mapBytes('normal', k));
-      return new Int16Array(b.buffer, b.byteOffset, b.length / 2);
-    });
-  } else defines.push('VFF_NO_NORMALS');
+    texture(gl, is3d, FORMATS.rg16i, sl.normals.width, sl.normals.height, sl.normals.layers, sl.normals.slice);
+  }
   const { block, table } = buildQueryTables(file, L);
   const ubo = gl.createBuffer();
   gl.bindBuffer(gl.UNIFORM_BUFFER, ubo);
   gl.bufferData(gl.UNIFORM_BUFFER, block, gl.STATIC_DRAW);
   gl.bindBufferBase(gl.UNIFORM_BUFFER, 0, ubo);
-  const vec4s = table.length / 4, pw = Math.min(vec4s, 2048), ph = Math.ceil(vec4s / pw);
-  const padded = new Float32Array(pw * ph * 4);
-  padded.set(table);
+  const pos = positionsTexture(table);
   gl.activeTexture(gl.TEXTURE2);
   const pt = gl.createTexture();
   gl.bindTexture(gl.TEXTURE_2D, pt);
   gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
   gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
-  gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, pw, ph, 0, gl.RGBA, gl.FLOAT, padded);
+  gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, pos.width, pos.height, 0, gl.RGBA, gl.FLOAT, pos.data);
   return { field: { defines, center: fd.sphere.center, radius: fd.sphere.radius }, layout: L, note: chosen.note, bc4: rgtc ? 'gpu' : e === 5 ? 'cpu' : null };
 }
