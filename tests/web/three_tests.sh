@@ -3,5 +3,35 @@
 # helpers (skip, need_node, need_chromium, node_test) are web_tests.sh's.
 source "$(dirname "$0")/web_common.sh"
 
+need_three() {
+  need_node
+  local m
+  for m in three three-mesh-bvh @vff/three; do
+    [[ -e $WEB/node_modules/$m ]] || skip "no $m in $WEB/node_modules: run scripts/setup.sh (npm ci in web/)"
+  done
+}
+
+# VffField in node: the conformance vectors' uniforms, defines and texture sizes, VffError IDs.
+test_field() { need_three; node_test three-vff/test/field.test.js; }
+
+# In Chromium, one case a test of occlusion.browser.js (each bakes its knot and starts a browser):
+# the field's floor AO against three-mesh-bvh's exact reference of the same rays (RMS, share within 8
+# levels, ms a frame printed); a moving instance; mode 'off'.
+occlusion_case() {
+  need_three; need_chromium; need_bake_scene
+  VFF_WORK="$WORK" node_test --test-name-pattern="$1" three-vff/test/browser/occlusion.browser.js
+  grep -E '^# (floor|ms a frame|[0-9]+x[0-9]+,)' "$WORK/out"
+  grep -qE '^# pass 1$' "$WORK/out" || fail "no test of occlusion.browser.js matched '$1'"
+}
+test_occlusion_reference() { occlusion_case 'matches the three-mesh-bvh reference'; }
+test_occlusion_moving() { occlusion_case 'moving the knot'; }
+test_occlusion_off() { occlusion_case "mode 'off'"; }
+
+# In Chromium: GLTFLoader with VffGLTFPlugin on the .glb vff-bake writes for the sample scene.
+test_plugin() {
+  need_three; need_chromium; need_bake_scene
+  VFF_WORK="$WORK" node_test three-vff/test/browser/plugin.browser.js
+}
+
 # (test_* functions go above this line)
 run_test "$1"

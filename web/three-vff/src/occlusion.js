@@ -27,7 +27,7 @@ const RECEIVER_ID = 4095;   // a receiving surface that is no instance
 
 const DEFAULTS = Object.freeze({
   aoRange: 1, aoRays: 4, shadowRays: 2, lightDirection: new THREE.Vector3(0.4, 1, 0.3).normalize(), lightAngle: 0.08,
-  shadowRange: 1e4, aoIntensity: 1, shadowIntensity: 0.6, bias: 0, maxInstances: 16,
+  shadowRange: 1e4, aoIntensity: 1, shadowIntensity: 0.6, bias: 0, maxInstances: 16, interpolated: true,
 });
 
 const PRECISION = `precision highp float;
@@ -86,18 +86,20 @@ void main() {
 }`;
 
 /** The query's source for field slot i: every vff/Vff/VFF_ name gets the slot's prefix. */
-function slotGlsl(i, field) {
+export function slotGlsl(i, field) {
   const rename = (s) => s.replace(/\b(vff|Vff|VFF_)/g, (m) => (m === 'VFF_' ? `VFF${i}_` : `${m}${i}_`));
   const defines = Object.keys(field.defines).map((d) => `#define ${rename(d)}\n`).join('');
   return defines + rename(FIELD_STRUCT + VFF_QUERY_GLSL_ES);
 }
 
-function occlusionFragment({ mode, slots, maxInstances }) {
+function occlusionFragment({ mode, slots, maxInstances, interpolated }) {
   let resources = '', cases = '';
   if (mode === 'field') {
     slots.forEach((f, i) => {
       resources += slotGlsl(i, f) + '\n';
-      cases += `  if (s == ${i}) return vff${i}_Occluded(o, d, 0.0, tmax, VFF${i}_OFF_OBJECT);\n`;
+      cases += interpolated
+        ? `  if (s == ${i}) return vff${i}_IntersectInterpolated(o, d, 0.0, tmax, VFF${i}_OFF_OBJECT).hit;\n`
+        : `  if (s == ${i}) return vff${i}_Occluded(o, d, 0.0, tmax, VFF${i}_OFF_OBJECT);\n`;
     });
   } else {
     resources = BVHShaderGLSL.common_functions + BVHShaderGLSL.bvh_struct_definitions + BVHShaderGLSL.bvh_ray_functions;
@@ -117,9 +119,16 @@ uniform float uAoRange, uShadowRange, uBias, uCosCone;
 uniform vec3 uLight;
 uniform mat4 uInverse[MAX_INSTANCES];
 uniform int uSlot[MAX_INSTANCES];
+uniform vec4 uSphere[MAX_INSTANCES];
 ${resources}
 // Instance k's answer for a world ray p + t d, t in [0, tmax] (d unit): the ray in its local space.
 bool occludedBy(int k, vec3 p, vec3 dw, float tmax) {
+  // Rays that miss the instance's bounding sphere (slightly enlarged) are not asked.
+  vec3 oc = p - uSphere[k].xyz;
+  float bb = dot(oc, dw), cc = dot(oc, oc) - uSphere[k].w * uSphere[k].w;
+  if (cc > 0.0 && bb > 0.0) return false;
+  float disc = bb * bb - cc;
+  if (disc < 0.0 || -bb - sqrt(disc) > tmax) return false;
   vec3 o = (uInverse[k] * vec4(p, 1.0)).xyz;
   vec3 d = mat3(uInverse[k]) * dw;
   int s = uSlot[k];
@@ -176,6 +185,13 @@ void main() {
   vec4 cur = vec4(uAoRays > 0 ? ao / float(uAoRays) : 0.0, uShadowRays > 0 ? sh / float(uShadowRays) : 0.0, 1.0, 1.0);
   outColor = mix(texelFetch(uPrevious, px, 0), cur, uBlend);
 }`;
+}
+
+const keyIds = new WeakMap();
+let nextKeyId = 0;
+function keyId(k) {
+  if (!keyIds.has(k)) keyIds.set(k, ++nextKeyId);
+  return keyIds.get(k);
 }
 
 function target(w, h, count = 1) {
@@ -299,7 +315,7 @@ export class VffOcclusion {
   }
 
   buildMaterial(keys, slotOf) {
-    const key = `${this.mode}|${this.options.maxInstances}|${keys.map((k) => k.uuid ?? (k.__vffId ??= Math.random().toString(36).slice(2))).join(',')}`;
+    const key = `${this.mode}|${this.options.maxInstances}|${!!this.options.interpolated}|${keys.map(keyId).join(',')}`;
     if (key === this.materialKey && this.material) return;
     this.material?.dispose();
     const uniforms = {
@@ -308,6 +324,7 @@ export class VffOcclusion {
       uBias: { value: 0 }, uCosCone: { value: 1 }, uLight: { value: new THREE.Vector3() },
       uInverse: { value: Array.from({ length: this.options.maxInstances }, () => new THREE.Matrix4()) },
       uSlot: { value: new Int32Array(this.options.maxInstances) },
+      uSphere: { value: Array.from({ length: this.options.maxInstances }, () => new THREE.Vector4()) },
     };
     keys.forEach((k, i) => {
       if (this.mode === 'reference') {
@@ -320,7 +337,7 @@ export class VffOcclusion {
     });
     this.material = new THREE.RawShaderMaterial({
       glslVersion: THREE.GLSL3, vertexShader: QUAD_VERTEX, uniforms, depthTest: false, depthWrite: false,
-      fragmentShader: occlusionFragment({ mode: this.mode, slots: keys, maxInstances: this.options.maxInstances }),
+      fragmentShader: occlusionFragment({ mode: this.mode, slots: keys, maxInstances: this.options.maxInstances, interpolated: !!this.options.interpolated }),
     });
     this.materialKey = key;
   }
@@ -428,6 +445,8 @@ export class VffOcclusion {
     this.instances.forEach((inst, k) => {
       u.uInverse.value[k].copy(inst.object.matrixWorld).invert();
       u.uSlot.value[k] = slotOf[k];
+      const w = inst.object.matrixWorld, c = inst.field.center.clone().applyMatrix4(w);
+      u.uSphere.value[k].set(c.x, c.y, c.z, inst.field.radius * w.getMaxScaleOnAxis() * 1.001 + 1e-6);
     });
     this.quad.material = this.material;
     r.setRenderTarget(this.accum[1]);

@@ -1,0 +1,32 @@
+// tools.js - what the browser tests of @vff/three share: the project's tools (vff-bake and
+// vff-procedural-mesh, from the environment as ctest passes them, else the default build folder),
+// a scratch folder, and the figures that compare two 8-bit images.
+import { existsSync, mkdirSync } from 'node:fs';
+import { join } from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+export const ROOT = fileURLToPath(new URL('../../../', import.meta.url));
+const tool = (env, rel) => process.env[env] || (existsSync(join(ROOT, rel)) ? join(ROOT, rel) : '');
+export const BAKE = tool('VFF_BAKE', 'build/tools/vff-bake/vff-bake');
+export const MESHGEN = tool('VFF_PROCEDURAL_MESH', 'build/samples/vff-procedural-mesh');
+export const SKIP = !BAKE || !MESHGEN ? 'vff-bake and vff-procedural-mesh are not built (VFF_BAKE, VFF_PROCEDURAL_MESH)' : '';
+if (SKIP) console.log(`SKIP: ${SKIP}`);
+
+export function scratch(name) {
+  const dir = join(process.env.VFF_WORK ?? '/tmp', `three-vff-${name}`);
+  mkdirSync(dir, { recursive: true });
+  return dir;
+}
+
+/** RMS and the share within `tol` of a - b over the pixels where mask(i). */
+export function compare(a, b, mask, tol = 8) {
+  let n = 0, s2 = 0, within = 0;
+  for (let i = 0; i < a.length; ++i) {
+    if (!mask(i)) continue;
+    const d = a[i] - b[i];
+    ++n;
+    s2 += d * d;
+    within += Math.abs(d) <= tol;
+  }
+  return { pixels: n, rms: n ? Math.sqrt(s2 / n) : 0, within: n ? within / n : 1 };
+}
