@@ -66,8 +66,16 @@ int addMesh(GltfDoc& doc, const Mesh& mesh, const std::string& name) {
   }
   doc.json["accessors"].back()["min"] = lo;
   doc.json["accessors"].back()["max"] = hi;
-  if (mesh.normals.size() == mesh.positions.size())
-    prim["attributes"]["NORMAL"] = doc.addAccessor(doc.addView(mesh.normals.data(), n * 12, 0), kFloat, false, n, "VEC3");
+  if (mesh.normals.size() == mesh.positions.size()) {
+    // glTF wants unit normals; an importer's may be area-weighted sums.
+    std::vector<float> unit(mesh.normals);
+    for (size_t i = 0; i + 2 < unit.size(); i += 3) {
+      const float len = std::sqrt(unit[i] * unit[i] + unit[i + 1] * unit[i + 1] + unit[i + 2] * unit[i + 2]);
+      if (std::fabs(len - 1.0f) < 1e-3f) continue;  // unit already: kept bit for bit
+      for (size_t c = 0; c < 3; ++c) unit[i + c] = len > 0 ? unit[i + c] / len : (c == 2 ? 1.0f : 0.0f);
+    }
+    prim["attributes"]["NORMAL"] = doc.addAccessor(doc.addView(unit.data(), n * 12, 0), kFloat, false, n, "VEC3");
+  }
   prim["indices"] = doc.addAccessor(doc.addView(mesh.indices.data(), ni * 4, 0), kUInt, false, ni, "SCALAR");
   nlohmann::json m = {{"primitives", {prim}}};
   if (!name.empty()) m["name"] = name;
