@@ -33,5 +33,8 @@ test_plugin() {
   VFF_WORK="$WORK" node_test three-vff/test/browser/plugin.browser.js
 }
 
+# In Chromium: decodeInWorker on conformance vectors (the same field as VffField.fromBytes) and errors.
+test_worker() { need_three; need_chromium; node_test three-vff/test/browser/worker.browser.js; }
+
 # (test_* functions go above this line)
 run_test "$1"
