@@ -85,9 +85,9 @@ void main() {
   outColor = vec4(vec3(f), 1.0);
 }`;
 
-/** The query's source for field slot i: every vff/Vff/VFF_ name gets the slot's prefix. */
+/** The query's source for field slot i: every vff/Vff/VFF_/kVff name gets the slot's prefix. */
 export function slotGlsl(i, field) {
-  const rename = (s) => s.replace(/\b(vff|Vff|VFF_)/g, (m) => (m === 'VFF_' ? `VFF${i}_` : `${m}${i}_`));
+  const rename = (s) => s.replace(/\b(vff|Vff|VFF_|kVff)/g, (m) => (m === 'VFF_' ? `VFF${i}_` : `${m}${i}_`));
   const defines = Object.keys(field.defines).map((d) => `#define ${rename(d)}\n`).join('');
   return defines + rename(FIELD_STRUCT + VFF_QUERY_GLSL_ES);
 }
@@ -245,6 +245,7 @@ export class VffOcclusion {
     this.gbuffer = null;
     this.accum = [];
     this.material = null;
+    this.materials = new Map();             // key -> the occlusion pass's material
     this.materialKey = '';
     this.signature = null;
     this.quadCamera = new THREE.OrthographicCamera(-1, 1, 1, -1, 0, 1);
@@ -317,7 +318,18 @@ export class VffOcclusion {
   buildMaterial(keys, slotOf) {
     const key = `${this.mode}|${this.options.maxInstances}|${!!this.options.interpolated}|${keys.map(keyId).join(',')}`;
     if (key === this.materialKey && this.material) return;
-    this.material?.dispose();
+    // A program compiles slowly (seconds in software): one material a key, kept for a later switch back.
+    if (this.materials.has(key)) {
+      this.material = this.materials.get(key);
+      this.materialKey = key;
+      return;
+    }
+    // Samplers: the G-buffer's two and the running mean, then 3 a field (maps, normals, positions)
+    // or 4 a BVH (positions, index, bounds, contents).
+    const units = 3 + (this.mode === 'reference' ? 4 * keys.length : keys.reduce((n, f) => n + ('VFF_NO_NORMALS' in f.defines ? 2 : 3), 0));
+    const max = this.renderer.capabilities.maxTextures;
+    if (units > max)
+      throw new Error(`VffOcclusion: ${keys.length} distinct ${this.mode === 'reference' ? 'geometries' : 'fields'} need ${units} texture units, this context has ${max}`);
     const uniforms = {
       uPosition: { value: null }, uNormal: { value: null }, uPrevious: { value: null }, uBlend: { value: 1 }, uFrame: { value: 0 },
       uAoRays: { value: 0 }, uShadowRays: { value: 0 }, uCount: { value: 0 }, uAoRange: { value: 1 }, uShadowRange: { value: 1 },
@@ -340,6 +352,7 @@ export class VffOcclusion {
       fragmentShader: occlusionFragment({ mode: this.mode, slots: keys, maxInstances: this.options.maxInstances, interpolated: !!this.options.interpolated }),
     });
     this.materialKey = key;
+    this.materials.set(key, this.material);
   }
 
   idMaterial(id) {
@@ -473,7 +486,8 @@ export class VffOcclusion {
   dispose() {
     this.gbuffer?.dispose();
     for (const t of this.accum) t.dispose();
-    this.material?.dispose();
+    for (const m of this.materials.values()) m.dispose();
+    this.materials.clear();
     this.composite.dispose();
     for (const m of this.idMaterials.values()) m.dispose();
     for (const e of this.bvhs.values()) e.geometry.dispose();

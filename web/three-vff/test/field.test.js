@@ -71,8 +71,17 @@ test('invalid vectors throw the VffError of their ID', async () => {
 test("the occlusion shader's copy of the query for slot 2 has only prefixed names", async () => {
   const field = await VffField.fromBytes(readFileSync(join(CONF, 'valid', 'bit1-zstd-normals-meta-3d.vff')));
   const src = slotGlsl(2, field);
-  const names = new Set(src.replace(/\/\/.*$/gm, '').match(/\b(vff|Vff|VFF_?)[A-Za-z0-9_]*/g));
-  for (const n of names) assert.match(n, /^(vff2_|Vff2_|VFF2_)/, n);
+  const names = new Set(src.replace(/\/\/.*$/gm, '').match(/\b(vff|Vff|VFF_?|kVff)[A-Za-z0-9_]*/g));
+  for (const n of names) assert.match(n, /^(vff2_|Vff2_|VFF2_|kVff2_)/, n);
+  // Every top-level declaration of the query (functions, constants, structs, uniforms) is renamed, so
+  // several copies live in one shader.
+  const declared = new Set();
+  for (const line of src.split('\n')) {
+    const m = /^(?:const\s+)?(?:uniform\s+)?(?:highp\s+|precise\s+)?(?:struct\s+(\w+)|\w+\s+(\w+)\s*[=(;[])/.exec(line);
+    if (m) declared.add(m[1] ?? m[2]);
+  }
+  assert.ok(declared.size > 40, `${declared.size} top-level names`);
+  for (const n of declared) assert.match(n, /^(vff2_|Vff2_|VFF2_|kVff2_)/, `top-level ${n}`);
   assert.ok(src.includes('#define VFF2_MAPS_3D'));
   assert.ok(src.includes('bool vff2_Occluded('));
   assert.ok(src.includes('uniform Vff2_FieldData vff2_Field;'));

@@ -2,7 +2,9 @@
 // (its field baked by vff-bake from vff-procedural-mesh's knot). The floor AO of mode 'field'
 // matches mode 'reference' (three-mesh-bvh's GPU ray casting against the knot's triangles, the
 // same rays) within RMS 3 of 8 bits after accumulation; moving the knot restarts the accumulation
-// and moves its shadow; mode 'off' draws what three.js draws alone. VFF_WORK: scratch folder.
+// and moves its shadow; mode 'off' draws what three.js draws alone; a second knot with a field of
+// its own (a second copy of the query in the shader) darkens the floor and the first knot, and no
+// knot darkens itself. VFF_WORK: scratch folder.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
@@ -21,7 +23,9 @@ before(async () => {
   const obj = join(dir, 'knot.obj'), vff = join(dir, 'knot.vff');
   execFileSync(MESHGEN, ['torus-knot', obj], { stdio: 'ignore' });
   execFileSync(BAKE, [obj, '-o', vff, '-n', '16', '-m', '32'], { stdio: 'ignore' });
-  srv = await serve({ '/knot.obj': obj, '/knot.vff': vff });
+  const vff2 = join(dir, 'knot-8.vff');
+  execFileSync(BAKE, [obj, '-o', vff2, '-n', '8', '-m', '16'], { stdio: 'ignore' });
+  srv = await serve({ '/knot.obj': obj, '/knot.vff': vff, '/knot-8.vff': vff2 });
   browser = await launch();
   page = await browser.newPage();
   page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
@@ -87,5 +91,22 @@ test("mode 'off' draws the plain three.js image", { skip: SKIP || false }, async
   assert.ok(off.every((v, i) => v === plain[i]), "mode 'off' equals renderer.render");
   const darker = field.filter((v, i) => i % 4 !== 3 && v < plain[i] - 4).length;
   assert.ok(darker > 300, `mode 'field' darkens ${darker} channels`);
+  assert.deepEqual(errors, []);
+});
+
+test('two fields: each instance darkens the floor, a pixel on an instance skips that instance', { skip: SKIP || false }, async () => {
+  const one = await page.evaluate(() => window.run('field', 2));
+  const two = await page.evaluate(() => window.runTwoFields('/knot-8.vff', -2, 2));
+  const floorAo = (r, left) => r.ao.reduce((s, v, i) => s + (r.ids[i] === RECEIVER && (i % r.width < r.width * 0.3) === left ? v : 0), 0);
+  console.log(`floor AO left/right: one knot ${floorAo(one, true)}/${floorAo(one, false)}, two ${floorAo(two, true)}/${floorAo(two, false)}`);
+  assert.ok(two.ids.includes(2), 'the second instance is drawn with id 2');
+  assert.ok(floorAo(two, true) > 2 * floorAo(one, true) + 1000, 'the second knot darkens the floor on the left');
+  // A ray from a pixel on instance k skips instance k: alone, the knot darkens none of its pixels;
+  // beside a second knot, some.
+  const onKnot = (r) => r.ao.map((v, i) => (r.ids[i] === 1 ? v + r.shadow[i] : -1)).filter((v) => v >= 0);
+  const alone = onKnot(one), beside = onKnot(two);
+  console.log(`knot pixels darkened: alone ${alone.filter((v) => v > 0).length} of ${alone.length}, beside another ${beside.filter((v) => v > 0).length} of ${beside.length}`);
+  assert.ok(alone.length > 500 && alone.every((v) => v === 0), 'no self-occlusion');
+  assert.ok(beside.filter((v) => v > 0).length > 20, 'the other knot darkens the first');
   assert.deepEqual(errors, []);
 });
