@@ -166,21 +166,25 @@ void main() {
   uint seed = pcg(uint(px.x) + pcg(uint(px.y) + pcg(uFrame)));
   vec3 t, b;
   basis(n, t, b);
-  float ao = 0.0;
-  for (int r = 0; r < uAoRays; ++r) {
-    float u1 = rnd(seed), u2 = rnd(seed);
-    float rr = sqrt(u1), phi = 6.283185307179586 * u2;
-    vec3 d = normalize(t * (rr * cos(phi)) + b * (rr * sin(phi)) + n * sqrt(max(0.0, 1.0 - u1)));
-    if (occluded(skip, p, d, uAoRange)) ao += 1.0;
-  }
   vec3 lt, lb;
   basis(uLight, lt, lb);
-  float sh = 0.0;
-  for (int r = 0; r < uShadowRays; ++r) {
-    float u1 = rnd(seed), u2 = rnd(seed);
-    float c = 1.0 - u1 * (1.0 - uCosCone), sn = sqrt(max(0.0, 1.0 - c * c)), phi = 6.283185307179586 * u2;
-    vec3 d = normalize(lt * (sn * cos(phi)) + lb * (sn * sin(phi)) + uLight * c);
-    if (occluded(skip, p, d, uShadowRange)) sh += 1.0;
+  // One loop, one call site of the query (a program's size, and its compile time, grow with each):
+  // the AO rays first, then the shadow rays.
+  float ao = 0.0, sh = 0.0;
+  for (int r = 0; r < uAoRays + uShadowRays; ++r) {
+    float u1 = rnd(seed), u2 = rnd(seed), phi = 6.283185307179586 * u2;
+    bool isAo = r < uAoRays;
+    vec3 d;
+    if (isAo) {
+      float rr = sqrt(u1);
+      d = normalize(t * (rr * cos(phi)) + b * (rr * sin(phi)) + n * sqrt(max(0.0, 1.0 - u1)));
+    } else {
+      float c = 1.0 - u1 * (1.0 - uCosCone), sn = sqrt(max(0.0, 1.0 - c * c));
+      d = normalize(lt * (sn * cos(phi)) + lb * (sn * sin(phi)) + uLight * c);
+    }
+    if (occluded(skip, p, d, isAo ? uAoRange : uShadowRange)) {
+      if (isAo) ao += 1.0; else sh += 1.0;
+    }
   }
   vec4 cur = vec4(uAoRays > 0 ? ao / float(uAoRays) : 0.0, uShadowRays > 0 ? sh / float(uShadowRays) : 0.0, 1.0, 1.0);
   outColor = mix(texelFetch(uPrevious, px, 0), cur, uBlend);
