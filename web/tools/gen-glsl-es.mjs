@@ -31,7 +31,11 @@ void vffUmulExtended(uint a, uint b, out uint hi, out uint lo) {
 const POSITIONS = `// The positions buffer as an RGBA32F texture, row-major (ES 3.00 has no storage buffers).
 uniform highp sampler2D vffPositionsTex;
 vec4 vffPositionsAt(int i) {
+#ifdef VFF_POSITIONS_WIDTH
+  const int w = VFF_POSITIONS_WIDTH;  // the texture's width, where the loader defines it: i / w folds
+#else
   int w = textureSize(vffPositionsTex, 0).x;
+#endif
   return texelFetch(vffPositionsTex, ivec2(i % w, i / w), 0);
 }`;
 

@@ -27,15 +27,30 @@ uniform VffFieldData vffField;
 #define VFF_FIELD vffField
 `;
 
-/** The GLSL ES source of the query with its field uniform: what `field.glsl` holds. */
+/** The GLSL ES source of the query with its field uniform, for any field. */
 export const FIELD_GLSL = `precision highp float;\nprecision highp int;\n${FIELD_STRUCT}${VFF_QUERY_GLSL_ES}\n`;
+
+// The field's parameters that specialisedGlsl writes in as constants: those that choose a branch.
+// Sizes stay uniforms, so fields that differ only in size share one compiled program.
+const SPECIALISED = ['positionScheme', 'directionScheme', 'distanceEncoding', 'missCode', 'normalEncoding'];
+
+/**
+ * FIELD_GLSL (or `src`) specialised to one field: every `VFF_FIELD.<parameter>` that chooses a
+ * scheme or an encoding becomes the value in `value` (the vffField uniform's value). The compiler then
+ * drops the schemes and encodings the field does not use, which software renderers (SwiftShader)
+ * otherwise run, masked, on every lookup. What `field.glsl` holds.
+ */
+export function specialisedGlsl(value, src = FIELD_GLSL) {
+  for (const name of SPECIALISED) src = src.replaceAll(`VFF_FIELD.${name}`, `${value[name] >>> 0}u`);
+  return src;
+}
 
 const UINTS = ['positionScheme', 'positionParam', 'mapCount', 'directionScheme', 'mapResolution', 'distanceEncoding',
   'missCode', 'normalEncoding', 'target', 'gutter', 'tileSize', 'tilesPerRow', 'tilesPerColumn', 'sliceWidth',
   'sliceHeight', 'sliceCount'];
 
 /** The std140 VffFieldBlock (query_tables.js) as the struct uniform's value. */
-function blockValue(block) {
+export function blockValue(block) {
   const F = new Float32Array(block), U = new Uint32Array(block);
   const v = { sphereCenter: new THREE.Vector3(F[0], F[1], F[2]), sphereRadius: F[3] };
   UINTS.forEach((name, i) => { v[name] = U[4 + i]; });
@@ -95,7 +110,8 @@ export class VffField {
       vffPositionsTex: { value: null },
     };
     this.defines = Object.fromEntries(data.textures.defines.map((d) => [d, '']));
-    this.glsl = FIELD_GLSL;
+    this.defines.VFF_POSITIONS_WIDTH = String(data.textures.positions.width);
+    this.glsl = specialisedGlsl(this.uniforms.vffField.value);
   }
 
   /**

@@ -20,7 +20,7 @@
 // 'off' draws the scene alone.
 import * as THREE from 'three';
 import { MeshBVH, MeshBVHUniformStruct, BVHShaderGLSL } from 'three-mesh-bvh';
-import { FIELD_STRUCT } from './field.js';
+import { FIELD_STRUCT, specialisedGlsl } from './field.js';
 import { VFF_QUERY_GLSL_ES } from '../../src/vff_query_es.js';
 
 const RECEIVER_ID = 4095;   // a receiving surface that is no instance
@@ -85,61 +85,60 @@ void main() {
   outColor = vec4(vec3(f), 1.0);
 }`;
 
-/** The query's source for field slot i: every vff/Vff/VFF_/kVff name gets the slot's prefix. */
+/** The query's source for field slot i, specialised to its field: every vff/Vff/VFF_/kVff name gets the slot's prefix. */
 export function slotGlsl(i, field) {
   const rename = (s) => s.replace(/\b(vff|Vff|VFF_|kVff)/g, (m) => (m === 'VFF_' ? `VFF${i}_` : `${m}${i}_`));
-  const defines = Object.keys(field.defines).map((d) => `#define ${rename(d)}\n`).join('');
-  return defines + rename(FIELD_STRUCT + VFF_QUERY_GLSL_ES);
+  const defines = Object.entries(field.defines).map(([d, v]) => `#define ${rename(d)}${v === '' ? '' : ` ${v}`}\n`).join('');
+  return defines + rename(specialisedGlsl(field.uniforms.vffField.value, FIELD_STRUCT + VFF_QUERY_GLSL_ES));
 }
 
 function occlusionFragment({ mode, slots, maxInstances, interpolated }) {
-  let resources = '', cases = '';
-  if (mode === 'field') {
-    slots.forEach((f, i) => {
+  // The instances are ordered by slot (uRange[i] .. uRange[i + 1] use slot i), and each slot's query
+  // is called in a loop of its own: every instance costs one query, never a masked run of the others'.
+  let resources = '', loops = '';
+  slots.forEach((f, i) => {
+    let hit;
+    if (mode === 'field') {
       resources += slotGlsl(i, f) + '\n';
-      cases += interpolated
-        ? `  if (s == ${i}) return vff${i}_IntersectInterpolated(o, d, 0.0, tmax, VFF${i}_OFF_OBJECT).hit;\n`
-        : `  if (s == ${i}) return vff${i}_Occluded(o, d, 0.0, tmax, VFF${i}_OFF_OBJECT);\n`;
-    });
-  } else {
-    resources = BVHShaderGLSL.common_functions + BVHShaderGLSL.bvh_struct_definitions + BVHShaderGLSL.bvh_ray_functions;
-    slots.forEach((_, i) => {
+      hit = interpolated ? `vff${i}_IntersectInterpolated(o, d, 0.0, tmax, VFF${i}_OFF_OBJECT).hit` : `vff${i}_Occluded(o, d, 0.0, tmax, VFF${i}_OFF_OBJECT)`;
+    } else {
       resources += `uniform BVH bvh${i};\n`;
-      cases += `  if (s == ${i}) { uvec4 fi; vec3 fn, bc; float side, dist;
-    if (bvhIntersectFirstHit(bvh${i}, o, d, fi, fn, bc, side, dist) && dist >= 0.0 && dist <= tmax) return true; }\n`;
-    });
+      hit = `bvhIntersectFirstHit(bvh${i}, o, d, fi, fn, bc, side, dist) && dist >= 0.0 && dist <= tmax`;
+    }
+    loops += `  for (int j = uRange[${i}]; j < uRange[${i + 1}]; ++j) {
+    if (j == skip || !nearSphere(j, p, dw, tmax)) continue;
+    vec3 o = (uInverse[j] * vec4(p, 1.0)).xyz, d = mat3(uInverse[j]) * dw;
+${mode === 'field' ? '' : '    uvec4 fi; vec3 fn, bc; float side, dist;\n'}    if (${hit}) return true;
   }
+`;
+  });
+  if (mode === 'reference') resources = BVHShaderGLSL.common_functions + BVHShaderGLSL.bvh_struct_definitions + BVHShaderGLSL.bvh_ray_functions + resources;
   return `${PRECISION}
 #define MAX_INSTANCES ${maxInstances}
 uniform sampler2D uPosition, uNormal, uPrevious;
 uniform float uBlend;
 uniform uint uFrame;
-uniform int uAoRays, uShadowRays, uCount;
+uniform int uAoRays, uShadowRays;
 uniform float uAoRange, uShadowRange, uBias, uCosCone;
 uniform vec3 uLight;
-uniform mat4 uInverse[MAX_INSTANCES];
-uniform int uSlot[MAX_INSTANCES];
+uniform mat4 uInverse[MAX_INSTANCES];   // world to local, in slot order
+uniform int uSorted[MAX_INSTANCES];     // instance k's place in slot order
+uniform int uRange[${slots.length + 1}];
 uniform vec4 uSphere[MAX_INSTANCES];
 ${resources}
-// Instance k's answer for a world ray p + t d, t in [0, tmax] (d unit): the ray in its local space.
-bool occludedBy(int k, vec3 p, vec3 dw, float tmax) {
-  // Rays that miss the instance's bounding sphere (slightly enlarged) are not asked.
-  vec3 oc = p - uSphere[k].xyz;
-  float bb = dot(oc, dw), cc = dot(oc, oc) - uSphere[k].w * uSphere[k].w;
+// Whether a world ray p + t dw, t in [0, tmax], meets instance j's bounding sphere (slightly enlarged):
+// others are not asked.
+bool nearSphere(int j, vec3 p, vec3 dw, float tmax) {
+  vec3 oc = p - uSphere[j].xyz;
+  float bb = dot(oc, dw), cc = dot(oc, oc) - uSphere[j].w * uSphere[j].w;
   if (cc > 0.0 && bb > 0.0) return false;
   float disc = bb * bb - cc;
-  if (disc < 0.0 || -bb - sqrt(disc) > tmax) return false;
-  vec3 o = (uInverse[k] * vec4(p, 1.0)).xyz;
-  vec3 d = mat3(uInverse[k]) * dw;
-  int s = uSlot[k];
-${cases}  return false;
+  return disc >= 0.0 && -bb - sqrt(disc) <= tmax;
 }
-bool occluded(int skip, vec3 p, vec3 d, float tmax) {
-  for (int k = 0; k < MAX_INSTANCES; ++k) {
-    if (k >= uCount) break;
-    if (k != skip && occludedBy(k, p, d, tmax)) return true;
-  }
-  return false;
+// Whether an instance other than the one in slot order place \`skip\` blocks the ray (dw unit); each
+// instance answers in its local space.
+bool occluded(int skip, vec3 p, vec3 dw, float tmax) {
+${loops}  return false;
 }
 uint pcg(uint v) {
   uint s = v * 747796405u + 2891336453u;
@@ -162,7 +161,7 @@ void main() {
   if (id == 0) { outColor = vec4(0.0); return; }
   vec3 n = texelFetch(uNormal, px, 0).xyz;
   vec3 p = P.xyz + n * uBias;
-  int skip = id <= MAX_INSTANCES ? id - 1 : -1;
+  int skip = id <= MAX_INSTANCES ? uSorted[id - 1] : -1;
   uint seed = pcg(uint(px.x) + pcg(uint(px.y) + pcg(uFrame)));
   vec3 t, b;
   basis(n, t, b);
@@ -336,10 +335,11 @@ export class VffOcclusion {
       throw new Error(`VffOcclusion: ${keys.length} distinct ${this.mode === 'reference' ? 'geometries' : 'fields'} need ${units} texture units, this context has ${max}`);
     const uniforms = {
       uPosition: { value: null }, uNormal: { value: null }, uPrevious: { value: null }, uBlend: { value: 1 }, uFrame: { value: 0 },
-      uAoRays: { value: 0 }, uShadowRays: { value: 0 }, uCount: { value: 0 }, uAoRange: { value: 1 }, uShadowRange: { value: 1 },
+      uAoRays: { value: 0 }, uShadowRays: { value: 0 }, uAoRange: { value: 1 }, uShadowRange: { value: 1 },
       uBias: { value: 0 }, uCosCone: { value: 1 }, uLight: { value: new THREE.Vector3() },
       uInverse: { value: Array.from({ length: this.options.maxInstances }, () => new THREE.Matrix4()) },
-      uSlot: { value: new Int32Array(this.options.maxInstances) },
+      uSorted: { value: new Int32Array(this.options.maxInstances) },
+      uRange: { value: new Int32Array(keys.length + 1) },
       uSphere: { value: Array.from({ length: this.options.maxInstances }, () => new THREE.Vector4()) },
     };
     keys.forEach((k, i) => {
@@ -453,18 +453,24 @@ export class VffOcclusion {
     u.uFrame.value = this.frame;
     u.uAoRays.value = o.aoRays;
     u.uShadowRays.value = o.shadowRays;
-    u.uCount.value = this.instances.length;
     u.uAoRange.value = o.aoRange;
     u.uShadowRange.value = o.shadowRange;
     u.uBias.value = o.bias || o.aoRange / 1000;
     u.uCosCone.value = Math.cos(o.lightAngle);
     u.uLight.value.copy(o.lightDirection).normalize();
-    this.instances.forEach((inst, k) => {
-      u.uInverse.value[k].copy(inst.object.matrixWorld).invert();
-      u.uSlot.value[k] = slotOf[k];
-      const w = inst.object.matrixWorld, c = inst.field.center.clone().applyMatrix4(w);
-      u.uSphere.value[k].set(c.x, c.y, c.z, inst.field.radius * w.getMaxScaleOnAxis() * 1.001 + 1e-6);
+    // Slot order: the instances of slot 0, then of slot 1, ...; ties in the instances' order.
+    const order = this.instances.map((_, k) => k).sort((a, b) => slotOf[a] - slotOf[b] || a - b);
+    u.uRange.value.fill(0);
+    order.forEach((k, j) => {
+      const inst = this.instances[k], w = inst.object.matrixWorld;
+      u.uInverse.value[j].copy(w).invert();
+      u.uSorted.value[k] = j;
+      const c = inst.field.center.clone().applyMatrix4(w);
+      u.uSphere.value[j].set(c.x, c.y, c.z, inst.field.radius * w.getMaxScaleOnAxis() * 1.001 + 1e-6);
+      u.uRange.value[slotOf[k] + 1] = j + 1;
     });
+    // A slot without instances begins and ends where the slot before it ends.
+    for (let i = 1; i < u.uRange.value.length; ++i) u.uRange.value[i] = Math.max(u.uRange.value[i], u.uRange.value[i - 1]);
     this.quad.material = this.material;
     r.setRenderTarget(this.accum[1]);
     r.render(this.quadScene, this.quadCamera);
