@@ -37,13 +37,37 @@ test_glsl_es_generated() { need_node; node_test test/glsl.test.js; }
 # In headless Chromium: the decoder decodes the conformance vectors as under node.
 test_browser_decoder() { need_chromium; node_test test/browser/decoder.browser.js; }
 
-# In headless Chromium: the page loads a baked bunny, renders it with WebGL2, and its ground
-# matches the C++ reference render (vff_web_reference) of the same view.
+# In headless Chromium: the page loads a baked bunny, renders it with three.js, and its ground AO
+# reference view matches the C++ reference render (vff_web_reference) of the same view.
 test_browser_render() {
   need_chromium
   [[ -x ${VFF_BAKE:-} ]] || skip "vff-bake is not built (needs Embree)"
   [[ -f /usr/share/glmark2/models/bunny.obj ]] || skip "no /usr/share/glmark2/models/bunny.obj (apt-get install glmark2-data)"
   VFF_WORK="$WORK" node_test test/browser/render.browser.js
+}
+
+# In headless Chromium: the viewer page (web/test/browser/viewer.browser.js) driven as a user would,
+# in three cases (each page compiles the field's shaders in software, which takes a while):
+# viewer: ?file= and a sample, the object on its lowest point, a clean page and every problem after
+# a bad file, PNG and JSON downloads (JSON against vff-inspect when built), keyboard and names, the
+# message without web/node_modules; viewer_worker: a large field decoded in the Worker with progress
+# while the page answers (needs vff-bake, vff-procedural-mesh); viewer_sizes: 1280 and 390 wide, DPR 2.
+need_three() {
+  need_chromium
+  [[ -d $WEB/node_modules/three ]] || skip "no three in $WEB/node_modules: run scripts/setup.sh (npm ci in web/)"
+}
+test_browser_viewer() {
+  need_three
+  VFF_WORK="$WORK" node_test --test-name-pattern='opens a sample|bad file|downloads|keyboard|node_modules' test/browser/viewer.browser.js
+}
+test_browser_viewer_worker() {
+  need_three
+  need_bake_scene
+  VFF_WORK="$WORK" node_test --test-name-pattern='Worker' test/browser/viewer.browser.js
+}
+test_browser_viewer_sizes() {
+  need_three
+  VFF_WORK="$WORK" node_test --test-name-pattern='size at' test/browser/viewer.browser.js
 }
 
 # glTF extension VFF_visibility_field: the JS reader on spec/conformance/gltf and on assets made

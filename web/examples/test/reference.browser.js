@@ -11,7 +11,7 @@ import { openExample, frame, compare } from './common.js';
 // Frames accumulated per mode: the reference costs seconds a frame in software rendering.
 const FRAMES = 4;
 let ex;
-before(async () => { ex = await openExample({ query: 'noloop=1&paused=1&t=3&rays=4', viewport: { width: 200, height: 150 } }); });
+before(async () => { ex = await openExample({ query: 'noloop=1&paused=1&t=3&rays=4', viewport: { width: 160, height: 120 } }); });
 after(async () => { await ex?.close(); });
 
 async function draw(mode) {

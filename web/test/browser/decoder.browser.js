@@ -1,5 +1,6 @@
 // The decoder inside headless Chromium: the page's module decodes every conformance vector as
-// node does (valid ones to their expected values, invalid ones to their folder's ID).
+// node does (valid ones to their expected values, invalid ones to their folder's ID); the viewer
+// (its decoding Worker and three.js view) names an invalid file's ID and draws every valid one.
 import { test, after, before } from 'node:test';
 import assert from 'node:assert/strict';
 import { readdirSync } from 'node:fs';
@@ -15,8 +16,10 @@ before(async () => {
     for (const n of readdirSync(join(CONF, 'invalid', id))) extra[`/conf/invalid/${id}/${n}`] = join(CONF, 'invalid', id, n);
   srv = await serve(extra);
   browser = await launch();
-  page = await browser.newPage();
+  page = await browser.newPage({ viewport: { width: 480, height: 700 } });
   await page.goto(`${srv.url}/index.html`);
+  await page.waitForFunction(() => window.vffViewer?.view);
+  await page.evaluate(() => window.vffViewer.view.setOptions({ maxFrames: 1 }));
 });
 after(async () => { await browser?.close(); srv?.server.close(); });
 
@@ -78,9 +81,10 @@ test('the page names an invalid file\'s ID', async () => {
   const r = await page.evaluate(async () => {
     const bytes = new Uint8Array(await (await fetch('/conf/invalid/2002/magic-byte0.vff')).arrayBuffer());
     const res = await window.vffViewer.loadBytes(bytes, 'magic-byte0.vff');
-    return { res, text: document.getElementById('error').textContent };
+    return { res, text: document.getElementById('problems').textContent };
   });
   assert.equal(r.res.id, 2002);
+  assert.match(r.text, /^magic-byte0\.vff: /);
   assert.match(r.text, /bad-magic \(2002\)/);
 });
 
@@ -88,26 +92,21 @@ test('the page uploads and renders every valid vector (2D array and 3D, every en
   const names = readdirSync(join(CONF, 'valid')).filter((n) => n.endsWith('.vff'));
   const got = await page.evaluate(async (names) => {
     const out = [];
-    const canvas = document.getElementById('view');
     for (const n of names) {
       const bytes = new Uint8Array(await (await fetch(`/conf/valid/${n}`)).arrayBuffer());
-      canvas.width = 24; canvas.height = 24;
-      let res;
+      let res, object = 0, glError = -1;
       try {
+        window.vffViewer.view.setOptions({ interpolated: n.startsWith('u8c') });
         res = await window.vffViewer.loadBytes(bytes, n);
-        Object.assign(window.vffViewer.view, { reference: false, interpolated: n.startsWith('u8c'), aoRays: 4 });
         window.vffViewer.redraw();
+        glError = window.vffViewer.view.renderer.getContext().getError();
+        object = window.vffViewer.objectPixels();
       } catch (e) { res = { error: String(e.message).slice(0, 300) }; }
-      const gl = canvas.getContext('webgl2');
-      const px = new Uint8Array(24 * 24 * 4);
-      gl.readPixels(0, 0, 24, 24, gl.RGBA, gl.UNSIGNED_BYTE, px);
-      let object = 0;  // pixels of the object's warm colours (red clearly above blue)
-      for (let i = 0; i < px.length; i += 4) object += px[i] > px[i + 2] + 40;
-      out.push({ n, res, glError: gl.getError(), object });
+      out.push({ n, res: { ok: res.ok, gl: res.gl, message: res.message, error: res.error }, glError, object });
     }
     return out;
   }, names);
-  console.log(got.map((r) => `${r.n}: ${r.object} object pixels of 576`).join('\n'));
+  console.log(got.map((r) => `${r.n}: ${r.object} object pixels`).join('\n'));
   for (const r of got) {
     assert.ok(r.res.ok && r.res.gl, `${r.n}: ${JSON.stringify(r.res)}`);
     assert.equal(r.glError, 0, r.n);
@@ -116,32 +115,16 @@ test('the page uploads and renders every valid vector (2D array and 3D, every en
   assert.ok(got.filter((r) => r.object > 0).length >= 6, JSON.stringify(got.map((r) => [r.n, r.object])));
 });
 
-test('bc4-diameter: BC4 blocks sampled by the GPU (RGTC) answer as the CPU-decoded codes', async () => {
+test('bc4-diameter: blocks decoded to codes in the Worker answer as the CPU decoder', async () => {
+  // The viewer uploads bc4-diameter maps as the codes the decoder's BC4 reading gives (R8UI), so
+  // its reference view is the one of the same field written with unorm8-diameter codes.
   const got = await page.evaluate(async () => {
     const bytes = new Uint8Array(await (await fetch('/conf/valid/bc4-zstd-normals-slices.vff')).arrayBuffer());
-    const canvas = document.getElementById('view');
-    const size = 48;
-    const gl = canvas.getContext('webgl2');
-    const has = !!gl.getExtension('EXT_texture_compression_rgtc');
-    const shot = async (bc4OnCpu) => {
-      canvas.width = size; canvas.height = size;
-      const r = await window.vffViewer.loadBytes(bytes, 'bc4.vff', { bc4OnCpu });
-      Object.assign(window.vffViewer.view, { reference: true, interpolated: false });
-      window.vffViewer.redraw();
-      const px = new Uint8Array(size * size * 4);
-      gl.readPixels(0, 0, size, size, gl.RGBA, gl.UNSIGNED_BYTE, px);
-      return { r, px: Array.from(px.filter((_, i) => i % 4 === 0)) };
-    };
-    const gpu = await shot(false), cpu = await shot(true);
-    return { has, gpu, cpu };
+    const r = await window.vffViewer.loadBytes(bytes, 'bc4.vff');
+    const px = window.vffViewer.reference(48, false);
+    return { r: { ok: r.ok, gl: r.gl }, occluded: px.filter((v) => v < 230).length, n: px.length };
   });
-  if (!got.has) { console.log('SKIP: no EXT_texture_compression_rgtc in this context'); return; }
-  assert.equal(got.gpu.r.bc4, 'gpu');
-  assert.equal(got.cpu.r.bc4, 'cpu');
-  let differ = 0, occluded = 0;
-  got.gpu.px.forEach((v, i) => { differ += Math.abs(v - got.cpu.px[i]) > 16; occluded += got.cpu.px[i] < 230; });
-  console.log(`bc4 RGTC vs CPU decode: ${differ} of ${got.cpu.px.length} pixels differ by more than 16 levels; ${occluded} occluded`);
-  assert.ok(occluded > 50);
-  // Texture units may round interpolated palette entries differently (format.md 7.4): a few flips.
-  assert.ok(differ <= got.cpu.px.length * 0.02);
+  console.log(`bc4: ${got.occluded} of ${got.n} reference pixels occluded`);
+  assert.ok(got.r.ok && got.r.gl);
+  assert.ok(got.occluded > 50);
 });

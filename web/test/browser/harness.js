@@ -9,15 +9,19 @@ import { chromium } from 'playwright-core';
 export const WEB = fileURLToPath(new URL('../../', import.meta.url));
 const TYPES = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript', '.json': 'application/json', '.wasm': 'application/wasm' };
 
-/** Serves web/ on 127.0.0.1; `extra` maps URL paths to files (test data). */
-export async function serve(extra = {}) {
+/**
+ * Serves web/ on 127.0.0.1; `extra` maps URL paths to files (test data). options.hide: URL path
+ * prefixes answered 404 (a checkout without web/node_modules).
+ */
+export async function serve(extra = {}, options = {}) {
   const server = createServer(async (req, res) => {
     const path = decodeURIComponent(new URL(req.url, 'http://x').pathname);
+    if ((options.hide ?? []).some((p) => path.startsWith(p))) { res.writeHead(404); res.end(); return; }
     const file = extra[path] ?? join(WEB, normalize(path).replace(/^(\.\.[/\\])+/, ''));
     try {
       const body = await readFile(file.endsWith('/') ? join(file, 'index.html') : file);
-      res.writeHead(200, { 'content-type': TYPES[extname(file)] ?? 'application/octet-stream' });
-      res.end(body);
+      res.writeHead(200, { 'content-type': TYPES[extname(file)] ?? 'application/octet-stream', 'content-length': body.length });
+      res.end(req.method === 'HEAD' ? undefined : body);
     } catch {
       res.writeHead(404);
       res.end();
