@@ -29,14 +29,15 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BEGIN = "<!-- benchmarks:begin: made by `python3 benchmarks/report.py readme`; do not edit -->"
 END = "<!-- benchmarks:end -->"
 STEPS = ["bake", "query", "accuracy-ao", "accuracy-intra-ao", "accuracy-shadows", "accuracy-reflections",
-         "scene", "triangles", "compression", "sdf", "gpu", "python", "library"]
+         "scene", "triangles", "compression", "sdf", "gpu", "python", "library", "three"]
 # Steps a results file may lack: the GPU bench (no headless OpenGL), the Python module (not built),
-# the distance field and the library bake (files from before they existed).
-OPTIONAL = ("gpu", "python", "sdf", "library")
+# the distance field and the library bake (files from before they existed), the three.js frame time
+# (no node, web/node_modules or chromium).
+OPTIONAL = ("gpu", "python", "sdf", "library", "three")
 # run.sh --only NAME: the steps it runs.
 ONLY = {"bake": ["bake"], "query": ["query"], "accuracy": [s for s in STEPS if s.startswith("accuracy-")],
         "scene": ["scene"], "triangles": ["triangles"], "compression": ["compression"], "gpu": ["gpu"],
-        "sdf": ["sdf"], "python": ["python"], "library": ["library"]}
+        "sdf": ["sdf"], "python": ["python"], "library": ["library"], "three": ["three"]}
 
 
 class ParseError(Exception):
@@ -297,7 +298,34 @@ def parse_sdf(text):
     return {"rays": int(head.group(1)), "threads": int(head.group(2)), "values": head.group(4), "rows": rows}
 
 
-PARSERS = {"sdf": parse_sdf, "library": parse_library, "bake": parse_bake, "scene": parse_scene, "triangles": parse_triangles, "query": parse_query,
+def parse_three(text):
+    """web/tools/bench-three.mjs: the renderer, the frame, and ms per frame of each effect."""
+    head = re.search(r"^three\.js frame time: (.*)$", text, re.M)
+    frame = re.search(r"^frame: (\d+)x(\d+), (\d+) AO rays and (\d+) shadow rays per pixel, (\d+) moving instances, "
+                      r"median of (\d+) frames$", text, re.M)
+    ratio = re.search(r"^field speed-up over exact \(exact ms / field ms\): ([0-9.]+)x$", text, re.M)
+    rows = [r for r in md_rows(text) if len(r) == 3 and r[0] != "effect"]
+    if not head or not frame or not ratio or len(rows) < 2:
+        raise ParseError("bench-three.mjs output lacks its renderer, frame or ratio line or its table")
+    return {"renderer": head.group(1), "width": int(frame.group(1)), "height": int(frame.group(2)),
+            "ao": int(frame.group(3)), "shadow": int(frame.group(4)), "instances": int(frame.group(5)),
+            "frames": int(frame.group(6)), "ratio": float(ratio.group(1)),
+            "rows": [{"effect": r[0], "ms": number(r[1]), "x": number(r[2])} for r in rows]}
+
+
+def three_table(t):
+    lines = ["| effect | ms/frame | / field |", "|---|---:|---:|"]
+    lines += [f"| {r['effect']} | {fmt(r['ms'], 1)} | {r['x']:.2f} |" for r in t["rows"]]
+    return lines + ["", f"The field's speed-up over the exact reference (exact ms / field ms): {t['ratio']:.2f}x."]
+
+
+def three_heading(t):
+    return (f"three.js frame time: the field effect against three-mesh-bvh's exact AO ({t['renderer']}; "
+            f"{t['width']}x{t['height']}, {t['ao']} AO and {t['shadow']} shadow rays per pixel, "
+            f"{t['instances']} moving instances)")
+
+
+PARSERS = {"three": parse_three, "sdf": parse_sdf, "library": parse_library, "bake": parse_bake, "scene": parse_scene, "triangles": parse_triangles, "query": parse_query,
            "compression": parse_compression, "gpu": parse_gpu, "python": parse_python}
 
 
@@ -582,6 +610,8 @@ def sections(machine, steps, heading, queries=None, only=None):
     if "library" in steps:
         out += [f"{heading} Library bake (vff-library against the same bakes one after another)", "",
                 *library_table(steps["library"]), ""]
+    if "three" in steps:
+        out += [f"{heading} {three_heading(steps['three'])}", "", *three_table(steps["three"]), ""]
     return out
 
 
@@ -691,7 +721,7 @@ def full_block(runs, newest, base):
              f"From {link(path, base)}: {machine['cpu']}, {machine['cores']} cores, commit {machine['commit']}, "
              f"{machine['mesh']}, field {machine['field']}; the query table has a row for each CPU on record. "
              "Figures differ between CPUs: `bash benchmarks/run.sh` measures yours.", ""]
-    main = sections(machine, {k: v for k, v in steps.items() if k != "sdf"}, "###", list(latest.values()),
+    main = sections(machine, {k: v for k, v in steps.items() if k not in ("sdf", "three")}, "###", list(latest.values()),
                     machine["field"])
     # The distance-field comparison: from the newest file that has it (a whole run, or --only sdf).
     with_sdf = [r for r in runs if "sdf" in r[2]]
@@ -704,6 +734,16 @@ def full_block(runs, newest, base):
                  f"{smachine['commit']}, {d['values']} values, {d['rays']} rays per set; command "
                  f"`{ssteps['sdf_cmd']}`. Speed above 1x: the field is faster; wrong answers: rays answered otherwise "
                  "than Embree.", "", *sdf_summary(d), ""]
+    # The three.js frame time: from the newest file that has it (a whole run, or --only three).
+    with_three = [r for r in runs if "three" in r[2]]
+    if with_three:
+        tpath, tmachine, tsteps = with_three[-1]
+        reduced = f" (`run.sh --only {tmachine['only']}`: a reduced run)" if tmachine.get("only") else ""
+        t = tsteps["three"]
+        main += [f"### {three_heading(t)}", "",
+                 f"From {link(tpath, base)}{reduced}: {tmachine['cpu']}, {tmachine['cores']} cores, commit "
+                 f"{tmachine['commit']}; the example scene (web/examples/contact-shadows), the same page, frame and "
+                 f"rays for each effect, median of {t['frames']} frames.", "", *three_table(t), ""]
     return "\n".join(lines + main + [END])
 
 
