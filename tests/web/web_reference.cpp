@@ -1,6 +1,6 @@
 // vff_web_reference FIELD OUT.pgm SIZE nearest|interpolated
 //
-// The CPU reference of web/'s reference view (web/src/scene.js, referenceView): ground ambient
+// The CPU reference of web/'s reference view (web/src/viewer/passes.js, referenceView): ground ambient
 // occlusion seen from straight above, the object unrotated. Pixel (x, y) of SIZE x SIZE looks at
 // the ground point (cx + (2 (x + 0.5) / SIZE - 1) 2R, cy - R, cz + (2 (y + 0.5) / SIZE - 1) 2R)
 // (the ground plane touches the bottom of the bounding sphere); its value is the mean, over the
@@ -18,9 +18,9 @@
 
 namespace {
 
-constexpr int kAoRays = 32;  // web/src/scene.js AO_RAYS
+constexpr int kAoRays = 32;  // web/src/viewer/passes.js REFERENCE_AO_RAYS
 
-// Direction i of the cosine-weighted hemisphere set around +y (web/src/scene.js aoDirection):
+// Direction i of the cosine-weighted hemisphere set around +y (web/src/viewer/passes.js aoDirection):
 // a spherical Fibonacci spiral, in binary32 as the shader computes it.
 vff::Vec3 aoDirection(int i) {
   const float u = (float(i) + 0.5f) / float(kAoRays);

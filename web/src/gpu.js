@@ -1,9 +1,6 @@
-// gpu.js - uploads a decoded .vff for the GLSL ES query: distance (and normal) slices as
-// TEXTURE_2D_ARRAY (or TEXTURE_3D) layers within the limits the context reports, the field block
-// and the positions table (spec/format.md 10.4).
-import { computeLayout, composeSlice } from './layout.js';
-import { buildQueryTables } from './query_tables.js';
-import { fieldSlices, positionsTexture } from './field_textures.js';
+// gpu.js - the WebGL2 limits a field's slices must fit, and the layout that fits them (the file's
+// own, or a repack: spec/format.md 10.4); field_textures.js and three-vff make the textures.
+import { computeLayout } from './layout.js';
 
 /** The limits of a WebGL2 context that a layout must respect. */
 export function contextLimits(gl) {
@@ -50,54 +47,3 @@ function texture(gl, is3d, fmt, width, height, layers, sliceData) {
   return t;
 }
 
-/**
- * Uploads a file. Returns {field: {defines, center, radius}, layout, note} or {error}.
- * bc4-diameter blocks are uploaded as they are (COMPRESSED_RED_RGTC1) when the context has
- * EXT_texture_compression_rgtc and options.bc4OnCpu is not set; otherwise they are decoded to unorm8
- * codes on the CPU and uploaded as R8UI, which every WebGL2 context has.
- */
-export function uploadField(gl, file, options = {}) {
-  const chosen = chooseLayout(file, contextLimits(gl));
-  if (chosen.error) return chosen;
-  const L = chosen.layout, fd = file.field, e = fd.distanceEncoding, M = fd.mapResolution;
-  const sl = fieldSlices(file, L);
-  const is3d = sl.is3d;
-  const FORMATS = {
-    r8ui: { internal: gl.R8UI, format: gl.RED_INTEGER, type: gl.UNSIGNED_BYTE },
-    r16ui: { internal: gl.R16UI, format: gl.RED_INTEGER, type: gl.UNSIGNED_SHORT },
-    rg16i: { internal: gl.RG16I, format: gl.RG_INTEGER, type: gl.SHORT },
-  };
-  const defines = [];
-  const rgtc = e === 5 && !options.bc4OnCpu ? gl.getExtension('EXT_texture_compression_rgtc') : null;
-  gl.activeTexture(gl.TEXTURE0);
-  if (rgtc) {
-    defines.push('VFF_MAPS_BC4');
-    const plane = { kind: 'bc4', texelBytes: 1, fill: 0xff, M, mapCount: fd.mapCount };
-    const t = gl.createTexture();
-    gl.bindTexture(gl.TEXTURE_2D_ARRAY, t);
-    gl.texParameteri(gl.TEXTURE_2D_ARRAY, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
-    gl.texParameteri(gl.TEXTURE_2D_ARRAY, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
-    gl.texStorage3D(gl.TEXTURE_2D_ARRAY, 1, rgtc.COMPRESSED_RED_RGTC1_EXT, L.sliceWidth, L.sliceHeight, L.sliceCount);
-    for (let s = 0; s < L.sliceCount; ++s)
-      gl.compressedTexSubImage3D(gl.TEXTURE_2D_ARRAY, 0, 0, 0, s, L.sliceWidth, L.sliceHeight, 1, rgtc.COMPRESSED_RED_RGTC1_EXT,
-        composeSlice(L, plane, s, (k) => file.mapBytes('distance', k)));
-  } else texture(gl, is3d, FORMATS[sl.maps.format], sl.maps.width, sl.maps.height, sl.maps.layers, sl.maps.slice);
-  defines.push(...sl.defines);
-  if (sl.normals) {
-    gl.activeTexture(gl.TEXTURE1);
-    texture(gl, is3d, FORMATS.rg16i, sl.normals.width, sl.normals.height, sl.normals.layers, sl.normals.slice);
-  }
-  const { block, table } = buildQueryTables(file, L);
-  const ubo = gl.createBuffer();
-  gl.bindBuffer(gl.UNIFORM_BUFFER, ubo);
-  gl.bufferData(gl.UNIFORM_BUFFER, block, gl.STATIC_DRAW);
-  gl.bindBufferBase(gl.UNIFORM_BUFFER, 0, ubo);
-  const pos = positionsTexture(table);
-  gl.activeTexture(gl.TEXTURE2);
-  const pt = gl.createTexture();
-  gl.bindTexture(gl.TEXTURE_2D, pt);
-  gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
-  gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
-  gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, pos.width, pos.height, 0, gl.RGBA, gl.FLOAT, pos.data);
-  return { field: { defines, center: fd.sphere.center, radius: fd.sphere.radius }, layout: L, note: chosen.note, bc4: rgtc ? 'gpu' : e === 5 ? 'cpu' : null };
-}
