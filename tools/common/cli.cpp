@@ -10,12 +10,14 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cinttypes>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <iostream>
 
 #include "vff/format.h"
@@ -353,6 +355,26 @@ Status AtomicFile::commit() {
     return writeError(path_, "cannot rename the temporary file into place");
   }
   return {};
+}
+
+bool endsWithNoCase(std::string_view s, std::string_view suffix) {
+  if (s.size() < suffix.size()) return false;
+  const size_t base = s.size() - suffix.size();
+  for (size_t i = 0; i < suffix.size(); ++i)
+    if (std::tolower(static_cast<unsigned char>(s[base + i])) != suffix[i]) return false;
+  return true;
+}
+
+bool isGltfInput(const std::string& path) {
+  if (path == "-") return false;
+  if (endsWithNoCase(path, ".gltf") || endsWithNoCase(path, ".glb")) return true;
+  // Only a regular file is peeked at: a FIFO's bytes would be consumed, and the .vff path reports
+  // why the others cannot be read.
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return false;
+  std::ifstream in(path, std::ios::binary);
+  char magic[4] = {};
+  return in.read(magic, 4) && std::memcmp(magic, "glTF", 4) == 0;
 }
 
 }  // namespace vff::cli

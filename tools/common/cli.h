@@ -163,4 +163,11 @@ class AtomicFile {
   int fd_ = -1;
 };
 
+// Whether s ends with suffix, ASCII letters compared without case (suffix in lower case).
+bool endsWithNoCase(std::string_view s, std::string_view suffix);
+
+// Whether `path` names a glTF asset: a name ending in .gltf or .glb (any case), or a regular file
+// that starts with the GLB magic "glTF" ("-" never: standard input is not peeked at).
+bool isGltfInput(const std::string& path);
+
 }  // namespace vff::cli

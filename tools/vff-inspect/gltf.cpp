@@ -7,11 +7,8 @@
 // (VFF_BUILD_BAKE=OFF) refuses glTF input as unsupported.
 #include <sys/stat.h>
 
-#include <cctype>
 #include <cerrno>
 #include <cinttypes>
-#include <cstring>
-#include <fstream>
 
 #include "cli.h"
 #include "inspect.h"
@@ -24,30 +21,6 @@
 namespace vff::inspect {
 
 using nlohmann::json;
-
-namespace {
-
-bool endsWithNoCase(const std::string& s, const char* suffix) {
-  const size_t n = std::strlen(suffix);
-  if (s.size() < n) return false;
-  for (size_t i = 0; i < n; ++i)
-    if (std::tolower(static_cast<unsigned char>(s[s.size() - n + i])) != suffix[i]) return false;
-  return true;
-}
-
-}  // namespace
-
-bool isGltfInput(const std::string& path) {
-  if (path == "-") return false;
-  if (endsWithNoCase(path, ".gltf") || endsWithNoCase(path, ".glb")) return true;
-  // Any other name: a GLB by its magic. Only a regular file is peeked at (a FIFO's bytes would be
-  // consumed, and the .vff path reports why the others cannot be read).
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return false;
-  std::ifstream in(path, std::ios::binary);
-  char magic[4] = {};
-  return in.read(magic, 4) && std::memcmp(magic, "glTF", 4) == 0;
-}
 
 #if !VFF_INSPECT_HAS_BAKE
 
@@ -218,8 +191,8 @@ void reportFirstError(const std::string& label, const GltfFieldsReport& r) {
 std::string stemOf(const std::string& path) {
   const size_t slash = path.find_last_of('/');
   std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
-  if (endsWithNoCase(name, ".glb")) name.resize(name.size() - 4);
-  else if (endsWithNoCase(name, ".gltf")) name.resize(name.size() - 5);
+  if (cli::endsWithNoCase(name, ".glb")) name.resize(name.size() - 4);
+  else if (cli::endsWithNoCase(name, ".gltf")) name.resize(name.size() - 5);
   return name;
 }
 

@@ -97,9 +97,7 @@ inline constexpr uint64_t kMaxPreviewPixels = uint64_t{1} << 26;
 Result<PreviewGeometry> writePreview(const File& file, const std::string& path, uint32_t maps);
 
 // ---- glTF assets (gltf.cpp) -----------------------------------------------------------------------
-// A glTF input: a name ending in .gltf or .glb (any case), or a regular file starting with the GLB
-// magic "glTF".
-bool isGltfInput(const std::string& path);
+// A glTF input: cli::isGltfInput.
 
 struct GltfInspectOptions {
   bool json = false;         // --format json

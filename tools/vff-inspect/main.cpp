@@ -53,7 +53,7 @@ void printDocument(const json& doc, cli::OutputFormat format) {
 // A glTF input is listed by gltf.cpp (its exit code); --extract is for nothing else. Nothing for
 // a .vff input, which run() goes on with.
 std::optional<int> inspectGltf(const CLI::App& app, const Options& o) {
-  if (!inspect::isGltfInput(o.input)) {
+  if (!cli::isGltfInput(o.input)) {
     if (!app.count("--extract")) return std::nullopt;
     cli::usageError(kProg, "--extract applies to a glTF input (.gltf, .glb), not to " +
                                (o.input == "-" ? std::string("standard input") : o.input));

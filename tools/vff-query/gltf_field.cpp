@@ -1,12 +1,6 @@
 // gltf_field.cpp - the payload of one mesh's field in a glTF asset (gltf_field.h).
 #include "gltf_field.h"
 
-#include <sys/stat.h>
-
-#include <cctype>
-#include <cstring>
-#include <fstream>
-
 #include "cli.h"
 
 #if VFF_QUERY_HAS_BAKE
@@ -19,26 +13,7 @@ namespace {
 
 constexpr const char* kProg = "vff-query";
 
-bool endsWithNoCase(const std::string& s, const char* suffix) {
-  const size_t n = std::strlen(suffix);
-  if (s.size() < n) return false;
-  for (size_t i = 0; i < n; ++i)
-    if (std::tolower(static_cast<unsigned char>(s[s.size() - n + i])) != suffix[i]) return false;
-  return true;
-}
-
 }  // namespace
-
-bool isGltfInput(const std::string& path) {
-  if (path == "-") return false;
-  if (endsWithNoCase(path, ".gltf") || endsWithNoCase(path, ".glb")) return true;
-  // Only a regular file is peeked at: a FIFO's bytes would be consumed (and is refused anyway).
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return false;
-  std::ifstream in(path, std::ios::binary);
-  char magic[4] = {};
-  return in.read(magic, 4) && std::memcmp(magic, "glTF", 4) == 0;
-}
 
 #if !VFF_QUERY_HAS_BAKE
 

@@ -9,8 +9,6 @@
 
 namespace vff::query_tool {
 
-// A name ending in .gltf or .glb (any case), or a regular file starting with the GLB magic "glTF".
-bool isGltfInput(const std::string& path);
 
 // The .vff bytes of mesh `mesh`'s field in the asset at `path` (mesh < 0: the asset's one field)
 // into *bytes, read and checked by the baker's reader (vff/bake/gltf_fields.h). Otherwise the exit

@@ -533,7 +533,7 @@ int run(int argc, char** argv) {
   // own (file_bytes.h), which the File and the query borrow.
   Stages at;
   at.open = Clock::now();
-  const bool gltf = isGltfInput(o.field);
+  const bool gltf = cli::isGltfInput(o.field);
   if (!gltf && o.mesh >= 0) {
     cli::usageError(kProg, "--mesh chooses a field of a glTF asset (.gltf, .glb), not of " + o.field);
     return cli::kExitUsage;
