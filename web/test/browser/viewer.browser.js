@@ -25,7 +25,7 @@ before(async () => {
   const blocks = openVff(bytes).planes.distance.blocks;
   assert.ok(blocks.length >= 2, 'the sample has two blocks');
   const bad = bytes.slice();
-  for (const b of blocks) bad[b.offset + 17] ^= 0x5a;
+  for (const b of blocks.slice(0, 2)) bad[b.offset + 17] ^= 0x5a;
   writeFileSync(join(WORK, 'two-bad-blocks.vff'), bad);
   extra['/two-bad-blocks.vff'] = join(WORK, 'two-bad-blocks.vff');
   srv = await serve(extra);
