@@ -129,7 +129,7 @@ export function fieldPass(field, body, uniforms = {}) {
       renderer.render(scene, camera);
       renderer.setRenderTarget(old);
     },
-    dispose() { material.dispose(); mesh.geometry.dispose(); },
+    dispose(keep = null) { if (keep) keep.push(material); else material.dispose(); mesh.geometry.dispose(); },
   };
 }
 
@@ -147,15 +147,17 @@ export function floatTarget(w, h, renderer) {
 
 /**
  * The object's lowest point (world y): the highest first hit of no upward ray lies below it. A grid
- * of `grid` x `grid` vertical rays over the sphere's footprint; null when every ray misses.
+ * of `grid` x `grid` vertical rays over the sphere's footprint; null when every ray misses. With
+ * `keep` (an array), the pass's material goes there instead of being disposed: its compiled program
+ * then serves the next field of the same schemes (see FieldView.clear).
  */
-export function lowestPoint(renderer, field, grid = 96) {
+export function lowestPoint(renderer, field, grid = 96, keep = null) {
   const pass = fieldPass(field, LOWEST, { uResolution: { value: new THREE.Vector2(grid, grid) } });
   const target = floatTarget(grid, grid, renderer);
   pass.run(renderer, target);
   const px = new Float32Array(grid * grid * 4);
   renderer.readRenderTargetPixels(target, 0, 0, grid, grid, px);
-  pass.dispose(); target.dispose();
+  pass.dispose(keep); target.dispose();
   let low = Infinity, hits = 0;
   for (let i = 0; i < px.length; i += 4) if (px[i + 1] > 0.5) { ++hits; low = Math.min(low, px[i]); }
   return hits ? { y: low, hits, rays: grid * grid } : null;

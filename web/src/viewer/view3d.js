@@ -59,6 +59,8 @@ export class FieldView {
     this.raf = 0;
     this.field = null;
     this.targets = [];
+    this.kept = [];     // this field's pass materials, retired with it
+    this.retired = [];  // the previous field's materials, disposed once this field has drawn
     canvas.addEventListener('keydown', (e) => this.key(e));
     this.resizeObserver = new ResizeObserver(() => this.resize());
     this.resizeObserver.observe(container);
@@ -83,7 +85,7 @@ export class FieldView {
     this.clear();
     this.field = field;
     const c = field.center, R = field.radius;
-    const low = lowestPoint(this.renderer, field);
+    const low = lowestPoint(this.renderer, field, 96, this.kept);
     this.groundY = low ? low.y : c.y - R;
     this.lowest = low;
     this.impostor = createVffImpostor(field, { interpolated: this.options.interpolated });
@@ -126,10 +128,17 @@ export class FieldView {
     return (1.15 * this.field.radius) / Math.sin(Math.min(v, h) / 2);
   }
 
-  /** Removes the field's object and ground: the empty view. */
+  /**
+   * Removes the field's object and ground: the empty view. Its materials are retired, not disposed,
+   * until the next field has drawn a frame: three.js shares a compiled program among live materials
+   * of the same source, so a next field of the same schemes and encodings (sizes are uniforms)
+   * compiles nothing, where shader compiles are the slowest step of opening a file.
+   */
   clear() {
-    for (const o of [this.impostor, this.ground, this.grid]) if (o) { this.scene.remove(o); o.geometry.dispose(); o.material.dispose(); }
-    this.accumulate?.dispose();
+    for (const o of [this.impostor, this.ground, this.grid]) if (o) { this.scene.remove(o); o.geometry.dispose(); this.retired.push(o.material); }
+    this.accumulate?.dispose(this.retired);
+    this.retired.push(...this.kept);
+    this.kept = [];
     this.field?.dispose();
     this.impostor = this.ground = this.grid = this.accumulate = this.field = null;
     this.invalidate();
@@ -204,6 +213,10 @@ export class FieldView {
     if (this.impostor) this.impostor.visible = o.show === 0;
     this.renderer.setRenderTarget(null);
     this.renderer.render(this.scene, this.camera);
+    if (this.field && this.retired.length) {
+      for (const m of this.retired) m.dispose();
+      this.retired = [];
+    }
     const ms = performance.now() - t0;
     this.onFrame({ frame: this.frame, maxFrames: o.maxFrames, ms });
     if (this.field && this.frame < o.maxFrames) this.request();
