@@ -110,7 +110,7 @@ test('files the tools write open and render in the page', async () => {
     const bytes = readFileSync(path);
     results[name] = await page.evaluate(async (b64) => {
       const bytes = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
-      window.vffViewer.view.setOptions({ maxFrames: 1, interpolated: true });
+      window.vffViewer.view.setOptions({ maxFrames: 0, interpolated: true });  // the object; accumulation is the test above's
       const r = await window.vffViewer.loadBytes(bytes, 'f.vff');
       window.vffViewer.redraw();
       const gl = window.vffViewer.view.renderer.getContext();
