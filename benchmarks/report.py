@@ -723,28 +723,33 @@ def full_block(runs, newest, base):
              "Figures differ between CPUs: `bash benchmarks/run.sh` measures yours.", ""]
     main = sections(machine, {k: v for k, v in steps.items() if k not in ("sdf", "three")}, "###", list(latest.values()),
                     machine["field"])
-    # The distance-field comparison: from the newest file that has it (a whole run, or --only sdf).
-    with_sdf = [r for r in runs if "sdf" in r[2]]
-    if with_sdf:
-        spath, smachine, ssteps = with_sdf[-1]
-        reduced = f" (`run.sh --only {smachine['only']}`: a reduced run)" if smachine.get("only") else ""
+    # The distance-field comparison and the three.js frame time: each from the newest file that has it
+    # (a whole run, or --only sdf / --only three).
+    ssteps, source = newest_with(runs, "sdf", base)
+    if ssteps:
         d = ssteps["sdf"]
         main += [f"### Field against a signed distance field at equal memory per object", "",
-                 f"From {link(spath, base)}{reduced}: {smachine['cpu']}, {smachine['cores']} cores, commit "
-                 f"{smachine['commit']}, {d['values']} values, {d['rays']} rays per set; command "
+                 f"{source}, {d['values']} values, {d['rays']} rays per set; command "
                  f"`{ssteps['sdf_cmd']}`. Speed above 1x: the field is faster; wrong answers: rays answered otherwise "
                  "than Embree.", "", *sdf_summary(d), ""]
-    # The three.js frame time: from the newest file that has it (a whole run, or --only three).
-    with_three = [r for r in runs if "three" in r[2]]
-    if with_three:
-        tpath, tmachine, tsteps = with_three[-1]
-        reduced = f" (`run.sh --only {tmachine['only']}`: a reduced run)" if tmachine.get("only") else ""
+    tsteps, source = newest_with(runs, "three", base)
+    if tsteps:
         t = tsteps["three"]
         main += [f"### {three_heading(t)}", "",
-                 f"From {link(tpath, base)}{reduced}: {tmachine['cpu']}, {tmachine['cores']} cores, commit "
-                 f"{tmachine['commit']}; the example scene (web/examples/contact-shadows), the same page, frame and "
+                 f"{source}; the example scene (web/examples/contact-shadows), the same page, frame and "
                  f"rays for each effect, median of {t['frames']} frames.", "", *three_table(t), ""]
     return "\n".join(lines + main + [END])
+
+
+def newest_with(runs, step, base):
+    """The steps of the newest run that has `step`, and the words naming it ("From <file> (a reduced
+    run): CPU, cores, commit"); (None, None) when no run has it."""
+    have = [r for r in runs if step in r[2]]
+    if not have:
+        return None, None
+    path, machine, steps = have[-1]
+    reduced = f" (`run.sh --only {machine['only']}`: a reduced run)" if machine.get("only") else ""
+    return steps, f"From {link(path, base)}{reduced}: {machine['cpu']}, {machine['cores']} cores, commit {machine['commit']}"
 
 
 def sdf_headline_row(machine, d):
