@@ -9,13 +9,11 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
 import { join } from 'node:path';
-import { serve, launch } from '../../../test/browser/harness.js';
-import { BAKE, MESHGEN, SKIP, scratch, compare } from '../tools.js';
+import { BAKE, MESHGEN, SKIP, scratch, compare, openTestPage } from '../tools.js';
 
 const RECEIVER = 4095;   // occlusion.js's id of a receiving surface that is no instance: the floor
 const FRAMES = 10;
-let srv, browser, page;
-const errors = [];
+let session, page, errors = [];
 
 before(async () => {
   if (SKIP) return;
@@ -25,16 +23,11 @@ before(async () => {
   execFileSync(BAKE, [obj, '-o', vff, '-n', '16', '-m', '32'], { stdio: 'ignore' });
   const vff2 = join(dir, 'knot-8.vff');
   execFileSync(BAKE, [obj, '-o', vff2, '-n', '8', '-m', '16'], { stdio: 'ignore' });
-  srv = await serve({ '/knot.obj': obj, '/knot.vff': vff, '/knot-8.vff': vff2 });
-  browser = await launch();
-  page = await browser.newPage();
-  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
-  page.on('pageerror', (e) => errors.push(String(e)));
-  await page.goto(`${srv.url}/three-vff/test/browser/occlusion.html`);
-  await page.waitForFunction(() => window.ready === true);
+  session = await openTestPage({ '/knot.obj': obj, '/knot.vff': vff, '/knot-8.vff': vff2 });
+  ({ page, errors } = session);
   await page.evaluate(() => window.setup('/knot.obj', '/knot.vff', { aoRange: 1, aoRays: 4, shadowRays: 2 }));
 });
-after(async () => { await browser?.close(); srv?.server.close(); });
+after(async () => { await session?.close(); });
 
 test('field AO on the floor matches the three-mesh-bvh reference of the same rays', { skip: SKIP || false }, async () => {
   const f = await page.evaluate((n) => window.run('field', n), FRAMES);

@@ -6,11 +6,9 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
 import { join } from 'node:path';
-import { serve, launch } from '../../../test/browser/harness.js';
-import { BAKE, MESHGEN, SKIP, scratch } from '../tools.js';
+import { BAKE, MESHGEN, SKIP, scratch, openTestPage } from '../tools.js';
 
-let srv, browser, page;
-const errors = [];
+let session, page, errors = [];
 
 before(async () => {
   if (SKIP) return;
@@ -18,15 +16,10 @@ before(async () => {
   const scene = join(dir, 's.gltf'), glb = join(dir, 's.glb');
   execFileSync(MESHGEN, ['--gltf-scene', scene], { stdio: 'ignore' });
   execFileSync(BAKE, [scene, '-o', glb, '-n', '2', '-m', '8'], { stdio: 'ignore' });
-  srv = await serve({ '/s.glb': glb });
-  browser = await launch();
-  page = await browser.newPage();
-  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
-  page.on('pageerror', (e) => errors.push(String(e)));
-  await page.goto(`${srv.url}/three-vff/test/browser/occlusion.html`);
-  await page.waitForFunction(() => window.ready === true);
+  session = await openTestPage({ '/s.glb': glb });
+  ({ page, errors } = session);
 });
-after(async () => { await browser?.close(); srv?.server.close(); });
+after(async () => { await session?.close(); });
 
 test('VffGLTFPlugin: fields found, problems reported, userData.vffField set', { skip: SKIP || false }, async () => {
   const r = await page.evaluate(() => window.loadGlb('/s.glb'));

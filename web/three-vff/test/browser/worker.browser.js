@@ -5,27 +5,20 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { join } from 'node:path';
-import { serve, launch } from '../../../test/browser/harness.js';
-import { ROOT } from '../tools.js';
+import { ROOT, openTestPage } from '../tools.js';
 
 const CONF = join(ROOT, 'spec', 'conformance');
-let srv, browser, page;
-const errors = [];
+let session, page, errors = [];
 
 before(async () => {
-  srv = await serve({
+  session = await openTestPage({
     '/a.vff': join(CONF, 'valid', 'u8d-zstd-normals-meta.vff'),
     '/b.vff': join(CONF, 'valid', 'bit1-zstd-normals-meta-3d.vff'),
     '/bad.vff': join(CONF, 'invalid', '2001', 'header-63-bytes.vff'),
   });
-  browser = await launch();
-  page = await browser.newPage();
-  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
-  page.on('pageerror', (e) => errors.push(String(e)));
-  await page.goto(`${srv.url}/three-vff/test/browser/occlusion.html`);
-  await page.waitForFunction(() => window.ready === true);
+  ({ page, errors } = session);
 });
-after(async () => { await browser?.close(); srv?.server.close(); });
+after(async () => { await session?.close(); });
 
 test('decodeInWorker: the same field as fromBytes, progress, errors', async () => {
   for (const url of ['/a.vff', '/b.vff']) {
