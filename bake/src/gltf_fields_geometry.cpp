@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "gltf_fields_glb.h"
+#include "gltf_matrix.h"
 #include "mesh_importers.h"
 #include "vff/bake/mesh.h"
 
@@ -15,20 +16,7 @@ namespace vff::bake {
 namespace detail {
 namespace {
 
-using Mat4 = std::array<double, 16>;  // column-major, as glTF stores it
-
-Mat4 identity() { return {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}; }
-
-Mat4 mul(const Mat4& a, const Mat4& b) {
-  Mat4 r{};
-  for (int c = 0; c < 4; ++c)
-    for (int rr = 0; rr < 4; ++rr) {
-      double s = 0;
-      for (int k = 0; k < 4; ++k) s += a[size_t(k * 4 + rr)] * b[size_t(c * 4 + k)];
-      r[size_t(c * 4 + rr)] = s;
-    }
-  return r;
-}
+using Mat4 = GltfMatrix;
 
 // The numbers of a JSON array of `n` numbers, or nothing.
 bool numbers(const nlohmann::json& node, const char* key, size_t n, double* out) {
@@ -42,40 +30,13 @@ bool numbers(const nlohmann::json& node, const char* key, size_t n, double* out)
 }
 
 Mat4 nodeMatrix(const nlohmann::json& n) {
-  Mat4 m = identity();
+  Mat4 m = gltfIdentity();
   if (numbers(n, "matrix", 16, m.data())) return m;
   double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
   numbers(n, "translation", 3, t);
   numbers(n, "rotation", 4, q);
   numbers(n, "scale", 3, s);
-  const double x = q[0], y = q[1], z = q[2], w = q[3];
-  const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w),     2 * (x * z - y * w),
-                       2 * (x * y - z * w),     1 - 2 * (x * x + z * z), 2 * (y * z + x * w),
-                       2 * (x * z + y * w),     2 * (y * z - x * w),     1 - 2 * (x * x + y * y)};
-  for (int c = 0; c < 3; ++c)
-    for (int rr = 0; rr < 3; ++rr) m[size_t(c * 4 + rr)] = r[c * 3 + rr] * s[c];
-  m[12] = t[0];
-  m[13] = t[1];
-  m[14] = t[2];
-  return m;
-}
-
-// Why a node's world matrix cannot place a field, or "" when it is a similarity (as vff-bake's
-// scene split decides: a positive uniform scale times a rotation, within float precision).
-std::string notSimilarity(const Mat4& m) {
-  const double a[3][3] = {{m[0], m[4], m[8]}, {m[1], m[5], m[9]}, {m[2], m[6], m[10]}};
-  const double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
-                     a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
-  if (det < 0) return "mirror";
-  if (!(det > 0)) return "non-uniform scale";
-  const double s = std::cbrt(det);
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      double dot = 0;
-      for (int k = 0; k < 3; ++k) dot += a[k][i] * a[k][j];
-      if (std::fabs(dot - (i == j ? s * s : 0.0)) > 1e-5 * s * s) return "non-uniform scale";
-    }
-  return "";
+  return gltfTrs(t, q, s);
 }
 
 // A mesh with morph targets whose weights (the node's, else the mesh's; zero when absent) are not
@@ -103,7 +64,7 @@ int intMember(const nlohmann::json& o, const char* key) {
 }  // namespace
 
 Result<GltfMeshGeometry> meshGeometry(const tinygltf::Model& model, const std::string& path, int mesh) {
-  auto m = importGltfMeshes(model, path, {{mesh, identity(), /*skipNonTriangles=*/true}});
+  auto m = importGltfMeshes(model, path, {{mesh, gltfIdentity(), /*skipNonTriangles=*/true}});
   if (!m) return std::move(m).error();
   const std::string name = size_t(mesh) < model.meshes.size() ? model.meshes[size_t(mesh)].name : "";
   if (Status s = checkMesh(&*m, path + ": mesh " + std::to_string(mesh) + (name.empty() ? "" : " '" + name + "'")); !s)
@@ -149,13 +110,13 @@ std::vector<std::vector<GltfFieldNode>> meshInstances(const nlohmann::json& doc)
     int depth;
   };
   std::vector<Frame> stack;
-  for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, identity(), 0});
+  for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, gltfIdentity(), 0});
   while (!stack.empty()) {
     const Frame f = stack.back();
     stack.pop_back();
     if (f.node < 0 || size_t(f.node) >= nodes.size() || f.depth > 64 || !nodes[size_t(f.node)].is_object()) continue;
     const nlohmann::json& n = nodes[size_t(f.node)];
-    const Mat4 world = mul(f.parent, nodeMatrix(n));
+    const Mat4 world = gltfMul(f.parent, nodeMatrix(n));
     const int mesh = intMember(n, "mesh");
     if (mesh >= 0 && size_t(mesh) < meshes.size()) {
       GltfFieldNode fn;
@@ -163,7 +124,7 @@ std::vector<std::vector<GltfFieldNode>> meshInstances(const nlohmann::json& doc)
       if (n.contains("name") && n["name"].is_string()) fn.name = n["name"].get<std::string>();
       if (n.contains("skin")) fn.reason = "skin";
       else if (morphed(meshes[size_t(mesh)], n)) fn.reason = "morph targets";
-      else fn.reason = notSimilarity(world);
+      else fn.reason = gltfNotSimilarity(world);
       fn.answered = fn.reason.empty();
       out[size_t(mesh)].push_back(std::move(fn));
     }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <map>
 
+#include "gltf_matrix.h"
 #include "mesh_importers.h"
 #include "vff/bake/gltf.h"
 #include "vff/scene_description.h"
@@ -16,44 +17,17 @@ namespace {
 
 using Mat4 = GltfMatrix;
 
-Mat4 identity() { return {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}; }
-
-Mat4 mul(const Mat4& a, const Mat4& b) {
-  Mat4 r{};
-  for (int c = 0; c < 4; ++c)
-    for (int rr = 0; rr < 4; ++rr) {
-      double s = 0;
-      for (int k = 0; k < 4; ++k) s += a[size_t(k * 4 + rr)] * b[size_t(c * 4 + k)];
-      r[size_t(c * 4 + rr)] = s;
-    }
-  return r;
-}
-
 Mat4 nodeMatrix(const tinygltf::Node& n) {
+  Mat4 m;
   if (n.matrix.size() == 16) {
-    Mat4 m;
     std::copy(n.matrix.begin(), n.matrix.end(), m.begin());
     return m;
   }
-  Mat4 t = identity(), r = identity(), s = identity();
-  if (n.translation.size() == 3) {
-    t[12] = n.translation[0];
-    t[13] = n.translation[1];
-    t[14] = n.translation[2];
-  }
-  if (n.rotation.size() == 4) {
-    const double x = n.rotation[0], y = n.rotation[1], z = n.rotation[2], w = n.rotation[3];
-    r = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w),     2 * (x * z - y * w),     0,
-         2 * (x * y - z * w),     1 - 2 * (x * x + z * z), 2 * (y * z + x * w),     0,
-         2 * (x * z + y * w),     2 * (y * z - x * w),     1 - 2 * (x * x + y * y), 0,
-         0,                       0,                       0,                       1};
-  }
-  if (n.scale.size() == 3) {
-    s[0] = n.scale[0];
-    s[5] = n.scale[1];
-    s[10] = n.scale[2];
-  }
-  return mul(t, mul(r, s));
+  double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
+  if (n.translation.size() == 3) std::copy(n.translation.begin(), n.translation.end(), t);
+  if (n.rotation.size() == 4) std::copy(n.rotation.begin(), n.rotation.end(), q);
+  if (n.scale.size() == 3) std::copy(n.scale.begin(), n.scale.end(), s);
+  return gltfTrs(t, q, s);
 }
 
 // A node that has a mesh, with its world matrix.
@@ -67,7 +41,7 @@ struct NodeMesh {
 Result<std::vector<NodeMesh>> sceneMeshes(const tinygltf::Model& model, const std::string& path, int sceneIndex) {
   std::vector<NodeMesh> out;
   if (sceneIndex < 0) {
-    for (size_t m = 0; m < model.meshes.size(); ++m) out.push_back({-1, int(m), identity()});
+    for (size_t m = 0; m < model.meshes.size(); ++m) out.push_back({-1, int(m), gltfIdentity()});
     return out;
   }
   struct Frame {
@@ -77,7 +51,7 @@ Result<std::vector<NodeMesh>> sceneMeshes(const tinygltf::Model& model, const st
   };
   std::vector<Frame> stack;
   const auto& roots = model.scenes[size_t(sceneIndex)].nodes;
-  for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, identity(), 0});
+  for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, gltfIdentity(), 0});
   while (!stack.empty()) {
     const Frame f = stack.back();
     stack.pop_back();
@@ -85,7 +59,7 @@ Result<std::vector<NodeMesh>> sceneMeshes(const tinygltf::Model& model, const st
       return makeError(Code::kMeshIndex, path + ": node index " + std::to_string(f.node) + " out of range");
     if (f.depth > 64) return makeError(Code::kMeshParse, path + ": node hierarchy deeper than 64 (a cycle?)");
     const tinygltf::Node& n = model.nodes[size_t(f.node)];
-    const Mat4 world = mul(f.parent, nodeMatrix(n));
+    const Mat4 world = gltfMul(f.parent, nodeMatrix(n));
     if (n.mesh >= 0) {
       if (size_t(n.mesh) >= model.meshes.size())
         return makeError(Code::kMeshIndex, path + ": node " + std::to_string(f.node) + " references a missing mesh");
@@ -155,17 +129,9 @@ bool isGlb(const std::string& path) {
 // The world matrix as translation * similarity, when its linear part is one: a positive uniform
 // scale times a rotation, within float precision.
 bool similarity(const Mat4& m, GltfPlacement* p) {
+  double s = 0;
+  if (!gltfNotSimilarity(m, &s).empty()) return false;
   const double a[3][3] = {{m[0], m[4], m[8]}, {m[1], m[5], m[9]}, {m[2], m[6], m[10]}};
-  const double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
-                     a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
-  if (!(det > 0)) return false;
-  const double s = std::cbrt(det);
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      double dot = 0;  // (A^T A)_ij
-      for (int k = 0; k < 3; ++k) dot += a[k][i] * a[k][j];
-      if (std::fabs(dot - (i == j ? s * s : 0.0)) > 1e-5 * s * s) return false;
-    }
   float r[3][3];
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) r[i][j] = float(a[i][j] / s);
@@ -212,14 +178,14 @@ Result<std::vector<GltfObject>> loadGltfObjects(const std::string& path, const G
     place.node = n.node;
     if (n.node >= 0) place.name = (*model)->nodes[size_t(n.node)].name;
     const bool similar = detail::similarity(n.world, &place);
-    detail::GltfMatrix bakedMatrix = detail::identity();
+    detail::GltfMatrix bakedMatrix = detail::gltfIdentity();
     if (!similar) {  // the linear part goes into the geometry, the translation into the placement
       bakedMatrix = n.world;
       bakedMatrix[12] = bakedMatrix[13] = bakedMatrix[14] = 0;
       place.translation = {float(n.world[12]), float(n.world[13]), float(n.world[14])};
     }
     const bool ownFrame = options.split == GltfSplit::kMesh && options.ownFrame;
-    if (ownFrame && !similar) bakedMatrix = detail::identity();
+    if (ownFrame && !similar) bakedMatrix = detail::gltfIdentity();
     const bool shared = options.split == GltfSplit::kMesh && (similar || ownFrame);
     if (shared && sharedObject.count(n.mesh)) {
       if (similar) objects[sharedObject[n.mesh]].placements.push_back(place);
