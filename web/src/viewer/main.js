@@ -183,6 +183,7 @@ document.body.addEventListener('drop', (e) => {
 });
 $('sample').addEventListener('change', (e) => { if (e.target.value) loadUrl(e.target.value); });
 $('interp').addEventListener('change', (e) => view.setOptions({ interpolated: e.target.checked }));
+view.setOptions({ interpolated: $('interp').checked });  // a browser may restore the box's state on reload
 $('show').addEventListener('change', (e) => {
   view.setOptions({ show: Number(e.target.value) });
   $('ao-legend-title').textContent = ['Ground: lit colour × (AO and shadow)', 'Ground AO', 'Ground light (soft shadow)'][Number(e.target.value)];

@@ -54,7 +54,7 @@ export class FieldView {
     this.controls.enableDamping = false;
     this.controls.maxPolarAngle = Math.PI / 2 - 0.02;  // never below the ground
     this.controls.addEventListener('change', () => this.invalidate());
-    this.options = { interpolated: false, show: 0, aoRaysPerFrame: 2, shadowRaysPerFrame: 1, maxFrames: 64, lightAzimuth: -0.8, lightElevation: 0.9, lightAngle: 0.12 };
+    this.options = { interpolated: true, show: 0, aoRaysPerFrame: 2, shadowRaysPerFrame: 1, maxFrames: 64, lightAzimuth: -0.8, lightElevation: 0.9, lightAngle: 0.12 };
     this.frame = 0;
     this.raf = 0;
     this.field = null;

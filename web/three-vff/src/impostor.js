@@ -28,6 +28,9 @@ uniform vec3 uGroundBounce;   // ambient from below
 uniform bool uInterpolated;
 uniform bool uSelfShadow;
 uniform float uRadius;       // the field's sphere radius (object space)
+// How far (in radii) a self-shadow ray starts off the surface: past the intra-object test's error
+// near its origin, which otherwise darkens whole sampling cells (acne).
+const float VFF_SHADOW_LIFT = 0.05;
 in vec3 vWorld;
 out highp vec4 fragColor;
 
@@ -55,7 +58,10 @@ void main() {
   float lit = max(dot(n, uLight), 0.0);
   if (uSelfShadow && lit > 0.0) {
     vec3 lObj = normalize(mat3(uWorldToObject) * uLight);
-    if (vffOccluded(pObj, lObj, 0.0, 1e30, -1.0)) lit = 0.0;
+    // The intra-object test (section 7.3) from a point lifted off the hit along its normal: from
+    // the hit point itself, the sampling's error shades whole cells of the surface (acne).
+    vec3 pLift = pObj + normalize(mat3(uWorldToObject) * n) * (VFF_SHADOW_LIFT * uRadius);
+    if (vffOccluded(pLift, lObj, 0.0, 1e30, -1.0)) lit = 0.0;
   }
   vec3 ambient = mix(uGroundBounce, uSky, 0.5 + 0.5 * n.y);
   vec3 col = uColor * (0.8 * ambient + 0.6 * lit);
