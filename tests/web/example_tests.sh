@@ -85,5 +85,29 @@ test_browser_missing() {
   VFF_WORK="$WORK" node_test "$WEB/examples/test/missing.browser.js"
 }
 
+# tools/shot-example.mjs: a picture of the example's page, whole (a PNG of the asked size) after the
+# asked frames; a bad option is exit 1, a missing asset exit 2, and neither writes a file.
+test_shot_example() {
+  need_chromium
+  need_gltf
+  need_bake_scene
+  run node "$WEB/tools/make-example.mjs" --bake "$VFF_BAKE" --procedural "$VFF_PROCEDURAL_MESH" \
+    --meshes "${VFF_SHARED_MESHES:-/nonexistent}" --out "$WORK/a"
+  expect_rc 0
+  run node "$WEB/tools/shot-example.mjs" --asset "$WORK/a/example.glb" --out "$WORK/a.png" --size 200x120 --frames 2
+  expect_rc 0
+  expect_out "a.png: 200x120, 3 frames of 4 AO and 4 shadow rays a pixel accumulated (field)"
+  [[ $(head -c 8 "$WORK/a.png" | od -An -tx1 | tr -d ' \n') == 89504e470d0a1a0a ]] || fail "not a PNG"
+  [[ $(od -An -tu1 -j16 -N8 "$WORK/a.png" | tr -s ' ' | sed 's/^ //') == "0 0 0 200 0 0 0 120" ]] || fail "not 200 x 120"
+  [[ ! -e $WORK/a.png.tmp ]] || fail "a temporary file was left"
+  run node "$WEB/tools/shot-example.mjs" --asset "$WORK/a/example.glb" --out "$WORK/b.png" --mode wrong
+  expect_rc 1
+  expect_err "usage:"
+  run node "$WEB/tools/shot-example.mjs" --asset "$WORK/none.glb" --out "$WORK/b.png"
+  expect_rc 2
+  expect_err "none.glb: no such file"
+  [[ ! -e $WORK/b.png ]] || fail "a failed run wrote $WORK/b.png"
+}
+
 # (test_* functions go above this line)
 run_test "$1"
