@@ -280,6 +280,7 @@ struct Options {
   bool sdf = true;
   SdfValues sdfValues = SdfValues::kFp8;
   float sdfBand = SdfBuildOptions{}.bandVoxels;
+  bool sdfUnsure = false;  // sdf-bench --unsure
   // scene
   std::vector<std::string> objects;  // meshes besides --mesh (none: four procedural shapes)
 };

@@ -88,6 +88,9 @@ int main(int argc, char** argv) {
                  "nearest payload; --config instead names them)")
       ->capture_default_str()
       ->check(CLI::Range(0.01, 4096.0));
+  app.add_flag("--unsure", o.sdfUnsure, "sdf-bench: a second table, where the field's wrong answers lie: on the rays "
+               "whose interpolated visibility is strictly between 0 and 1 (the samples around the ray disagree), or on "
+               "the rest");
   app.add_option("--instances", o.instanceCounts, "scene-bench: instance counts (one table row each)")
       ->capture_default_str()
       ->check(CLI::Range(1u, 1u << 20));

@@ -139,6 +139,21 @@ case "$case" in
     awk -F'|' '/^\| (knot|bowl)\.obj/ { if ($7 + 0 <= 0 || $8 + 0 <= 0 || $9 + 0 <= 0 || $11 + 0 >= 50 || $12 + 0 >= 50) bad = 1 }
                END { exit bad }' stdout.txt || { cat stdout.txt; fail "sdf-bench: implausible figures"; }
     ;;
+  sdf_bench_unsure_splits_the_wrong_answers)
+    # --unsure: a second table, a row per main row; the field's wrong answers on the unsure rays and
+    # on the rest add up to its wrong answers of the main table, and the SDF's agree with it.
+    "$exp" sdf-bench --mesh knot.obj --config 290x16x16 --bench-rays 5000 --repeat 1 -j 2 --unsure \
+      >stdout.txt 2>stderr.txt || { cat stderr.txt; fail "sdf-bench --unsure failed"; }
+    grep -q "^| mesh | field | memory MiB | ray set | unsure rays | field wrong, of the unsure |" stdout.txt \
+      || { cat stdout.txt; fail "no table of unsure rays"; }
+    awk -F'|' '
+      function n(x) { gsub(/[ %]/, "", x); return x + 0 }
+      /^\| knot\.obj/ && NF == 13 { fw[$6] = n($11); sw[$6] = n($12); ++main }
+      /^\| knot\.obj/ && NF == 12 { u = n($6); split_ = u * n($7) / 100 + n($9); ++rows
+        if (u <= 0 || u >= 100 || n($11) <= 0) bad = 1
+        if (split_ - fw[$5] > 0.02 || fw[$5] - split_ > 0.02 || n($10) != sw[$5]) bad = 1 }
+      END { exit bad || main != 2 || rows != 2 }' stdout.txt || { cat stdout.txt; fail "the unsure table does not add up to the main one"; }
+    ;;
   small_fields_leave_out_the_distance_field)
     # A field under kSdfMinBudget (sdf_field.h) has no distance field beside it: the image
     # experiments and `scene` leave the distance-field rows out with a note and finish; scene-bench
