@@ -139,6 +139,9 @@ export class FieldView {
     this.accumulate?.dispose(this.retired);
     this.retired.push(...this.kept);
     this.kept = [];
+    // A retired material is never drawn again: its textures go, so that the old field's data is not
+    // held while the next file loads (or after it fails).
+    for (const m of this.retired) for (const u of Object.values(m.uniforms ?? {})) if (u.value?.isTexture) u.value = null;
     this.field?.dispose();
     this.impostor = this.ground = this.grid = this.accumulate = this.field = null;
     this.invalidate();
