@@ -200,8 +200,10 @@ for (const [width, height, dpr] of [[1280, 800, 1], [390, 844, 1], [390, 844, 2]
     // A resize follows the container (ResizeObserver), without reloading.
     await page.setViewportSize({ width: Math.round(width * 0.8), height });
     await page.waitForFunction((w) => document.getElementById('view').width !== w, r.buffer[0]);
-    const after = await page.evaluate(() => [document.getElementById('view').width, document.getElementById('view').getBoundingClientRect().width]);
+    const after = await page.evaluate(() => [document.getElementById('view').width, document.getElementById('view').getBoundingClientRect().width,
+      document.documentElement.scrollWidth, window.innerWidth]);
     assert.equal(after[0], Math.floor(after[1]) * dpr);
+    assert.ok(after[2] <= after[3], `after the resize the page is ${after[2]} px wide in ${after[3]}`);
     if (width === 1280 && dpr === 1) await page.screenshot({ path: join(WORK, 'viewer-1280.png') });
     if (width === 390 && dpr === 2) await page.screenshot({ path: join(WORK, 'viewer-390.png'), fullPage: true });
     assert.deepEqual(errors, []);
