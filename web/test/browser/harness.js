@@ -1,12 +1,24 @@
 // harness.js - a static server for web/ (and named extra files) and headless Debian chromium with
 // WebGL2 on SwiftShader, driven by playwright-core (the research note's recipe).
 import { createServer } from 'node:http';
+import { existsSync } from 'node:fs';
 import { readFile } from 'node:fs/promises';
 import { join, extname, normalize } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
 
 export const WEB = fileURLToPath(new URL('../../', import.meta.url));
+
+/**
+ * A program of the project's build: the environment variable `env` when set (ctest sets it), else
+ * `rel` under the default build folder of the checkout when built there, else '' (the caller skips,
+ * saying why).
+ */
+export function builtTool(env, rel) {
+  if (process.env[env]) return process.env[env];
+  const path = join(WEB, '..', 'build', rel);
+  return existsSync(path) ? path : '';
+}
 const TYPES = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript', '.json': 'application/json', '.wasm': 'application/wasm' };
 
 /**

@@ -2,15 +2,22 @@
 // reference view, ground AO seen from above with fixed rays, matches the C++ render of the same view
 // (tests/web/web_reference.cpp, libvff's FieldQuery) within TOLERANCE; a screenshot of the page
 // (AO accumulated over frames) is kept in $VFF_WORK/web-viewer.png.
-// Needs VFF_BAKE (vff-bake) and VFF_WEB_REFERENCE (vff_web_reference); VFF_WORK: scratch folder.
+// Needs vff-bake and vff_web_reference (VFF_BAKE, VFF_WEB_REFERENCE, else the default build folder)
+// and glmark2's bunny, each case skipping with the reason otherwise; VFF_WORK: scratch folder.
 import { test, after, before } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { readFileSync, mkdirSync } from 'node:fs';
+import { readFileSync, mkdirSync, existsSync } from 'node:fs';
 import { join } from 'node:path';
-import { serve, launch } from './harness.js';
+import { serve, launch, builtTool } from './harness.js';
 
 const WORK = process.env.VFF_WORK ?? '/tmp/vff-web-render';
+const BUNNY = '/usr/share/glmark2/models/bunny.obj';
+const BAKE = builtTool('VFF_BAKE', 'tools/vff-bake/vff-bake');
+const REFERENCE = builtTool('VFF_WEB_REFERENCE', 'tests/web/vff_web_reference');
+const SKIP = !BAKE ? 'vff-bake is not built (VFF_BAKE)' : !existsSync(BUNNY) ? `no ${BUNNY} (apt-get install glmark2-data)` : '';
+const SKIP_REFERENCE = SKIP || (!REFERENCE ? 'vff_web_reference is not built (VFF_WEB_REFERENCE)' : '');
+if (SKIP_REFERENCE) console.log(`SKIP: ${SKIP_REFERENCE}`);
 const SIZE = 96;
 // One AO ray that flips changes a pixel by 255/32 = 8 levels; binary32 rounding in the GLSL ES
 // port (no fma, no `precise`) flips a few rays at texel and sample boundaries.
@@ -19,8 +26,9 @@ const TOLERANCE = { meanLevels: 1.5, within16Share: 0.98 };
 let srv, browser, page;
 const field = join(WORK, 'bunny.vff');
 before(async () => {
+  if (SKIP) return;
   mkdirSync(WORK, { recursive: true });
-  execFileSync(process.env.VFF_BAKE, ['/usr/share/glmark2/models/bunny.obj', '-o', field, '-n', '16', '-m', '32'], { stdio: 'ignore' });
+  execFileSync(BAKE, [BUNNY, '-o', field, '-n', '16', '-m', '32'], { stdio: 'ignore' });
   srv = await serve({ '/bunny.vff': field });
   browser = await launch();
   page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
@@ -47,9 +55,9 @@ async function renderReference(interpolated) {
 }
 
 for (const mode of ['nearest', 'interpolated']) {
-  test(`ground AO (${mode}) matches the C++ reference render`, async () => {
+  test(`ground AO (${mode}) matches the C++ reference render`, { skip: SKIP_REFERENCE || false }, async () => {
     const pgm = join(WORK, `reference-${mode}.pgm`);
-    execFileSync(process.env.VFF_WEB_REFERENCE, [field, pgm, String(SIZE), mode]);
+    execFileSync(REFERENCE, [field, pgm, String(SIZE), mode]);
     const ref = readPgm(pgm);
     const gpu = await renderReference(mode === 'interpolated');
     let sum = 0, within = 0, dark = 0;
@@ -67,7 +75,7 @@ for (const mode of ['nearest', 'interpolated']) {
   });
 }
 
-test('the interactive view renders, accumulates, and a screenshot is kept', async () => {
+test('the interactive view renders, accumulates, and a screenshot is kept', { skip: SKIP || false }, async () => {
   const FRAMES = 8;
   const ms = await page.evaluate((frames) => {
     const v = window.vffViewer;
@@ -84,11 +92,11 @@ test('the interactive view renders, accumulates, and a screenshot is kept', asyn
 
 // Every kind of file the tools write opens in the page and renders: the bunny baked with each
 // encoding and option, and compressed by vff-compress (zstd + hits-med, and BC4).
-test('files the tools write open and render in the page', async () => {
+test('files the tools write open and render in the page', { skip: SKIP || false }, async () => {
   const bake = (name, ...args) => {
     const out = join(WORK, `${name}.vff`);
     const n = args.includes('-n') ? [] : ['-n', '6'];
-    execFileSync(process.env.VFF_BAKE, ['/usr/share/glmark2/models/bunny.obj', '-o', out, ...n, '-m', '16', ...args], { stdio: 'ignore' });
+    execFileSync(BAKE, [BUNNY, '-o', out, ...n, '-m', '16', ...args], { stdio: 'ignore' });
     return out;
   };
   const files = {

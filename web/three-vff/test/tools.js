@@ -2,15 +2,14 @@
 // vff-procedural-mesh, from the environment as ctest passes them, else the default build folder),
 // a scratch folder, the test page in headless Chromium, and the figures that compare two 8-bit
 // images.
-import { existsSync, mkdirSync } from 'node:fs';
+import { mkdirSync } from 'node:fs';
 import { join } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { serve, launch } from '../../test/browser/harness.js';
+import { serve, launch, builtTool } from '../../test/browser/harness.js';
 
 export const ROOT = fileURLToPath(new URL('../../../', import.meta.url));
-const tool = (env, rel) => process.env[env] || (existsSync(join(ROOT, rel)) ? join(ROOT, rel) : '');
-export const BAKE = tool('VFF_BAKE', 'build/tools/vff-bake/vff-bake');
-export const MESHGEN = tool('VFF_PROCEDURAL_MESH', 'build/samples/vff-procedural-mesh');
+export const BAKE = builtTool('VFF_BAKE', 'tools/vff-bake/vff-bake');
+export const MESHGEN = builtTool('VFF_PROCEDURAL_MESH', 'samples/vff-procedural-mesh');
 export const SKIP = !BAKE || !MESHGEN ? 'vff-bake and vff-procedural-mesh are not built (VFF_BAKE, VFF_PROCEDURAL_MESH)' : '';
 if (SKIP) console.log(`SKIP: ${SKIP}`);
 
