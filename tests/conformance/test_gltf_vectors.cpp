@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "common/param_name.h"
 #include "vff/bake/gltf_fields.h"
 #include "vff/reader.h"
 
@@ -62,13 +63,6 @@ std::vector<std::string> listAssets() {
   }
   std::sort(out.begin(), out.end());
   return out;
-}
-
-std::string caseName(const ::testing::TestParamInfo<std::string>& info) {
-  std::string s = info.param;
-  for (char& c : s)
-    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-  return s;
 }
 
 // A scratch folder of this process, removed with it.
@@ -172,7 +166,7 @@ TEST_P(GltfAsset, ReadsAsTheManifestSays) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(GltfVectors, GltfAsset, ::testing::ValuesIn(listAssets()), caseName);
+INSTANTIATE_TEST_SUITE_P(GltfVectors, GltfAsset, ::testing::ValuesIn(listAssets()), vff::test::paramCaseName);
 
 // Every asset of the manifest is on disk and the other way round; the invalid assets cover every
 // error rule, each named by the rule it raises first; the valid ones have no error and cover the

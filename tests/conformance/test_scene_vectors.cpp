@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "common/param_name.h"
 #include "vff/reader.h"
 #include "vff/scene_description.h"
 
@@ -48,13 +49,6 @@ std::vector<std::string> listVectors(const std::string& kind) {
   return out;
 }
 
-std::string caseName(const ::testing::TestParamInfo<std::string>& info) {
-  std::string s = info.param;
-  for (char& c : s)
-    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-  return s;
-}
-
 class InvalidSceneVector : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(InvalidSceneVector, RaisesItsFoldersId) {
@@ -74,7 +68,7 @@ TEST_P(InvalidSceneVector, RaisesItsFoldersId) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(SceneVectors, InvalidSceneVector, ::testing::ValuesIn(listVectors("invalid")), caseName);
+INSTANTIATE_TEST_SUITE_P(SceneVectors, InvalidSceneVector, ::testing::ValuesIn(listVectors("invalid")), vff::test::paramCaseName);
 
 // A binary32 the reader produced equals the expected number (a binary32 written as a binary64).
 void expectFloat(float got, const json& want, const std::string& where) {
@@ -142,7 +136,7 @@ TEST_P(ValidSceneVector, ReadsAsExpected) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(SceneVectors, ValidSceneVector, ::testing::ValuesIn(listVectors("valid")), caseName);
+INSTANTIATE_TEST_SUITE_P(SceneVectors, ValidSceneVector, ::testing::ValuesIn(listVectors("valid")), vff::test::paramCaseName);
 
 // Enough vectors, and every rule of spec/scene.md section 5 pinned by one at least.
 TEST(SceneVectors, EveryRuleHasVectors) {
