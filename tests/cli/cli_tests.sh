@@ -57,7 +57,7 @@ test_counts_take_their_number() {
 test_version() {
   inspect --version
   expect_rc 0
-  expect_out_re '^vff-inspect [0-9]+\.[0-9]+\.[0-9]+ \(libvff [0-9.]+, \.vff format 1\.2\)$'
+  expect_out_re '^vff-inspect [0-9]+\.[0-9]+\.[0-9]+ \(libvff [0-9.]+, \.vff format 1\.3\)$'
 }
 
 test_unknown_option() {

@@ -90,6 +90,9 @@ enum class Code : uint32_t {
   // 8xxx: metadata (META)
   kMetadataJson = 8001,        // not valid UTF-8 JSON
   kMetadataNotObject = 8002,   // the JSON value is not an object
+  kRefineHeader = 8501,        // REFN: header size, counts, margin, reserved bytes or total size wrong
+  kRefineUnsure = 8502,        // REFN: unsureTexels is not the number of bits set, or padding is not zero
+  kRefineMesh = 8503,          // REFN: a vertex index out of range, or a position not finite or outside the sphere
   // 10xxx: mesh input (the baker's front end)
   kMeshFormat = 10001,         // unknown mesh file extension
   kMeshParse = 10002,          // the mesh file cannot be parsed

@@ -17,7 +17,7 @@ namespace vff {
 
 // ---- Versions and fixed sizes -----------------------------------------------------------------
 inline constexpr uint16_t kVersionMajor = 1;
-inline constexpr uint16_t kVersionMinor = 2;  // the newest minor version this library reads and writes
+inline constexpr uint16_t kVersionMinor = 3;  // the newest minor version this library reads and writes
 inline constexpr uint8_t kMagic[8] = {0x89, 'V', 'F', 'F', 0x0D, 0x0A, 0x1A, 0x0A};
 inline constexpr uint32_t kHeaderSize = 64;
 inline constexpr uint32_t kSectionEntrySize = 64;

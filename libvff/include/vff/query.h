@@ -78,6 +78,7 @@
 #include "vff/export.h"
 #include "vff/format.h"
 #include "vff/positions.h"
+#include "vff/refine.h"
 
 namespace vff {
 
@@ -93,6 +94,13 @@ struct Ray {
 enum class Reconstruction : uint8_t {
   kNearest = 0,       // the paper: nearest positional sample, texel containing the direction
   kInterpolated = 1,  // miss-aware blend of the neighbouring samples and texels (see above)
+  // A refined field's answer (vff/refine.h, spec/geometry.md section 7.5): kNearest's where the
+  // field is sure; where its texel is marked unsure, or its hit lies within the refinement's margin
+  // of either end of the ray's range (tmin or the origin, tmax), an exact ray cast against the
+  // object's triangles over [tmin, tmax] (two-sided; QueryHit::normal the triangle's, facing the
+  // ray). Rays answered by section 7.3 (from the object's own surface) get kNearest's answer. A
+  // field without a refinement answers as kNearest. visibility() is 0 or 1.
+  kRefined = 2,
 };
 
 // Which map and texel answer a ray: the positional sample nearest to the point where the lookup
@@ -182,8 +190,10 @@ class VFF_API FieldQuery {
   // Borrows map-major planes laid out as in a file (mapCount * mapBytes each; normals may be empty).
   // Errors: kInvalidArgument when a size does not match the description; the checks of
   // FieldDesc validation (kMapCount, kPositionScheme...).
+  // A refinement (vff/refine.h; borrowed, like the maps) enables Reconstruction::kRefined; its
+  // problems are kInvalidArgument. fromFile takes the file's REFN section when it has one.
   static Result<FieldQuery> fromMaps(const FieldDesc& field, std::span<const uint8_t> distance,
-                                     std::span<const uint8_t> normals = {});
+                                     std::span<const uint8_t> normals = {}, const RefinementView& refinement = {});
 
   const FieldDesc& field() const noexcept;
   const PositionSet& positions() const noexcept;
@@ -192,6 +202,12 @@ class VFF_API FieldQuery {
   uint64_t payloadBytes() const noexcept;
   // Bytes of those maps the kernel moved to huge pages when this view was made (see above).
   uint64_t hugePageBytes() const noexcept;
+  // Whether the field has a refinement (kRefined answers from it), and the bytes its exact step
+  // reads: the unsure bits, the vertex positions, and the triangle BVH built from them (its nodes
+  // and the triangles' indices). payloadBytes() + refinementBytes(): the memory a refined query
+  // needs (what a GPU would hold).
+  bool refined() const noexcept;
+  uint64_t refinementBytes() const noexcept;
 
   // Object-space queries.
   QueryHit intersect(const Ray& ray, const QueryOptions& options = {}) const noexcept;

@@ -22,6 +22,7 @@
 #include "vff/error.h"
 #include "vff/export.h"
 #include "vff/format.h"
+#include "vff/refine.h"
 
 namespace vff {
 
@@ -119,6 +120,9 @@ class VFF_API File {
   // canonical: sorted keys, no spaces), or empty when there is no META section. Its numbers may lie
   // beyond binary64 range (spec/format.md section 9).
   std::string_view metadata() const noexcept;
+  // The refinement (REFN, format 1.3: vff/refine.h), checked when the file was opened; empty when
+  // the file has none. Its views live as long as the File.
+  const RefinementView& refinement() const noexcept;
   // The whole file's bytes (mapped or borrowed).
   std::span<const uint8_t> bytes() const noexcept;
 

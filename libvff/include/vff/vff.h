@@ -9,6 +9,7 @@
 #include "vff/format.h"
 #include "vff/positions.h"
 #include "vff/query.h"
+#include "vff/refine.h"
 #include "vff/reader.h"
 #include "vff/scene.h"
 #include "vff/scene_description.h"

@@ -22,6 +22,7 @@
 #include "vff/export.h"
 #include "vff/format.h"
 #include "vff/reader.h"
+#include "vff/refine.h"
 
 namespace vff {
 
@@ -41,6 +42,9 @@ struct WriteOptions {
   // no insignificant whitespace), so equal objects give equal bytes. Keys starting with "vff."
   // are reserved for the names in spec/format.md.
   std::string metadataJson;
+  // A refinement (vff/refine.h), written as the section REFN after the planes (format 1.3), with
+  // `codec`; borrowed until finish(). Empty: none. It must match the field (else kInvalidArgument).
+  RefinementView refinement;
   bool sync = true;  // fsync the file and its folder before and after the rename
   // Threads compressing blocks (0: one per core). The bytes written do not depend on it.
   unsigned threads = 0;
@@ -65,6 +69,10 @@ class VFF_API Writer {
   // Appends whole maps (bytes.size() must be a multiple of the plane's map size). All distance
   // maps come first, then (if the field has a normal encoding) all normal maps.
   Status writeMaps(Plane p, std::span<const uint8_t> bytes);
+  // Sets (or replaces) the refinement written as REFN when the file is finished: the same as
+  // WriteOptions::refinement, for a refinement made after the maps (from them). Copied. Errors:
+  // kInvalidArgument when it does not match the field, kBadState after finish().
+  Status setRefinement(const RefinementView& refinement);
   // Completes the file: writes the indexes, header and checksums, syncs and renames into place.
   Status finish();
   Result<std::vector<uint8_t>> finishToMemory();

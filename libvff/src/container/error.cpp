@@ -66,6 +66,9 @@ const char* codeName(Code code) noexcept {
     case Code::kLayoutReserved: return "layout-reserved";
     case Code::kMetadataJson: return "metadata-json";
     case Code::kMetadataNotObject: return "metadata-not-object";
+    case Code::kRefineHeader: return "refine-header";
+    case Code::kRefineUnsure: return "refine-unsure";
+    case Code::kRefineMesh: return "refine-mesh";
     case Code::kMeshFormat: return "mesh-format";
     case Code::kMeshParse: return "mesh-parse";
     case Code::kMeshUnsupported: return "mesh-unsupported";

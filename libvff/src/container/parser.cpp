@@ -1,4 +1,5 @@
 #include "container/parser.h"
+#include "refine/refine_section.h"
 
 #define ZSTD_STATIC_LINKING_ONLY  // ZSTD_getFrameHeader (exported by libzstd since 1.3)
 #include <zstd.h>
@@ -31,6 +32,7 @@ class Parser {
     if (!planeSection(Plane::kDistance)) return false;
     if (!planeSection(Plane::kNormal)) return false;
     if (!metadataSection()) return false;
+    if (!refinementSection()) return false;
     return usable_;
   }
 
@@ -120,7 +122,8 @@ class Parser {
                                         {kTagLayout, kSectionRequired},
                                         {kTagDistance, kSectionRequired},
                                         {kTagNormal, 0},
-                                        {kTagMetadata, kSectionCopySafe}};
+                                        {kTagMetadata, kSectionCopySafe},
+                                        {kTagRefinement, 0}};
 
   bool sectionTable() {
     FileInfo& fi = out_->info;
@@ -599,6 +602,26 @@ class Parser {
       return report(Code::kMetadataNotObject, kTagMetadata, s.offset, "metadata JSON is not an object");
     }
     out_->metadata = std::move(text);
+    return true;
+  }
+
+  // REFN, format.md section 14 (rules 8501-8503), once the field description is known.
+  bool refinementSection() {
+    const int idx = find(kTagRefinement);
+    if (idx < 0 || !out_->fieldOk) return true;
+    const SectionInfo& s = out_->info.sections[size_t(idx)];
+    std::vector<uint8_t> raw;
+    if (!sectionBytes(idx, &raw)) return usable_ = false, true;
+    RefinementView view;
+    if (Status st = parseRefinement(out_->field, raw, &view); !st) {
+      usable_ = false;
+      const Error& e = st.error();
+      // A stored section's problem is at its byte; a compressed one's at the section.
+      const uint64_t at = s.codec == Codec::kStored ? s.offset + e.offset : s.offset;
+      return report(e.code, kTagRefinement, at, e.message);
+    }
+    out_->refinementRaw = std::move(raw);  // (the buffer moves with it: the view stays valid)
+    out_->refinement = view;
     return true;
   }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "vff/reader.h"
+#include "vff/refine.h"
 #include "vff/validate.h"
 
 namespace vff::detail {
@@ -36,6 +37,9 @@ struct ParsedFile {
   bool layoutOk = false;
   PlaneInfo planes[2];
   std::string metadata;
+  // REFN (format.md section 14), decoded, and the view into it the parse checked.
+  std::vector<uint8_t> refinementRaw;
+  RefinementView refinement;
   // Byte ranges [begin, end) the structures cover; what lies between must be zero padding.
   std::vector<std::pair<uint64_t, uint64_t>> covered;
 };

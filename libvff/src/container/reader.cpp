@@ -151,6 +151,7 @@ const FieldDesc& File::field() const noexcept { return impl_->parsed.field; }
 const LayoutDesc& File::layout() const noexcept { return impl_->parsed.layout; }
 const PlaneInfo& File::plane(Plane p) const noexcept { return impl_->parsed.planes[size_t(p)]; }
 std::string_view File::metadata() const noexcept { return impl_->parsed.metadata; }
+const RefinementView& File::refinement() const noexcept { return impl_->parsed.refinement; }
 std::span<const uint8_t> File::bytes() const noexcept { return impl_->bytes; }
 
 Result<std::span<const uint8_t>> File::blockData(Plane p, uint32_t block) const { return impl_->block(p, block); }

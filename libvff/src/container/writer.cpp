@@ -173,6 +173,7 @@ struct VFF_HIDDEN Writer::Impl {  // (VFF_HIDDEN: not exported with its class, v
   bool finished = false;
   bool failed = false;
   std::string metaPending;  // canonical metadata JSON, written by writePrologue()
+  std::vector<uint8_t> refinePending;  // REFN's raw bytes, written by finish() after the planes
 
   // The sections that precede the planes: FDSC, LAYT and META.
   Status writePrologue() {
@@ -389,6 +390,11 @@ struct VFF_HIDDEN Writer::Impl {  // (VFF_HIDDEN: not exported with its class, v
         return makeError(Code::kBadState, std::string("only ") + std::to_string(planes[p].mapsWritten) + " of " +
                                               std::to_string(field.mapCount) + " " + planeName(Plane(p)) +
                                               " maps were written");
+    if (!refinePending.empty()) {
+      Status st = addSection(kTagRefinement, 0, refinePending, options.codec);
+      if (!st) return fail(std::move(st).error());
+      refinePending.clear();
+    }
     uint64_t incompat = 0;
     for (const auto& s : sections)
       if (s.codec == Codec::kZstd) incompat |= kFeatureZstd;
@@ -400,9 +406,14 @@ struct VFF_HIDDEN Writer::Impl {  // (VFF_HIDDEN: not exported with its class, v
     std::vector<uint8_t> head(kHeaderSize + sections.size() * kSectionEntrySize, 0);
     std::copy(std::begin(kMagic), std::end(kMagic), head.begin());
     store<uint16_t>(&head[8], kVersionMajor);
-    // The lowest version that holds the file: 1.2 with a 1.2 feature (bc4-diameter), else 1.1 with a
-    // 1.1 feature (a filter), else 1.0.
-    store<uint16_t>(&head[10], uint16_t((incompat & kFeatureBc4) ? 2 : (incompat & kFeatureFilters) ? 1 : 0));
+    // The lowest version that holds the file: 1.3 with a refinement, else 1.2 with a 1.2 feature
+    // (bc4-diameter), else 1.1 with a 1.1 feature (a filter), else 1.0.
+    bool refined = false;
+    for (const auto& s : sections) refined = refined || s.tag == kTagRefinement;
+    store<uint16_t>(&head[10], uint16_t(refined                     ? 3
+                                        : (incompat & kFeatureBc4)     ? 2
+                                        : (incompat & kFeatureFilters) ? 1
+                                                                       : 0));
     store<uint32_t>(&head[12], kHeaderSize);
     store<uint64_t>(&head[16], fileSize);
     store<uint64_t>(&head[24], incompat);
@@ -466,6 +477,7 @@ Result<std::unique_ptr<Writer::Impl>> prepare(const FieldDesc& field, const Writ
   auto impl = std::make_unique<Writer::Impl>();
   impl->field = field;
   impl->options = options;
+  impl->options.refinement = {};  // (encoded below: the writer keeps no borrowed view)
   impl->layout = *layout;
   const uint64_t mapBytes[2] = {distanceMapBytes(field.distanceEncoding, field.mapResolution),
                                 normalMapBytes(field.normalEncoding, field.mapResolution)};
@@ -506,8 +518,14 @@ Result<std::unique_ptr<Writer::Impl>> prepare(const FieldDesc& field, const Writ
       return makeError(Code::kMetadataJson, std::string("metadataJson: ") + e.what());
     }
   }
-  // Sections before the planes: FDSC, LAYT, META. The table is sized for all of them.
-  const size_t count = 3 + (impl->planes[1].enabled ? 1 : 0) + (meta.empty() ? 0 : 1);
+  if (!options.refinement.empty()) {
+    auto raw = encodeRefinement(field, options.refinement);
+    if (!raw) return std::move(raw).error();
+    impl->refinePending = std::move(*raw);
+  }
+  // Sections before the planes: FDSC, LAYT, META; REFN after them (setRefinement may add it later:
+  // the table's room is counted for it, and at most 6 entries fit the first 4096 bytes anyway).
+  const size_t count = 3 + (impl->planes[1].enabled ? 1 : 0) + (meta.empty() ? 0 : 1) + 1;
   impl->cursor = alignUp(kHeaderSize + count * kSectionEntrySize, kSectionAlignment);
   impl->sections.reserve(count);
   impl->metaPending = std::move(meta);
@@ -543,6 +561,19 @@ Result<Writer> Writer::createInMemory(const FieldDesc& field, const WriteOptions
 Status Writer::writeMaps(Plane p, std::span<const uint8_t> bytes) {
   if (!impl_) return makeError(Code::kBadState, "moved-from writer");
   return impl_->writeMaps(p, bytes);
+}
+
+Status Writer::setRefinement(const RefinementView& refinement) {
+  if (!impl_) return makeError(Code::kBadState, "moved-from writer");
+  if (impl_->finished || impl_->failed) return makeError(Code::kBadState, "the writer is finished or has failed");
+  if (refinement.empty()) {
+    impl_->refinePending.clear();
+    return {};
+  }
+  auto raw = encodeRefinement(impl_->field, refinement);
+  if (!raw) return std::move(raw).error();
+  impl_->refinePending = std::move(*raw);
+  return {};
 }
 
 Status Writer::finish() {

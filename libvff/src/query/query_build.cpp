@@ -133,7 +133,7 @@ FieldQuery& FieldQuery::operator=(FieldQuery&&) noexcept = default;
 FieldQuery::~FieldQuery() = default;
 
 Result<FieldQuery> FieldQuery::fromMaps(const FieldDesc& field, std::span<const uint8_t> distance,
-                                        std::span<const uint8_t> normals) {
+                                        std::span<const uint8_t> normals, const RefinementView& refinement) {
   if (Status s = checkFieldDesc(field); !s) return s.error();
   auto ps = PositionSet::fromField(field);
   if (!ps) return ps.error();
@@ -158,7 +158,12 @@ Result<FieldQuery> FieldQuery::fromMaps(const FieldDesc& field, std::span<const 
     for (uint32_t k = 0; k < field.mapCount; ++k) impl->norm[k] = normals.data() + k * nb;
     impl->payload += normals.size();
   }
+  if (!refinement.empty()) {
+    // The reader's checks of a REFN section, made on the section this refinement would be.
+    if (auto raw = encodeRefinement(field, refinement); !raw) return std::move(raw).error();
+  }
   impl->build();
+  if (Status s = impl->setRefinement(refinement); !s) return s.error();
   FieldQuery q;
   q.impl_ = std::move(impl);
   return q;
@@ -197,6 +202,7 @@ Result<FieldQuery> FieldQuery::fromFile(const File& file) {
     impl->payload += file.plane(Plane::kNormal).rawBytes;
   }
   impl->build();
+  if (Status s = impl->setRefinement(file.refinement()); !s) return s.error();
   FieldQuery q;
   q.impl_ = std::move(impl);
   return q;

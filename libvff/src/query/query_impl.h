@@ -24,6 +24,7 @@
 #include "vff/query.h"
 
 #include "query/fast_lookup.h"
+#include "refine/triangle_bvh.h"
 #include "query/batch/query_group.h"
 
 namespace vff {
@@ -156,6 +157,11 @@ struct VFF_HIDDEN FieldQuery::Impl {  // (VFF_HIDDEN: not exported with its clas
   float distanceStep = 0;
   std::vector<float> chordScale;     // unorm8-chord: quantizationStep per texel (M * M)
   uint64_t payload = 0;
+  // Reconstruction::kRefined (vff/refine.h): the unsure bits, the margin in object units, the BVH.
+  RefinementView refine;
+  float refineMargin = 0;
+  detail::TriangleBvh bvh;
+  Status setRefinement(const RefinementView& r);
   uint64_t hugePages = 0;  // bytes of the maps on huge pages (build(): adviseMapRuns)
 
   detail::Sample texel(uint32_t k, uint32_t i, uint32_t j) const noexcept {
@@ -325,6 +331,11 @@ struct VFF_HIDDEN FieldQuery::Impl {  // (VFF_HIDDEN: not exported with its clas
     while (next < made) handOver();
   }
   QueryHit query(const Ray& ray, const QueryOptions& o, float* visibility) const noexcept;
+  // kRefined (query_refined.cpp): the answer of a prepared lookup at texel (i, j) of map k, from
+  // the maps where the field is sure, else exact (anyHit: the first hit found, for occlusion).
+  QueryHit refinedAt(const Ray& ray, uint32_t k, uint32_t i, uint32_t j, float t0, bool inside, float lo, float hi,
+                     float len, bool anyHit, float* visibility) const noexcept;
+  QueryHit exactHit(const Ray& ray, bool anyHit, float* visibility) const noexcept;
   // Whether the nearest lookup at texel (i, j) of map k hits within [lo, hi] (hitAt(...).hit).
   // *t: the hit's distance along the ray's unit direction.
   bool hitsAt(uint32_t k, uint32_t i, uint32_t j, float t0, bool inside, float lo, float hi,
@@ -338,8 +349,10 @@ struct VFF_HIDDEN FieldQuery::Impl {  // (VFF_HIDDEN: not exported with its clas
   // kHitOnly: emit(base, n, hits) per run of rays; otherwise emit(r, const QueryHit&, float
   // visibility) per ray (see the definition).
   // With `to`, the rays are in world space: the kernel and prepare() take them to object space.
+  // kRefined rays take the !kHitOnly path (refinedAt per ray; anyHit for occlusion).
   template <bool kHitOnly, class Emit>
-  void batchNearest(std::span<const Ray> rays, const QueryOptions& o, const detail::ToObject* to, Emit&& emit) const noexcept;
+  void batchNearest(std::span<const Ray> rays, const QueryOptions& o, const detail::ToObject* to, Emit&& emit,
+                    bool anyHit = false) const noexcept;
   // The batch calls of FieldQuery (x null: object-space rays) and of Instance (world-space rays, x
   // their transform). Nearest batches hand the transform to the group kernel, which applies it
   // lane by lane; interpolated batches take the rays to object space a few hundred at a time.

@@ -94,7 +94,9 @@ QueryHit FieldQuery::Impl::query(const Ray& ray, const QueryOptions& o, float* v
   if (!prepare(ray, o, &l)) return {};
   // From inside, kInterpolated answers like kNearest: the blended samples' rays pass beside the
   // origin and take its own surface for an occluder (tests/query, intra-object occlusion).
-  if (o.reconstruction == Reconstruction::kNearest || l.inside) return nearestAnswer(ray, l, visibility);
+  if (o.reconstruction == Reconstruction::kRefined && !bvh.empty())
+    return refinedAt(ray, l.k0, l.i, l.j, l.t0, l.inside, l.lo, l.hi, l.len, false, visibility);
+  if (o.reconstruction != Reconstruction::kInterpolated || l.inside) return nearestAnswer(ray, l, visibility);
   return interpolated(ray, l, visibility);
 }
 

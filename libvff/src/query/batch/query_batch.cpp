@@ -75,7 +75,7 @@ void withToObject(const RigidTransform* x, Fn&& fn) {
 
 void FieldQuery::Impl::intersectBatch(std::span<const Ray> rays, std::span<QueryHit> out, const QueryOptions& o,
                                       const RigidTransform* x) const noexcept {
-  if (o.reconstruction == Reconstruction::kNearest) {
+  if (o.reconstruction != Reconstruction::kInterpolated) {
     withToObject(x, [&](const detail::ToObject* to) {
       batchNearest<false>(rays, o, to, [&](size_t r, const QueryHit& h, float) {
         out[r] = h;
@@ -94,7 +94,13 @@ void FieldQuery::Impl::intersectBatch(std::span<const Ray> rays, std::span<Query
 
 void FieldQuery::Impl::occludedBatch(std::span<const Ray> rays, std::span<uint8_t> out, const QueryOptions& o,
                                      const RigidTransform* x) const noexcept {
-  if (o.reconstruction == Reconstruction::kNearest) {
+  if (o.reconstruction == Reconstruction::kRefined && !bvh.empty()) {
+    withToObject(x, [&](const detail::ToObject* to) {
+      batchNearest<false>(rays, o, to, [&](size_t r, const QueryHit& h, float) { out[r] = h.hit ? 1 : 0; }, true);
+    });
+    return;
+  }
+  if (o.reconstruction != Reconstruction::kInterpolated) {
     withToObject(x, [&](const detail::ToObject* to) {
       batchNearest<true>(rays, o, to,
                          [&](size_t base, size_t count, uint64_t hits) { writeHitBytes(hits, count, &out[base]); });
@@ -108,7 +114,13 @@ void FieldQuery::Impl::occludedBatch(std::span<const Ray> rays, std::span<uint8_
 
 void FieldQuery::Impl::visibilityBatch(std::span<const Ray> rays, std::span<float> out, const QueryOptions& o,
                                        const RigidTransform* x) const noexcept {
-  if (o.reconstruction == Reconstruction::kNearest) {
+  if (o.reconstruction == Reconstruction::kRefined && !bvh.empty()) {
+    withToObject(x, [&](const detail::ToObject* to) {
+      batchNearest<false>(rays, o, to, [&](size_t r, const QueryHit& h, float) { out[r] = h.hit ? 0.0f : 1.0f; }, true);
+    });
+    return;
+  }
+  if (o.reconstruction != Reconstruction::kInterpolated) {
     withToObject(x, [&](const detail::ToObject* to) {
       batchNearest<true>(rays, o, to, [&](size_t base, size_t count, uint64_t hits) {
         for (size_t r = 0; r < count; ++r) out[base + r] = (hits >> r) & 1u ? 0.0f : 1.0f;

@@ -16,7 +16,8 @@ namespace vff {
 // whether ray base + r hits. Otherwise: emit(r, const QueryHit&, float visibility) per ray.
 template <bool kHitOnly, class Emit>
 void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOptions& o, const detail::ToObject* to,
-                                    Emit&& emit) const noexcept {
+                                    Emit&& emit, bool anyHit) const noexcept {
+  const bool refined = o.reconstruction == Reconstruction::kRefined && !bvh.empty();
   auto objectRay = [&](size_t r) { return to ? to->ray(rays[r]) : rays[r]; };
   // A batch of one ray (an Embree callback for rtcIntersect1 or rtcOccluded1) takes the reference
   // path: a group's fixed cost is larger than the ray's own, and there are no other texel reads
@@ -32,7 +33,9 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
         float vis = 1.0f;
         Lookup l;
         const Ray ray = objectRay(base + r);
-        const QueryHit h = prepare(ray, o, &l) ? nearestAnswer(ray, l, &vis) : QueryHit{};
+        const QueryHit h = !prepare(ray, o, &l) ? QueryHit{}
+                           : refined ? refinedAt(ray, l.k0, l.i, l.j, l.t0, l.inside, l.lo, l.hi, l.len, anyHit, &vis)
+                                     : nearestAnswer(ray, l, &vis);
         if constexpr (kHitOnly) {
           hits |= uint64_t(h.hit) << r;
         } else {
@@ -87,6 +90,9 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
         float vis = 1.0f;
         QueryHit h;
         if ((dead >> p) & 1u) {
+        } else if (refined) {
+          h = refinedAt(objectRay(base + r), g.k[p], g.i[p], g.j[p], g.t0[r], (g.inside >> r) & 1u, g.lo[r], g.hi[r],
+                        g.len[r], anyHit, &vis);
         } else if (g.t0[r] < 0) {
           h = offHitAt(objectRay(base + r), g.k[p], g.i[p], g.j[p], g.t0[r], g.lo[r], g.hi[r], g.len[r], &vis);
         } else {
