@@ -78,8 +78,8 @@ void appendSections(std::string& s, const BuiltValid& v, const Vff& file) {
   for (uint32_t i = 0; i < file.count(); ++i) {
     const uint64_t e = file.entryAt(i);
     const uint32_t tag = ld32(v.bytes, e);
-    const bool known =
-        tag == kTagField || tag == kTagLayout || tag == kTagDistance || tag == kTagNormal || tag == kTagMetadata;
+    const bool known = tag == kTagField || tag == kTagLayout || tag == kTagDistance || tag == kTagNormal ||
+                       tag == kTagMetadata || tag == kTagRefinement;
     s += "    {\"tag\": " + jstr(sectionTagName(tag)) + ", \"flags\": " + std::to_string(ld32(v.bytes, e + 4)) +
          ", \"codec\": " + jstr(codecName(Codec(ld16(v.bytes, e + 32)))) +
          ", \"known\": " + (known ? "true" : "false") + "}" + (i + 1 < file.count() ? "," : "") + "\n";
@@ -113,6 +113,55 @@ void appendPlanes(std::string& s, const BuiltValid& v, const Vff& file) {
     firstPlane = false;
   }
   s += "\n  },\n";
+}
+
+// "refinement" (format 1.3, only when the file has REFN): what a reader decodes from REFN, from the
+// source refinement: margin, unsureTexels, per map the texels (j * M + i) whose bit is set, the XXH3-64
+// of the U bytes of bits, the counts, every vertex and triangle, and the XXH3-64 of the positions'
+// and indices' little-endian bytes as REFN stores them.
+void appendRefinement(std::string& s, const BuiltValid& v) {
+  if (!v.c.refined) return;
+  const Refinement& r = v.refinement;
+  const FieldDesc& f = v.c.field;
+  const uint64_t mm = uint64_t(f.mapResolution) * f.mapResolution;
+  const Bytes raw = referenceRefinementBytes(f, r);
+  const uint64_t posAt = raw.size() - 4 * (r.positions.size() + r.indices.size());
+  const auto bytes = std::span<const uint8_t>(raw);
+  s += "  \"refinement\": {\"margin\": " + jnum(r.margin) + ", \"unsureTexels\": " + std::to_string(r.unsureTexels) +
+       ", \"unsureBytes\": " + std::to_string(r.unsure.size()) + ", \"unsureXxh3\": " + jstr(hex64(xxh(r.unsure))) +
+       ",\n    \"unsure\": [";
+  for (uint32_t k = 0; k < f.mapCount; ++k) {
+    s += k ? ",\n               [" : "[";
+    bool first = true;
+    for (uint64_t t = 0; t < mm; ++t) {
+      const uint64_t x = k * mm + t;
+      if (!((r.unsure[x / 8] >> (x % 8)) & 1)) continue;
+      if (!first) s += ',';
+      s += std::to_string(t);
+      first = false;
+    }
+    s += "]";
+  }
+  s += "],\n    \"vertexCount\": " + std::to_string(r.positions.size() / 3) +
+       ", \"triangleCount\": " + std::to_string(r.indices.size() / 3) +
+       ", \"positionsXxh3\": " + jstr(hex64(xxh(bytes.subspan(posAt, 4 * r.positions.size())))) +
+       ", \"indicesXxh3\": " + jstr(hex64(xxh(bytes.subspan(posAt + 4 * r.positions.size())))) +
+       ",\n    \"positions\": [";
+  for (size_t p = 0; p < r.positions.size(); p += 3) {
+    // Appended piece by piece: GCC 12 warns (-Wrestrict, a false positive) on "[" + std::string.
+    if (p) s += ",\n                  ";
+    s += '[';
+    s += jnum(r.positions[p]) + ", " + jnum(r.positions[p + 1]) + ", " + jnum(r.positions[p + 2]);
+    s += ']';
+  }
+  s += "],\n    \"indices\": [";
+  for (size_t t = 0; t < r.indices.size(); t += 3) {
+    if (t) s += t % 24 ? ", " : ",\n                ";
+    s += '[';
+    s += std::to_string(r.indices[t]) + "," + std::to_string(r.indices[t + 1]) + "," + std::to_string(r.indices[t + 2]);
+    s += ']';
+  }
+  s += "]},\n";
 }
 
 // "maps": decoded values and the XXH3-64 of the raw bytes.
@@ -208,6 +257,7 @@ std::string expectedJson(const BuiltValid& v) {
   const std::string meta = v.c.post == Post::kMetaText ? jstr(v.metadata) : v.metadata;
   s += "  \"metadata\": " + (v.metadata.empty() ? std::string("null") : meta) + ",\n";
   appendPlanes(s, v, file);
+  appendRefinement(s, v);
   appendMaps(s, v);
   appendSlices(s, v);
   return s;

@@ -1,8 +1,9 @@
 // gen_invalid.cpp - the invalid conformance vectors (gen_invalid.h), by validation ID range: 2xxx
 // identity, 3xxx header, 4xxx section table and sections, 5xxx field description, 6xxx planes and
-// blocks, 7xxx packed layout, 8xxx metadata.
+// blocks, 7xxx packed layout, 8xxx metadata, 85xx refinement (REFN, format 1.3).
 #include "gen_invalid.h"
 
+#include <bit>
 #include <functional>
 #include <span>
 #include <utility>
@@ -27,6 +28,8 @@ const char* const M = "u16d-stored-meta-slices";        // FDSC, LAYT, META (sto
 const char* const B = "bit1-stored";
 const char* const C = "bc4-zstd-normals-slices";  // FDSC, LAYT, DIST, NORM (bc4-diameter, zstd blocks)
 const char* const H = "u8d-zstd-hits-med";        // FDSC, LAYT, DIST (1 zstd block, filter hits-med)
+const char* const RF = "u8d-refined";                    // FDSC, LAYT, DIST, REFN (stored, 3 padding bytes)
+const char* const RZ = "u8c-zstd-normals-meta-refined";  // FDSC, LAYT, META, DIST, NORM, REFN (zstd)
 // The section tags, as short as the base names in the lists below.
 constexpr uint32_t D = kTagDistance, F = kTagField, L = kTagLayout, T = kTagMetadata, NM = kTagNormal;
 
@@ -78,6 +81,19 @@ class Mutations {
           zstdContent(std::span<const uint8_t>(v.b).subspan(v.block(kTagDistance, 0), v.blockSize(kTagDistance, 0)));
       change(stream);
       v.replaceLastBlock(kTagDistance, zstdFrame(stream));
+    });
+  }
+  // The raw bytes of `base`'s REFN (its last section, decoded when zstd) changed by `change`, then
+  // written back with the same codec (a new zstd frame) and every checksum re-sealed.
+  void refn(uint32_t id, std::string name, std::string what, std::function<void(Bytes&)> change,
+            const std::string& base = RF) {
+    add(id, std::move(name), base, std::move(what), [change](Vff& v) {
+      const bool zstd = ld16(v.b, v.entry(kTagRefinement) + 32) == 1;
+      const auto stored = std::span<const uint8_t>(v.b).subspan(v.sec(kTagRefinement), v.secSize(kTagRefinement));
+      Bytes raw = zstd ? zstdContent(stored) : Bytes(stored.begin(), stored.end());
+      change(raw);
+      const Bytes out = zstd ? zstdFrame(raw) : raw;
+      v.replaceLastSection(kTagRefinement, out, raw.size());
     });
   }
 
@@ -365,6 +381,82 @@ void addLayoutAndMetadata(Mutations& g) {
   g.meta(8002, "array", "metadata '[1,2]' (valid JSON, not an object)", "[1,2]");
 }
 
+// 85xx: REFN (format 1.3), changed inside its raw bytes (re-compressed when zstd) and re-sealed.
+void addRefinement(Mutations& g) {
+  const FieldDesc& f = g.valid(RF).c.field;
+  const uint64_t texels = uint64_t(f.mapCount) * f.mapResolution * f.mapResolution;
+  const uint64_t unsureBytes = (texels + 7) / 8;
+  if (texels % 8 == 0 || unsureBytes % 4 == 0) die(std::string(RF) + ": needs unused bits and padding after them");
+  // Offsets inside REFN's raw bytes: the positions start after the bits and padding; the indices end it.
+  const auto positionsAt = [](const Bytes& raw) { return raw.size() - 12 * uint64_t(ld32(raw, 4)) - 12 * uint64_t(ld32(raw, 8)); };
+  const auto setF32 = [](Bytes& raw, uint64_t at, float value) { st32(raw, at, std::bit_cast<uint32_t>(value)); };
+
+  g.refn(8501, "header-size-63", "REFN headerSize 63", [](Bytes& r) { st32(r, 0, 63); });
+  g.refn(8501, "vertex-count-2", "REFN vertexCount 2 (the section's size left as it was)", [](Bytes& r) { st32(r, 4, 2); });
+  g.refn(8501, "triangle-count-0", "REFN triangleCount 0 (the section's size left as it was)",
+         [](Bytes& r) { st32(r, 8, 0); });
+  g.refn(8501, "margin-negative", "REFN margin -0.1875", [&](Bytes& r) { setF32(r, 12, -0.1875f); });
+  g.refn(8501, "margin-nan", "REFN margin NaN", [](Bytes& r) { st32(r, 12, 0x7FC00000u); });
+  g.refn(8501, "margin-infinity", "REFN margin +infinity", [](Bytes& r) { st32(r, 12, 0x7F800000u); });
+  g.refn(8501, "reserved-byte-20", "REFN header byte 20 (reserved) is 1", [](Bytes& r) { r[20] = 1; });
+  g.refn(8501, "reserved-byte-63", "REFN header byte 63 (reserved) is 1", [](Bytes& r) { r[63] = 1; });
+  g.refn(8501, "raw-size-plus-4", "4 zero bytes appended to REFN: rawSize 64 + U + P + 12V + 12T + 4",
+         [](Bytes& r) { r.insert(r.end(), 4, 0); });
+  g.refn(8501, "raw-size-minus-4", "REFN's last 4 bytes (the last index) cut off: rawSize 64 + U + P + 12V + 12T - 4",
+         [](Bytes& r) { r.resize(r.size() - 4); });
+  g.refn(8501, "header-60-bytes", "REFN cut to 60 bytes, less than its header", [](Bytes& r) { r.resize(60); });
+  g.add(8501, "bit1-field", B,
+        "a REFN section (margin 0.1875, the silhouette texels, an octahedron) appended to a bit1 field, "
+        "versionMinor 3",
+        [&](Vff& v) {
+          const BuiltValid& base = g.valid(B);
+          const Refinement r = makeRefinementSource(base.c.field, base.content, 0.1875f, 0);
+          v.appendSection(kTagRefinement, 0, referenceRefinementBytes(base.c.field, r));
+          st16(v.b, 10, 3);
+          v.sealHeader();
+        });
+  g.refn(
+      8501, "zstd-vertex-count-2", "zstd REFN with vertexCount 2 (re-compressed)", [](Bytes& r) { st32(r, 4, 2); },
+      RZ);
+
+  g.refn(8502, "count-plus-1", "REFN unsureTexels one more than the bits set",
+         [](Bytes& r) { st32(r, 16, ld32(r, 16) + 1); });
+  g.refn(8502, "bit-past-last-texel",
+         "the bit of texel " + std::to_string(texels) + " set, past the last texel (" + std::to_string(texels - 1) +
+             "); unsureTexels unchanged",
+         [&](Bytes& r) { r[64 + texels / 8] = uint8_t(r[64 + texels / 8] | 1u << (texels % 8)); });
+  g.refn(8502, "padding-byte", "REFN's last padding byte (before the positions) is 1",
+         [&](Bytes& r) { r[positionsAt(r) - 1] = 1; });
+  g.refn(
+      8502, "zstd-count-minus-1", "zstd REFN with unsureTexels one less than the bits set (re-compressed)",
+      [](Bytes& r) { st32(r, 16, ld32(r, 16) - 1); }, RZ);
+
+  g.refn(8503, "index-out-of-range", "REFN's last index is vertexCount",
+         [](Bytes& r) { st32(r, r.size() - 4, ld32(r, 4)); });
+  g.refn(8503, "vertex-outside-sphere",
+         "REFN vertex 0 at C + (1.0002 R, 0, 0), beyond the sphere's tolerance (1 + 1e-4) R + 1e-6", [&](Bytes& r) {
+           const uint64_t p = positionsAt(r);
+           setF32(r, p, float(double(f.sphere.center[0]) + 1.0002 * double(f.sphere.radius)));
+           setF32(r, p + 4, f.sphere.center[1]);
+           setF32(r, p + 8, f.sphere.center[2]);
+         });
+  g.refn(8503, "position-nan", "REFN: the y of vertex 2 is NaN",
+         [&](Bytes& r) { st32(r, positionsAt(r) + 12 * 2 + 4, 0x7FC00000u); });
+  g.refn(8503, "position-infinity", "REFN: the z of vertex 5 is +infinity",
+         [&](Bytes& r) { st32(r, positionsAt(r) + 12 * 5 + 8, 0x7F800000u); });
+  g.refn(
+      8503, "zstd-index-out-of-range", "zstd REFN whose first index is vertexCount (re-compressed)",
+      [&](Bytes& r) { st32(r, positionsAt(r) + 12 * uint64_t(ld32(r, 4)), ld32(r, 4)); }, RZ);
+
+  // The section table and codec, for REFN.
+  g.edit(4009, "refn-copy-safe", RF, "REFN flags 2 (COPY_SAFE) where the spec gives 0",
+         [&](Vff& v) { st32(v.b, v.entry(kTagRefinement) + 4, kSectionCopySafe); });
+  g.edit(4011, "refn-raw-size", RZ, "zstd REFN with rawSize 4 more than its frame declares", [&](Vff& v) {
+    if (ld16(v.b, v.entry(kTagRefinement) + 32) != 1) die("refn-raw-size: REFN is not zstd");
+    st64(v.b, v.entry(kTagRefinement) + 24, ld64(v.b, v.entry(kTagRefinement) + 24) + 4);
+  });
+}
+
 }  // namespace
 
 std::vector<InvalidCase> invalidCases(const std::map<std::string, BuiltValid>& valid) {
@@ -375,7 +467,23 @@ std::vector<InvalidCase> invalidCases(const std::map<std::string, BuiltValid>& v
   addPlanesAndBlocks(g);
   addFiltersAndFeatures(g);
   addLayoutAndMetadata(g);
-  return g.take();
+  addRefinement(g);
+  std::vector<InvalidCase> out = g.take();
+  // The reference decoder of REFN (gen_reference.h, from the spec's text) raises each 85xx vector's ID.
+  for (const InvalidCase& c : out) {
+    if (c.id / 100 != 85) continue;
+    const Vff v{c.bytes};
+    const uint64_t e = v.entry(kTagRefinement);
+    const auto stored = std::span<const uint8_t>(v.b).subspan(v.sec(kTagRefinement), v.secSize(kTagRefinement));
+    const Bytes raw = ld16(v.b, e + 32) == 1 ? zstdContent(stored) : Bytes(stored.begin(), stored.end());
+    ReferenceRefinement ref;
+    std::string why;
+    const uint32_t id = referenceDecodeRefinement(valid.at(c.base).c.field, raw, &ref, &why);
+    if (id != c.id)
+      fail("invalid/" + std::to_string(c.id) + "/" + c.name + ": the reference REFN decoder gives " +
+           std::to_string(id) + (id ? " (" + why + ")" : ""));
+  }
+  return out;
 }
 
 }  // namespace vff::gen

@@ -2,6 +2,8 @@
 #include "gen_reference.h"
 
 #include <algorithm>
+#include <bit>
+#include <cmath>
 
 namespace vff::gen {
 
@@ -135,6 +137,90 @@ bool sameLayout(const LayoutDesc& a, const LayoutDesc& b) {
   return a.target == b.target && a.gutter == b.gutter && a.tileSize == b.tileSize && a.tilesPerRow == b.tilesPerRow &&
          a.tilesPerColumn == b.tilesPerColumn && a.sliceWidth == b.sliceWidth && a.sliceHeight == b.sliceHeight &&
          a.sliceCount == b.sliceCount && a.maxTextureSize == b.maxTextureSize && a.maxLayers == b.maxLayers;
+}
+
+// ---- REFN, written from spec/format.md section 14 independently of libvff ---------------------------
+// Raw layout: u32 headerSize (64), u32 vertexCount V, u32 triangleCount T, f32 margin, u32
+// unsureTexels, 44 reserved zero bytes; U = ceil(mapCount * M^2 / 8) bytes of unsure bits (texel
+// x = (k * M + j) * M + i at bit x % 8 of byte x / 8); zero padding to a multiple of 4; 3V f32
+// positions; 3T u32 indices.
+namespace {
+uint64_t refnUnsureBytes(const FieldDesc& f) {
+  return (uint64_t(f.mapCount) * f.mapResolution * f.mapResolution + 7) / 8;
+}
+}  // namespace
+
+Bytes referenceRefinementBytes(const FieldDesc& f, const Refinement& r) {
+  const uint64_t u = refnUnsureBytes(f), posAt = 64 + alignUp(u, 4);
+  Bytes b(posAt + 4 * r.positions.size() + 4 * r.indices.size(), 0);
+  st32(b, 0, 64);
+  st32(b, 4, uint32_t(r.positions.size() / 3));
+  st32(b, 8, uint32_t(r.indices.size() / 3));
+  st32(b, 12, std::bit_cast<uint32_t>(r.margin));
+  st32(b, 16, r.unsureTexels);
+  std::copy(r.unsure.begin(), r.unsure.end(), b.begin() + 64);
+  for (size_t v = 0; v < r.positions.size(); ++v) st32(b, posAt + 4 * v, std::bit_cast<uint32_t>(r.positions[v]));
+  const uint64_t idxAt = posAt + 4 * r.positions.size();
+  for (size_t x = 0; x < r.indices.size(); ++x) st32(b, idxAt + 4 * x, r.indices[x]);
+  return b;
+}
+
+uint32_t referenceDecodeRefinement(const FieldDesc& f, std::span<const uint8_t> raw, ReferenceRefinement* out,
+                                   std::string* why) {
+  const Bytes b(raw.begin(), raw.end());
+  const auto bad = [&](uint32_t id, std::string text) {
+    *why = std::move(text);
+    return id;
+  };
+  // Rule 8501: bit1 fields have no REFN; the header; the total size.
+  if (f.distanceEncoding == DistanceEncoding::kBit1) return bad(8501, "REFN in a bit1 field");
+  if (b.size() < 64) return bad(8501, "REFN shorter than its 64-byte header");
+  if (ld32(b, 0) != 64) return bad(8501, "headerSize is not 64");
+  const uint32_t v = ld32(b, 4), t = ld32(b, 8);
+  const float margin = std::bit_cast<float>(ld32(b, 12));
+  if (v < 3 || t < 1) return bad(8501, "vertexCount < 3 or triangleCount < 1");
+  if (!std::isfinite(margin) || margin < 0) return bad(8501, "margin not finite or negative");
+  for (uint64_t at = 20; at < 64; ++at)
+    if (b[at] != 0) return bad(8501, "reserved byte " + std::to_string(at) + " is not zero");
+  const uint64_t u = refnUnsureBytes(f), p = alignUp(u, 4) - u;
+  const uint64_t posAt = 64 + u + p, idxAt = posAt + 12 * uint64_t(v);
+  if (b.size() != idxAt + 12 * uint64_t(t)) return bad(8501, "rawSize is not 64 + U + P + 12V + 12T");
+  // Rule 8502: the bits past the last texel and the padding are zero; unsureTexels counts the bits.
+  const uint64_t texels = uint64_t(f.mapCount) * f.mapResolution * f.mapResolution;
+  for (uint64_t x = texels; x < 8 * u; ++x)
+    if ((b[64 + x / 8] >> (x % 8)) & 1) return bad(8502, "bit " + std::to_string(x) + " past the last texel is set");
+  for (uint64_t at = 64 + u; at < posAt; ++at)
+    if (b[at] != 0) return bad(8502, "padding byte " + std::to_string(at) + " is not zero");
+  uint64_t set = 0;
+  for (uint64_t x = 0; x < texels; ++x) set += (b[64 + x / 8] >> (x % 8)) & 1;
+  if (set != ld32(b, 16)) return bad(8502, "unsureTexels is not the number of bits set");
+  // Rule 8503: positions finite and within (1 + 1e-4) R + 1e-6 of the centre; indices < V.
+  const double lim = double(f.sphere.radius) * (1 + 1e-4) + 1e-6;
+  std::vector<float> pos(3 * size_t(v));
+  for (size_t k = 0; k < pos.size(); ++k) pos[k] = std::bit_cast<float>(ld32(b, posAt + 4 * k));
+  for (size_t k = 0; k < v; ++k) {
+    double d2 = 0;
+    bool finite = true;
+    for (int a = 0; a < 3; ++a) {
+      const double d = double(pos[3 * k + a]) - double(f.sphere.center[a]);
+      finite = finite && std::isfinite(d);
+      d2 += d * d;
+    }
+    if (!finite || d2 > lim * lim) return bad(8503, "vertex " + std::to_string(k) + " not finite or outside the sphere");
+  }
+  std::vector<uint32_t> idx(3 * size_t(t));
+  for (size_t k = 0; k < idx.size(); ++k) {
+    idx[k] = ld32(b, idxAt + 4 * k);
+    if (idx[k] >= v) return bad(8503, "index " + std::to_string(k) + " is not below vertexCount");
+  }
+  out->vertexCount = v;
+  out->triangleCount = t;
+  out->margin = margin;
+  out->unsureTexels = ld32(b, 16);
+  out->unsure.assign(b.begin() + 64, b.begin() + std::ptrdiff_t(64 + u));
+  out->positions = std::move(pos);
+  out->indices = std::move(idx);
+  return 0;
 }
 
 }  // namespace vff::gen

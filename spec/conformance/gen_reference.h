@@ -1,10 +1,11 @@
 // gen_reference.h - what the conformance vectors must decode to, computed from spec/format.md
-// independently of libvff: the bc4-diameter decoder, the hits-med filter's stream, the packed slices
-// and the canonical layout (vff-conformance-gen only; see generate.cpp).
+// independently of libvff: the bc4-diameter decoder, the hits-med filter's stream, the packed slices,
+// the canonical layout and the REFN section (vff-conformance-gen only; see generate.cpp).
 #pragma once
 
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "gen_bytes.h"
@@ -31,5 +32,23 @@ std::vector<Bytes> composeSlices(const FieldDesc& f, const LayoutDesc& l, const 
 // The canonical layout, computed from spec/format.md's rule (checked against the writer's).
 LayoutDesc canonicalLayout(const FieldDesc& f, const LayoutLimits& lim);
 bool sameLayout(const LayoutDesc& a, const LayoutDesc& b);
+
+// REFN (spec/format.md section 14), written from the spec's text independently of libvff.
+struct ReferenceRefinement {
+  uint32_t vertexCount = 0, triangleCount = 0;
+  float margin = 0;
+  uint32_t unsureTexels = 0;
+  Bytes unsure;  // U = ceil(mapCount * M^2 / 8) bytes
+  std::vector<float> positions;
+  std::vector<uint32_t> indices;
+};
+// REFN's raw bytes (before its codec) for field `f`: the 64-byte header, the unsure bits, zero
+// padding to a multiple of 4, the positions and the indices. It does not check `r`.
+Bytes referenceRefinementBytes(const FieldDesc& f, const Refinement& r);
+// Decodes REFN's raw bytes for field `f` and checks rules 8501-8503 in the order of
+// spec/validation.md: 0 and *out filled when they hold, else the ID of the first rule broken (and
+// *why says how).
+uint32_t referenceDecodeRefinement(const FieldDesc& f, std::span<const uint8_t> raw, ReferenceRefinement* out,
+                                   std::string* why);
 
 }  // namespace vff::gen

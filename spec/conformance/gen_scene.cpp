@@ -1,9 +1,12 @@
 // gen_scene.cpp - the conformance vectors' source data (gen_scene.h).
 #include "gen_scene.h"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <span>
 #include <string>
+#include <utility>
 
 namespace vff::gen {
 
@@ -128,6 +131,64 @@ Content makeContent(const FieldDesc& f) {
     if (bc4) encodeBc4Map(std::span<const uint8_t>(c.codes).subspan(uint64_t(k) * m * m, uint64_t(m) * m), m, map);
   }
   return c;
+}
+
+Refinement makeRefinementSource(const FieldDesc& f, const Content& c, float margin, uint32_t level) {
+  Refinement r;
+  r.margin = margin;
+  const uint32_t m = f.mapResolution;
+  const uint64_t mapBytes = distanceMapBytes(f.distanceEncoding, m);
+  const bool bc4 = f.distanceEncoding == DistanceEncoding::kBc4Diameter;
+  const uint64_t texels = uint64_t(f.mapCount) * m * m;
+  r.unsure.assign((texels + 7) / 8, 0);
+  for (uint32_t k = 0; k < f.mapCount; ++k) {
+    const auto map = std::span<const uint8_t>(c.distance).subspan(k * mapBytes, mapBytes);
+    const auto hit = [&](int64_t i, int64_t j) {
+      const uint32_t code = bc4 ? c.codes[(uint64_t(k) * m + uint64_t(j)) * m + uint64_t(i)]
+                                : loadCode(f.distanceEncoding, map, m, uint32_t(i), uint32_t(j));
+      return code != (bc4 ? 255u : missCode(f.distanceEncoding));
+    };
+    for (int64_t j = 0; j < m; ++j)
+      for (int64_t i = 0; i < m; ++i) {
+        bool unsure = false;
+        for (const auto& [di, dj] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
+          const int64_t ni = i + di, nj = j + dj;
+          if (ni >= 0 && nj >= 0 && ni < m && nj < m && hit(ni, nj) != hit(i, j)) unsure = true;
+        }
+        if (!unsure) continue;
+        const uint64_t x = (uint64_t(k) * m + uint64_t(j)) * m + uint64_t(i);
+        r.unsure[x / 8] = uint8_t(r.unsure[x / 8] | 1u << (x % 8));
+        ++r.unsureTexels;
+      }
+  }
+  // The octahedron: +x, -x, +y, -y, +z, -z; faces counter-clockwise seen from outside.
+  std::vector<D3> dirs = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  std::vector<uint32_t> tris = {0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5};
+  for (uint32_t l = 0; l < level; ++l) {
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
+    const auto midpoint = [&](uint32_t a, uint32_t b) {
+      const auto key = std::minmax(a, b);
+      auto it = mid.find(key);
+      if (it != mid.end()) return it->second;
+      dirs.push_back(normalize(dirs[a] + dirs[b]));
+      return mid[key] = uint32_t(dirs.size() - 1);
+    };
+    std::vector<uint32_t> next;
+    for (size_t t = 0; t < tris.size(); t += 3) {
+      const uint32_t a = tris[t], b = tris[t + 1], cc = tris[t + 2];
+      const uint32_t ab = midpoint(a, b), bc = midpoint(b, cc), ca = midpoint(cc, a);
+      next.insert(next.end(), {a, ab, ca, ab, b, bc, ca, bc, cc, ab, bc, ca});
+    }
+    tris = std::move(next);
+  }
+  const double rr = f.sphere.radius;
+  const D3 inner = D3{f.sphere.center[0], f.sphere.center[1], f.sphere.center[2]} + D3{0.10, -0.08, 0.12} * rr;
+  for (const D3& d : dirs) {
+    const D3 p = inner + d * (0.7 * rr);
+    r.positions.insert(r.positions.end(), {float(p.x), float(p.y), float(p.z)});
+  }
+  r.indices = std::move(tris);
+  return r;
 }
 
 }  // namespace vff::gen

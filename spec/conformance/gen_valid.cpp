@@ -106,6 +106,27 @@ std::vector<ValidCase> validCases() {
                "(4x4 tiles, 2 slices, the second with 6 unused tiles)",
                makeField(DE::kBc4Diameter, NE::kOctSnorm16, PS::kOctaHemi2, 2, DS::kConcentricEqualArea, 16, unitish),
                makeOptions(Codec::kZstd, LT::kTexture2DArray, 0, 64, 0)});
+  // Format 1.3: REFN (spec/format.md section 14). The first has 3 padding bytes after its 41 bytes of
+  // unsure bits and 4 unused bits in the last of them; the second is compressed, after META and NORM.
+  v.push_back({"u8d-refined",
+               "format 1.3: unorm8-diameter, stored, ea-octa-grid n=3 (9 maps of 6x6), one block; REFN stored: "
+               "margin 0.1875, the silhouette texels unsure (41 bytes of bits, 3 padding bytes), an octahedron "
+               "(6 vertices, 8 triangles)",
+               makeField(DE::kUnorm8Diameter, NE::kNone, PS::kEqualAreaOctaGrid, 3, DS::kConcentricEqualArea, 6,
+                         unitish),
+               makeOptions(Codec::kStored, LT::kTexture2DArray, 0, 2048, 0)});
+  v.back().refined = true;
+  v.back().margin = 0.1875f;
+  v.push_back({"u8c-zstd-normals-meta-refined",
+               "format 1.3: unorm8-chord, zstd, normals, zstd metadata, fibonacci n=7 (7 maps of 8x8), "
+               "hemi-octahedral, 4 maps per block (last block 3); REFN zstd: margin 0, the silhouette texels "
+               "unsure, an octahedron split once (18 vertices, 32 triangles)",
+               makeField(DE::kUnorm8Chord, NE::kOctSnorm16, PS::kSphericalFibonacci, 7, DS::kHemiOctahedral, 8,
+                         {{0.5f, -1.0f, 2.0f}, 2.0f}),
+               makeOptions(Codec::kZstd, LT::kTexture2DArray, 0, 2048, 4), true});
+  v.back().refined = true;
+  v.back().margin = 0.0f;
+  v.back().meshLevel = 1;
   ValidCase unknownOptional = v[0];
   unknownOptional.name = "unknown-section-optional";
   unknownOptional.description = "u8d-stored plus an unknown section 'XTST' with flags 0 (a reader skips it)";
@@ -162,6 +183,10 @@ BuiltValid buildValid(const ValidCase& c) {
   v.content = makeContent(c.field);
   WriteOptions wo = c.options;
   if (c.metadata) wo.metadataJson = metadataFor(c);
+  if (c.refined) {
+    v.refinement = makeRefinementSource(c.field, v.content, c.margin, c.meshLevel);
+    wo.refinement = v.refinement.view();
+  }
   auto bytes = writeMemory(c.field, v.content.distance, v.content.normals, wo);
   if (!bytes) die(c.name + ": writeMemory failed: " + bytes.error().toString());
   Vff f{std::move(*bytes)};
@@ -210,6 +235,13 @@ void checkReadBack(const BuiltValid& v) {
     }
     if (!sameLayout(f->layout(), v.layout)) fail(n + ": the file's layout differs from the canonical layout");
     if (std::string(f->metadata()) != v.metadata) fail(n + ": metadata differs");
+    const RefinementView& r = f->refinement();
+    const Refinement& want = v.refinement;
+    if (r.empty() != !v.c.refined || r.margin != want.margin || r.unsureTexels != want.unsureTexels ||
+        !std::equal(r.unsure.begin(), r.unsure.end(), want.unsure.begin(), want.unsure.end()) ||
+        !std::equal(r.positions.begin(), r.positions.end(), want.positions.begin(), want.positions.end()) ||
+        !std::equal(r.indices.begin(), r.indices.end(), want.indices.begin(), want.indices.end()))
+      fail(n + ": File::refinement() differs from the source refinement");
     for (Plane p : {Plane::kDistance, Plane::kNormal}) {
       if (p == Plane::kNormal && !f->hasNormals()) continue;
       const Bytes& src = p == Plane::kDistance ? v.content.distance : v.content.normals;
@@ -278,6 +310,36 @@ void checkBc4(const BuiltValid& v) {
   if (worst > 8) fail(n + ": a BC4 texel is " + std::to_string(worst) + " codes from the code it was made from");
 }
 
+// REFN (format 1.3): the last section, flags 0, with the vector's codec; its raw bytes are exactly
+// what the reference encoder makes from the source, and the reference decoder (both written from
+// spec/format.md section 14) reads the source back from them.
+void checkRefinement(const BuiltValid& v, const Vff& file) {
+  const std::string& n = v.c.name;
+  if (ld16(v.bytes, 10) != 3) fail(n + ": a file with REFN must be version 1.3");
+  if (file.indexOf(kTagRefinement) != int(file.count()) - 1) fail(n + ": REFN is not the last section");
+  const uint64_t e = file.entry(kTagRefinement);
+  if (ld32(v.bytes, e + 4) != 0) fail(n + ": REFN flags are not 0");
+  const uint16_t codec = ld16(v.bytes, e + 32);
+  if (codec != uint16_t(v.c.options.codec)) fail(n + ": REFN is not written with the vector's codec");
+  if (codec == 1 && !(ld64(v.bytes, 24) & kFeatureZstd)) fail(n + ": a zstd REFN without the zstd feature bit");
+  const auto stored = std::span<const uint8_t>(v.bytes).subspan(file.sec(kTagRefinement), file.secSize(kTagRefinement));
+  const Bytes raw = codec == 1 ? zstdContent(stored) : Bytes(stored.begin(), stored.end());
+  if (raw.size() != ld64(v.bytes, e + 24)) fail(n + ": REFN rawSize differs from its content");
+  if (raw != referenceRefinementBytes(v.c.field, v.refinement))
+    fail(n + ": REFN's bytes differ from the reference encoding of the source");
+  ReferenceRefinement ref;
+  std::string why;
+  if (const uint32_t id = referenceDecodeRefinement(v.c.field, raw, &ref, &why); id != 0)
+    fail(n + ": the reference decoder rejects REFN with " + std::to_string(id) + ": " + why);
+  else if (ref.margin != v.refinement.margin || ref.unsureTexels != v.refinement.unsureTexels ||
+           ref.unsure != v.refinement.unsure || ref.positions != v.refinement.positions ||
+           ref.indices != v.refinement.indices)
+    fail(n + ": the reference decoder reads REFN differently from the source");
+  const uint64_t texels = uint64_t(v.c.field.mapCount) * v.c.field.mapResolution * v.c.field.mapResolution;
+  if (v.refinement.unsureTexels == 0 || v.refinement.unsureTexels >= texels)
+    fail(n + ": the refinement needs both sure and unsure texels");
+}
+
 }  // namespace
 
 void checkValid(const BuiltValid& v) {
@@ -296,12 +358,17 @@ void checkValid(const BuiltValid& v) {
     if (!anyZstdBlock) fail(n + ": a zstd vector without any zstd block");
     if (v.c.metadata && ld16(v.bytes, file.entry(kTagMetadata) + 32) != 1) fail(n + ": metadata was not compressed");
   }
+  if (v.c.refined) {
+    checkRefinement(v, file);
+  } else if (file.indexOf(kTagRefinement) >= 0) {
+    fail(n + ": REFN in a vector that is not refined");
+  }
   if (v.c.options.filter == Filter::kHitsMed) {
     checkHitsMed(v, file);
   } else if (v.c.field.distanceEncoding == DistanceEncoding::kBc4Diameter) {
     checkBc4(v);
-  } else if (ld16(v.bytes, 10) != 0) {
-    fail(n + ": a file without 1.1 or 1.2 features must be version 1.0");
+  } else if (ld16(v.bytes, 10) != (v.c.refined ? 3 : 0)) {
+    fail(n + ": a file without 1.1, 1.2 or 1.3 features must be version 1.0");
   }
   if (v.content.hits == 0 || v.content.misses == 0) fail(n + ": the content needs both hits and misses");
 }

@@ -25,6 +25,12 @@ struct ValidCase {
   bool metadata = false;
   Post post = Post::kNone;
   std::string metaText{};  // kMetaText only
+  // Format 1.3: a REFN section (spec/format.md section 14) with this margin, the generator's own
+  // unsure bits (refinementFor) and the octahedron of the scene's inner sphere, subdivided
+  // `meshLevel` times. Written with WriteOptions::codec.
+  bool refined = false;
+  float margin = 0;
+  uint32_t meshLevel = 0;
 };
 
 struct BuiltValid {
@@ -34,6 +40,7 @@ struct BuiltValid {
   std::string metadata;  // canonical text; for Post::kMetaText the stored text as it is
   Bytes bytes;
   bool zstd = false;
+  Refinement refinement;  // the source of REFN (empty unless c.refined)
 };
 
 // Every valid vector, in the order they are written.

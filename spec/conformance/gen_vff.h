@@ -146,6 +146,19 @@ struct Vff {
     sealAll();
   }
 
+  // Replaces the stored bytes of section `tag`, which must be the file's last section, with `stored`
+  // and its rawSize with `rawSize`: the file's size follows, and everything is re-sealed.
+  void replaceLastSection(uint32_t tag, std::span<const uint8_t> stored, uint64_t rawSize) {
+    const uint64_t e = entry(tag), off = sec(tag);
+    if (off + secSize(tag) != b.size()) die("replaceLastSection: '" + sectionTagName(tag) + "' is not the last section");
+    b.resize(off);
+    b.insert(b.end(), stored.begin(), stored.end());
+    st64(b, e + 16, stored.size());
+    st64(b, e + 24, rawSize);
+    setFileSize();
+    sealAll();
+  }
+
   // Replaces a stored section's bytes (it must keep fitting before the next section).
   void replaceStored(uint32_t tag, std::string_view text) {
     const uint64_t e = entry(tag), off = sec(tag), old = secSize(tag);

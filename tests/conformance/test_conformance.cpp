@@ -3,7 +3,8 @@
 // without rebuilding still runs, and an empty folder fails VectorSetIsComplete).
 //
 //   valid/NAME.vff     opens under every checksum policy, validates with no error (and exactly the
-//                      expected warnings), and decodes to NAME.expected.json.
+//                      expected warnings), and decodes to NAME.expected.json (REFN, format 1.3,
+//                      included: File::refinement()).
 //   invalid/ID/*.vff   raises ID in the validator and is rejected by File::openMemory with ID (or, for
 //                      the checks only the validator or a read makes, as its .expect.json records);
 //                      libvff's whole observed behaviour equals the .expect.json.
@@ -186,6 +187,42 @@ void checkContent(const File& f, const json& e, bool decode) {
   }
 }
 
+// REFN (format 1.3): File::refinement() against "refinement", which only a refined vector has.
+void checkRefinement(const File& f, const json& e) {
+  const RefinementView& r = f.refinement();
+  if (!e.contains("refinement")) {
+    EXPECT_TRUE(r.empty()) << "a refinement in a file without REFN";
+    return;
+  }
+  const json& er = e["refinement"];
+  ASSERT_FALSE(r.empty()) << "no refinement";
+  EXPECT_EQ(r.margin, er["margin"].get<float>());
+  EXPECT_EQ(r.unsureTexels, er["unsureTexels"]);
+  ASSERT_EQ(r.unsure.size(), er["unsureBytes"]);
+  EXPECT_EQ(hex64(r.unsure), er["unsureXxh3"]);
+  const FieldDesc& fd = f.field();
+  const uint64_t mm = uint64_t(fd.mapResolution) * fd.mapResolution;
+  ASSERT_EQ(er["unsure"].size(), fd.mapCount);
+  uint64_t count = 0;
+  for (uint32_t k = 0; k < fd.mapCount; ++k) {
+    json got = json::array();
+    for (uint64_t t = 0; t < mm; ++t)
+      if (r.isUnsure(k * mm + t)) got.push_back(t);
+    EXPECT_EQ(got, er["unsure"][k]) << "the unsure texels of map " << k;
+    count += got.size();
+  }
+  EXPECT_EQ(count, r.unsureTexels);
+  ASSERT_EQ(r.positions.size(), 3 * er["vertexCount"].get<uint64_t>());
+  ASSERT_EQ(r.indices.size(), 3 * er["triangleCount"].get<uint64_t>());
+  // (little-endian hosts: the bytes as REFN stores them)
+  EXPECT_EQ(hex64({reinterpret_cast<const uint8_t*>(r.positions.data()), r.positions.size() * 4}), er["positionsXxh3"]);
+  EXPECT_EQ(hex64({reinterpret_cast<const uint8_t*>(r.indices.data()), r.indices.size() * 4}), er["indicesXxh3"]);
+  for (size_t v = 0; v < r.positions.size() / 3; ++v)
+    for (size_t a = 0; a < 3; ++a) EXPECT_EQ(r.positions[3 * v + a], er["positions"][v][a].get<float>()) << "vertex " << v;
+  for (size_t t = 0; t < r.indices.size() / 3; ++t)
+    for (size_t a = 0; a < 3; ++a) EXPECT_EQ(r.indices[3 * t + a], er["indices"][t][a]) << "triangle " << t;
+}
+
 class ValidVector : public ::testing::TestWithParam<Vector> {};
 
 TEST_P(ValidVector, OpensValidatesAndDecodes) {
@@ -249,6 +286,7 @@ TEST_P(ValidVector, OpensValidatesAndDecodes) {
       ASSERT_EQ(pi.blocks.size(), ep["blockCodecs"].size());
       for (size_t b = 0; b < pi.blocks.size(); ++b) EXPECT_EQ(codecName(pi.blocks[b].codec), ep["blockCodecs"][b]);
     }
+    checkRefinement(*f, e);
     checkContent(*f, e, /*decode=*/policy == ChecksumPolicy::kVerifyAll);
   }
 }

@@ -1,6 +1,6 @@
-// container.js - opening a .vff: the header, the section table, FDSC, LAYT, the plane indexes and
-// META, checked in the order of spec/validation.md sections 4 to 8 (a first-error reader), plus the
-// validator-only checks of section 9 (padding, block decoding, normals of misses) on request.
+// container.js - opening a .vff: the header, the section table, FDSC, LAYT, the plane indexes, META
+// and REFN (1.3), checked in the order of spec/validation.md sections 4 to 8 (a first-error reader),
+// plus the validator-only checks of section 9 (padding, block decoding, normals of misses) on request.
 import { ByteReader, alignUp, hex64 } from './bytes.js';
 import { xxh3Hex } from './checksum.js';
 import { VffError, require } from './errors.js';
@@ -11,7 +11,7 @@ import { VffFile } from './file.js';
 
 export const MAGIC = [0x89, 0x56, 0x46, 0x46, 0x0d, 0x0a, 0x1a, 0x0a];
 /** Tag -> its defined flags (format.md section 3). */
-const KNOWN = { FDSC: 1, LAYT: 1, META: 2, DIST: 1, NORM: 0 };
+const KNOWN = { FDSC: 1, LAYT: 1, META: 2, DIST: 1, NORM: 0, REFN: 0 };
 const PLANES = new Set(['DIST', 'NORM']);
 
 /** The reader limits of spec/validation.md section 10, and the checksum policy. */
@@ -242,6 +242,48 @@ function readMeta(r, s) {
 }
 
 /**
+ * REFN (format.md section 14, rules 8501-8503 in the order of validation.md): the margin, the count
+ * and bytes of unsure bits (texel (k * M + j) * M + i at bit x % 8 of byte x / 8), the vertex
+ * positions and the triangles' indices. Problems are at the byte for a stored section, else at it.
+ */
+function readRefinement(r, s, field) {
+  const b = sectionBytes(r, s);
+  const at = (o) => ({ section: 'REFN', offset: s.codec === 0 ? s.offset + o : s.offset });
+  require(field.distanceEncoding !== 4, 8501, 'a bit1 field has no distances to refine: it cannot have REFN', at(0));
+  require(b.length >= 64, 8501, `REFN holds ${b.length} bytes, less than its 64-byte header`, at(0));
+  const h = new ByteReader(b);
+  require(h.u32(0) === 64, 8501, `headerSize ${h.u32(0)}, expected 64`, at(0));
+  const V = h.u32(4), T = h.u32(8), margin = h.f32(12), unsureTexels = h.u32(16);
+  require(V >= 3 && T >= 1, 8501, `vertexCount ${V} and triangleCount ${T}: at least 3 and 1`, at(4));
+  require(Number.isFinite(margin) && margin >= 0, 8501, `margin ${margin} is not a finite number >= 0`, at(12));
+  for (let o = 20; o < 64; ++o) require(b[o] === 0, 8501, 'reserved REFN header bytes are not zero', at(o));
+  const texels = field.mapCount * field.mapResolution * field.mapResolution;
+  const U = Math.ceil(texels / 8), posAt = 64 + alignUp(U, 4), idxAt = posAt + 12 * V, size = idxAt + 12 * T;
+  require(b.length === size, 8501, `REFN holds ${b.length} bytes; its header and the field give ${size}`, at(4));
+  let set = 0;
+  for (let i = 0; i < U; ++i) {
+    const v = b[64 + i];
+    require(!(i === U - 1 && texels % 8 && v >> (texels % 8)), 8502, 'bits past the last texel are not zero', at(64 + i));
+    for (let x = v; x; x &= x - 1) ++set;
+  }
+  for (let o = 64 + U; o < posAt; ++o) require(b[o] === 0, 8502, 'padding after the unsure bits is not zero', at(o));
+  require(set === unsureTexels, 8502, `unsureTexels ${unsureTexels}, ${set} bits are set`, at(16));
+  const positions = new Float32Array(3 * V), indices = new Uint32Array(3 * T);
+  for (let i = 0; i < 3 * V; ++i) positions[i] = h.f32(posAt + 4 * i);
+  const c = field.sphere.center, lim = field.sphere.radius * (1 + 1e-4) + 1e-6;
+  for (let v = 0; v < V; ++v) {
+    const x = positions[3 * v] - c[0], y = positions[3 * v + 1] - c[1], z = positions[3 * v + 2] - c[2];
+    require(Number.isFinite(x) && Number.isFinite(y) && Number.isFinite(z) && x * x + y * y + z * z <= lim * lim, 8503,
+      `vertex ${v} is not finite or lies outside the field's bounding sphere`, at(posAt + 12 * v));
+  }
+  for (let i = 0; i < 3 * T; ++i) {
+    indices[i] = h.u32(idxAt + 4 * i);
+    require(indices[i] < V, 8503, `triangle ${Math.floor(i / 3)} names vertex ${indices[i]} of ${V}`, at(idxAt + 4 * i));
+  }
+  return { margin, unsureTexels, unsure: b.slice(64, 64 + U), positions, indices };
+}
+
+/**
  * Opens a .vff held in memory: runs every reader check of spec/validation.md sections 4 to 8 and
  * throws the first problem as a VffError. Blocks are decoded when first read (rule 6010 then).
  * Requires `await initChecksums()` first.
@@ -263,5 +305,6 @@ export function openVff(data, options = {}) {
     field.normalEncoding ? 'normalEncoding is set but there is no NORM section' : 'a NORM section without normalEncoding');
   if (byTag.NORM) planes.normal = readPlane(r, byTag.NORM, field, header, opt, false);
   const metadata = byTag.META ? readMeta(r, byTag.META) : null;
-  return new VffFile({ reader: r, options: opt, header, sections, field, layout, planes, metadata, warnings });
+  const refinement = byTag.REFN ? readRefinement(r, byTag.REFN, field) : null;
+  return new VffFile({ reader: r, options: opt, header, sections, field, layout, planes, metadata, refinement, warnings });
 }

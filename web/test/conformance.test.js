@@ -44,6 +44,8 @@ export function checkValid(file, bytes, exp) {
     assert.deepEqual(mine.blocks.map((b) => (b.codec ? 'zstd' : 'stored')), p.blockCodecs);
     if (p.blockFilters) assert.deepEqual(mine.blocks.map((b) => (b.filter ? 'hits-med' : 'none')), p.blockFilters);
   }
+  if (exp.refinement === undefined) assert.equal(file.refinement, null);
+  else checkRefinement(file.refinement, exp.refinement, f);
   const M = f.mapResolution;
   for (const m of exp.maps) {
     assert.equal(xxh3Hex(file.mapBytes('distance', m.map)), m.distanceXxh3, `map ${m.map} distance bytes`);
@@ -64,6 +66,28 @@ export function checkValid(file, bytes, exp) {
   }
   for (const [name, hashes] of Object.entries(exp.slices))
     hashes.forEach((hx, s) => assert.equal(xxh3Hex(file.slice(name, s)), hx, `${name} slice ${s}`));
+}
+
+/** REFN (format 1.3) against the expected.json's "refinement". */
+function checkRefinement(r, er, f) {
+  assert.ok(r, 'no refinement');
+  assert.equal(r.margin, Math.fround(er.margin));
+  assert.equal(r.unsureTexels, er.unsureTexels);
+  assert.equal(r.unsure.length, er.unsureBytes);
+  assert.equal(xxh3Hex(r.unsure), er.unsureXxh3);
+  const MM = f.mapResolution * f.mapResolution;
+  er.unsure.forEach((want, k) => {
+    const got = [];
+    for (let t = 0; t < MM; ++t) if ((r.unsure[(k * MM + t) >> 3] >> ((k * MM + t) & 7)) & 1) got.push(t);
+    assert.deepEqual(got, want, `the unsure texels of map ${k}`);
+  });
+  assert.equal(er.unsure.length, f.mapCount);
+  assert.equal(r.positions.length, 3 * er.vertexCount);
+  assert.equal(r.indices.length, 3 * er.triangleCount);
+  assert.equal(xxh3Hex(new Uint8Array(r.positions.buffer, r.positions.byteOffset, r.positions.byteLength)), er.positionsXxh3);
+  assert.equal(xxh3Hex(new Uint8Array(r.indices.buffer, r.indices.byteOffset, r.indices.byteLength)), er.indicesXxh3);
+  er.positions.forEach((p, v) => p.forEach((c, a) => assert.equal(r.positions[3 * v + a], Math.fround(c), `vertex ${v}`)));
+  er.indices.forEach((t, i) => t.forEach((c, a) => assert.equal(r.indices[3 * i + a], c, `triangle ${i}`)));
 }
 
 /** The first validation ID a reader raises for the bytes (open, then read everything), or 0. */
