@@ -161,4 +161,54 @@ test_stale_temporaries_of_dead_processes_are_removed() {
   valid "$WORK/out.vff"
 }
 
+# ---- Refined fields (--refine: section REFN, format 1.3) -----------------------------------------
+# A refined bake: format 1.3 with a REFN section holding the mesh, the same bytes on 1 and 2 threads
+# (with and without probes), the plain bake's maps; and the options that do not go with it.
+test_refine_writes_refn_deterministically() {
+  knot
+  bake "$WORK/knot.obj" -o "$WORK/plain.vff" -n 4 -m 16 -q
+  expect_rc 0
+  bake "$WORK/knot.obj" -o "$WORK/r1.vff" -n 4 -m 16 --refine -j 1
+  expect_rc 0
+  expect_err_re "refined: [0-9]+ of 20992 texels unsure \([0-9.]+%\), [0-9]+ vertices and [0-9]+ triangles"
+  bake "$WORK/knot.obj" -o "$WORK/r2.vff" -n 4 -m 16 --refine -j 2 -q
+  expect_rc 0
+  cmp "$WORK/r1.vff" "$WORK/r2.vff" || fail "--refine depends on the thread count"
+  bake "$WORK/knot.obj" -o "$WORK/p1.vff" -n 4 -m 16 --refine --refine-probe -j 1 -q
+  bake "$WORK/knot.obj" -o "$WORK/p2.vff" -n 4 -m 16 --refine --refine-probe -j 2 -q
+  cmp "$WORK/p1.vff" "$WORK/p2.vff" || fail "--refine-probe depends on the thread count"
+  cmp -s "$WORK/p1.vff" "$WORK/r1.vff" && fail "--refine-probe marks the same texels as --refine"
+  run "$VFF_INSPECT" "$WORK/r1.vff" --format json --validate
+  expect_rc 0
+  expect_out '"version": "1.3"'
+  expect_out '"REFN"'
+  run "$VFF_INSPECT" "$WORK/plain.vff" --format json
+  expect_out '"version": "1.0"'
+  # The refined file's maps are the plain bake's: the same distance plane, byte for byte.
+  run "$VFF_INSPECT" "$WORK/plain.vff" --format json
+  mv "$WORK/out" "$WORK/plain.json"
+  run "$VFF_INSPECT" "$WORK/r1.vff" --format json
+  python3 - "$WORK/plain.json" "$WORK/out" <<'PY' || fail "--refine changed the maps"
+import json, sys
+a, b = (json.load(open(p)) for p in sys.argv[1:])
+dist = lambda d: next(s["checksum"] for s in d["sections"] if s["tag"] == "DIST")
+assert dist(a) == dist(b) and a["statistics"] == b["statistics"], "maps differ"
+assert a["refinement"] is None and b["refinement"]["triangles"] == 8192, b["refinement"]
+PY
+}
+
+test_refine_with_options_that_do_not_fit_is_a_usage_error() {
+  knot
+  bake "$WORK/knot.obj" -o "$WORK/x.vff" -n 1 -m 8 --refine-probe
+  expect_rc 1
+  expect_err "--refine-probe goes with --refine"
+  bake "$WORK/knot.obj" -o "$WORK/x.vff" -n 1 -m 8 --refine --encoding bit1
+  expect_rc 1
+  expect_err "--refine needs distances; --encoding bit1 has none"
+  bake "$WORK/knot.obj" -o "$WORK/x.vff" -n 1 -m 8 --refine --map-range 0:4
+  expect_rc 1
+  expect_err "--refine needs every map"
+  [[ ! -e $WORK/x.vff ]] || fail "output left behind"
+}
+
 run_test "$1"

@@ -41,6 +41,8 @@ struct Options {
   cli::EnumOption<DistanceEncoding> encoding{"--encoding", vff::kDistanceEncodings,
                                              DistanceEncoding::kUnorm8Diameter};
   bool normals = false;
+  bool refine = false;       // --refine: the REFN section (vff/refine.h)
+  bool refineProbe = false;  // --refine-probe: RefineOptions::probe
   unsigned threads = 0;
   std::vector<float> center;
   float radius = 0;

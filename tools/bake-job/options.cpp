@@ -48,6 +48,10 @@ void addOptions(CLI::App& app, Options& o) {
   o.directions.add(app, "hemisphere-to-square map")->capture_default_str();
   o.encoding.add(app, "distance encoding")->capture_default_str();
   app.add_flag("--normals", o.normals, "also store the surface normal at each hit (4 bytes per ray)");
+  app.add_flag("--refine", o.refine, "also store the unsure texels and the mesh's triangles (section REFN, format "
+               "1.3): a reader answers the rays the maps are unsure of exactly (Reconstruction::kRefined)");
+  app.add_flag("--refine-probe", o.refineProbe, "with --refine: keep a texel unsure only when a ray through a corner "
+               "of its cell meets the mesh otherwise than the texel says (fewer exact rays, a few more wrong answers)");
   app.add_option("-j,--threads", o.threads, "baking threads (0: all cores); the output does not depend on it")
       ->capture_default_str();
   app.add_option("--center", o.center, "bounding-sphere centre x y z (default: minimal enclosing sphere)")
@@ -76,7 +80,7 @@ void addOptions(CLI::App& app, Options& o) {
 std::optional<std::string> checkMergeOptions(const CLI::App& app) {
   if (app.count("mesh")) return "--merge takes partial results, not a mesh";
   for (const char* name : {"--grid", "--scene", "--split", "--positions", "--count", "--map-size", "--directions",
-                           "--encoding", "--normals", "--center", "--radius", "--allow-clipped-sphere", "--codec",
+                           "--encoding", "--normals", "--refine", "--refine-probe", "--center", "--radius", "--allow-clipped-sphere", "--codec",
                            "--zstd-level", "--maps-per-block", "--target", "--max-texture-size", "--max-layers",
                            "--gutter", "--benchmark", "--repeat", "--map-range"})
     if (app.count(name)) return std::string("--merge takes every bake option from its parts: ") + name + " does not apply";
@@ -93,6 +97,15 @@ std::optional<std::string> checkOptions(const Options& o) {
     if (isVdbPath(o.mesh)) return "--map-range applies to a mesh bake, not to a .vdb level set";
   }
   if (o.output.empty() && !o.benchmark) return "an output file is required (-o FILE), unless --benchmark is given";
+  if (o.refineProbe && !o.refine) return "--refine-probe goes with --refine";
+  if (o.refine) {
+    if (isVdbPath(o.mesh)) return "--refine stores a mesh's triangles; a .vdb level set has none";
+    if (isGltfPath(o.mesh) && (!o.split.empty() || isGlbPath(o.output)))
+      return "--refine applies to one field in a .vff file, not to --split or a .glb output";
+    if (!o.mapRange.empty()) return "--refine needs every map; it does not apply to --map-range";
+    if (o.allowClippedSphere) return "--refine stores the triangles inside the sphere: --allow-clipped-sphere does not apply";
+    if (o.encoding.value() == DistanceEncoding::kBit1) return "--refine needs distances; --encoding bit1 has none";
+  }
   if ((!o.center.empty()) != (o.radius > 0)) return "--center and --radius go together (radius > 0)";
   if (o.allowClippedSphere && o.center.empty()) return "--allow-clipped-sphere needs --center and --radius";
   if (isVdbPath(o.mesh)) {

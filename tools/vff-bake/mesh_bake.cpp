@@ -232,6 +232,20 @@ int bakeFromMesh(const Options& o, bake::BakeOptions bo, WriteOptions wo) {
   if (writer && range) {
     if (auto rc = writePartial(o, *writer, *field, *range, *baked, &m.write, &m.fileBytes)) return *rc;
   } else if (writer) {
+    if (o.refine) {
+      t0 = std::chrono::steady_clock::now();
+      auto r = makeRefinement(*field, baked->distance, mesh->positions, mesh->indices,
+                              {.probe = o.refineProbe, .threads = o.threads});
+      if (!r) return cli::reportError(kProg, o.mesh, r.error());
+      if (Status st = writer->setRefinement(r->view()); !st) return cli::reportError(kProg, o.output, st.error());
+      if (!o.quiet)
+        std::fprintf(stderr, "%s: refined: %u of %llu texels unsure (%.2f%%), %zu vertices and %zu triangles for the "
+                             "exact step, in %.2f s\n",
+                     kProg, r->unsureTexels, static_cast<unsigned long long>(uint64_t(field->mapCount) *
+                                                                             field->mapResolution * field->mapResolution),
+                     100.0 * r->unsureTexels / (double(field->mapCount) * field->mapResolution * field->mapResolution),
+                     mesh->vertexCount(), mesh->triangleCount(), secondsSince(t0));
+    }
     if (auto rc = writeBaked(o, o.output, *writer, *baked, &m.write, &m.fileBytes)) return *rc;
   }
   reportMeshBake(o, bo, *mesh, *scene, *field, baked->stats, m, writer.has_value());
