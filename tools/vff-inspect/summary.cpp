@@ -228,6 +228,18 @@ json summarize(const File& file, const ChecksumState& checksums, const DistanceS
       {"misses", stats.misses},   {"bins", bins},
   };
 
+  // REFN (format 1.3, vff/refine.h): what the exact step holds.
+  if (const RefinementView& r = file.refinement(); r.empty()) {
+    doc["refinement"] = nullptr;
+  } else {
+    const double texels = double(field.mapCount) * field.mapResolution * field.mapResolution;
+    doc["refinement"] = {{"margin", r.margin},
+                         {"unsureTexels", r.unsureTexels},
+                         {"unsureShare", texels > 0 ? double(r.unsureTexels) / texels : 0.0},
+                         {"vertices", r.positions.size() / 3},
+                         {"triangles", r.indices.size() / 3}};
+  }
+
   const std::string_view meta = file.metadata();
   if (meta.empty()) {
     doc["metadata"] = nullptr;

@@ -183,6 +183,11 @@ void printSummary(const json& doc, std::FILE* out) {
     }
   }
 
+  if (const json& r = doc["refinement"]; r.is_object())
+    std::fprintf(out, "\nrefinement:  %" PRIu64 " unsure texels (%s%%), margin %s R; exact step: %" PRIu64
+                      " vertices, %" PRIu64 " triangles\n",
+                 u64(r["unsureTexels"]), num(100 * r["unsureShare"].get<double>(), 2).c_str(),
+                 num(r["margin"].get<double>(), 4).c_str(), u64(r["vertices"]), u64(r["triangles"]));
   std::fprintf(out, "\nmetadata:");
   if (doc["metadata"].is_null())
     std::fprintf(out, " none\n");
