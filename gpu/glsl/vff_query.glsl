@@ -21,6 +21,7 @@
 //   VffHit vffIntersectInterpolated(...)  Reconstruction::kInterpolated (the miss-aware blend).
 //   float vffVisibility(...)  kInterpolated FieldQuery::visibility: the unoccluded share in [0, 1].
 //   VffHit vffQuery(..., bool interpolated, out float visibility)  the core of all four.
+// vff_refine.glsl, pasted after this file: vffIntersectRefined, vffOccludedRefined (kRefined).
 // A hit carries the object-space normal (hasNormal) when the field has a normal plane.
 //
 // Several fields at once (gpu/glsl/vff_scene.glsl): every lookup step reads its field through

@@ -18,7 +18,9 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <random>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -26,7 +28,9 @@
 
 #include "vff/encoding.h"
 #include "vff/gl/loader.h"
+#include "vff/gl/refine_loader.h"
 #include "vff/gl/scene_loader.h"
+#include "vff/refine.h"
 #include "vff/vff.h"
 
 namespace vff {
@@ -155,15 +159,22 @@ TEST(GlslConstants, FormatValuesMatchTheCppHeaders) {
 TEST(GlslConstants, DefaultBindingsMatchLoaderBindings) {
   static const std::regex define(R"(^#define (VFF_[A-Z]+_BINDING) ([0-9]+)$)");
   std::map<std::string, uint32_t> found;
-  for (const std::string& line : glslLines()) {
-    std::smatch m;
-    if (std::regex_match(line, m, define)) found[m[1]] = uint32_t(std::stoul(m[2]));
-  }
+  for (const char* file : {"vff_query.glsl", "vff_refine.glsl"})
+    for (const std::string& line : glslLines(file)) {
+      std::smatch m;
+      if (std::regex_match(line, m, define)) found[m[1]] = uint32_t(std::stoul(m[2]));
+    }
   const gl::Bindings b;
+  const gl::RefinementBindings rb;  // the refined path's (vff_refine.glsl)
   const std::map<std::string, uint32_t> expected = {{"VFF_FIELD_BINDING", b.field},
                                                     {"VFF_MAPS_BINDING", b.maps},
                                                     {"VFF_POSITIONS_BINDING", b.positions},
-                                                    {"VFF_NORMALS_BINDING", b.normals}};
+                                                    {"VFF_NORMALS_BINDING", b.normals},
+                                                    {"VFF_UNSURE_BINDING", rb.unsure},
+                                                    {"VFF_VERTICES_BINDING", rb.vertices},
+                                                    {"VFF_BVH_BINDING", rb.bvh},
+                                                    {"VFF_TRIANGLES_BINDING", rb.triangles},
+                                                    {"VFF_REFINE_BINDING", rb.block}};
   for (const auto& [name, value] : expected) {
     const auto it = found.find(name);
     if (it == found.end()) {
@@ -173,6 +184,10 @@ TEST(GlslConstants, DefaultBindingsMatchLoaderBindings) {
     EXPECT_EQ(it->second, value) << "the GLSL default " << name << " differs from vff::gl::Bindings";
   }
   EXPECT_EQ(found.size(), expected.size()) << "a GLSL binding default is checked against nothing";
+  // Distinct numbers: the declarations stay valid for Vulkan (one namespace per descriptor set).
+  std::set<uint32_t> numbers;
+  for (const auto& [name, value] : expected) numbers.insert(value);
+  EXPECT_EQ(numbers.size(), expected.size()) << "two GLSL binding defaults share a number";
 }
 
 // ---- Blocks --------------------------------------------------------------------------------------
@@ -537,6 +552,143 @@ TEST(GlslSceneLayout, PlanRefusesWhatOneTextureCannotHold) {
   EXPECT_EQ(code({u8, bc4}, {layoutOf(u8, 256, 0), layoutOf(bc4, 256, 0)}), Code::kUnsupported);
   EXPECT_EQ(code({u8}, {layoutOf(u8, 256, 0, LayoutTarget::kTexture3D)}), Code::kUnsupported);
   EXPECT_EQ(code({}, {}), Code::kInvalidArgument);
+}
+
+// ---- The refined path (vff_refine.glsl) and what loadRefinement uploads, without GL -----------------
+
+TEST(GlslRefineLayout, RefineBlockMatchesTheLoaderStruct) {
+  std::vector<Member> glsl =
+      glslBlock("layout(std140, binding = VFF_REFINE_BINDING) uniform VffRefineBlock {", "} vffRefine;",
+                "vff_refine.glsl");
+  layoutStd140(glsl);
+  using B = gl::RefineBlock;
+  const std::vector<Member> cpp = {VFF_MEMBER_AT("float", "margin", B, margin, 0, 4),
+                                   VFF_MEMBER_AT("uint", "triangleCount", B, triangleCount, 0, 4),
+                                   VFF_MEMBER_AT("uint", "nodeCount", B, nodeCount, 0, 4),
+                                   VFF_MEMBER_AT("uint", "stackDepth", B, stackDepth, 0, 4)};
+  expectSameMembers(glsl, cpp, sizeof(B), "VffRefineBlock");
+}
+
+TEST(GlslRefineLayout, StorageBlocksAreWordArrays) {
+  // makeRefinementBuffers' vectors are uploaded as they are: std430 arrays of 4-byte words (the
+  // BVH's 8 words a node read as two uvec4).
+  const std::pair<const char*, const char*> blocks[] = {
+      {"layout(std430, binding = VFF_UNSURE_BINDING) readonly buffer VffUnsureBlock {", "uint[] vffUnsure"},
+      {"layout(std430, binding = VFF_VERTICES_BINDING) readonly buffer VffVerticesBlock {", "float[] vffVertices"},
+      {"layout(std430, binding = VFF_BVH_BINDING) readonly buffer VffBvhBlock {", "uvec4[] vffBvh"},
+      {"layout(std430, binding = VFF_TRIANGLES_BINDING) readonly buffer VffTrianglesBlock {", "uint[] vffTriangles"}};
+  for (const auto& [header, member] : blocks) {
+    const std::vector<Member> glsl = glslBlock(header, "};", "vff_refine.glsl");
+    ASSERT_EQ(glsl.size(), 1u) << header;
+    EXPECT_EQ(glsl[0].type + " " + glsl[0].name, member) << header;
+  }
+}
+
+TEST(GlslRefineLayout, StackDefaultIsTheLoaders) {
+  static const std::regex def(R"(^#define VFF_REFINE_STACK ([0-9]+)$)");
+  int found = 0;
+  for (const std::string& line : glslLines("vff_refine.glsl")) {
+    std::smatch m;
+    if (!std::regex_match(line, m, def)) continue;
+    ++found;
+    EXPECT_EQ(uint32_t(std::stoul(m[1])), gl::kRefineStack);
+  }
+  EXPECT_EQ(found, 1);
+  gl::RefineBlock b;
+  b.stackDepth = 17;
+  EXPECT_EQ(gl::refinementShaderDefines(b), "#define VFF_REFINED\n#define VFF_REFINE_STACK 17\n");
+  b.stackDepth = 0;  // a BVH of one leaf: GLSL arrays hold at least one entry
+  EXPECT_EQ(gl::refinementShaderDefines(b), "#define VFF_REFINED\n#define VFF_REFINE_STACK 1\n");
+}
+
+// A field with random codes and random triangles inside its sphere: enough of both for unsure
+// texels and a BVH of several levels.
+struct SyntheticRefinement {
+  FieldDesc field;
+  std::vector<uint8_t> distance;
+  Refinement refinement;
+};
+
+SyntheticRefinement syntheticRefinement() {
+  SyntheticRefinement s;
+  s.field = makeField(PositionScheme::kOctaHemi2, 4, DirectionScheme::kConcentricEqualArea,
+                      DistanceEncoding::kUnorm8Diameter, 16, 1.28641f);
+  std::mt19937 rng(8501);
+  std::uniform_int_distribution<int> code(0, 255);
+  std::uniform_real_distribution<float> u(-0.5f, 0.5f);
+  s.distance.resize(size_t(s.field.mapCount) * 16 * 16);
+  for (uint8_t& c : s.distance) c = uint8_t(code(rng));
+  std::vector<float> positions;
+  std::vector<uint32_t> indices;
+  for (uint32_t t = 0; t < 300; ++t) {
+    for (int v = 0; v < 3; ++v) {
+      for (int a = 0; a < 3; ++a) positions.push_back(s.field.sphere.center[a] + u(rng));
+      indices.push_back(uint32_t(indices.size()));
+    }
+  }
+  auto r = makeRefinement(s.field, s.distance, positions, indices);
+  EXPECT_TRUE(r.ok()) << r.error().toString();
+  if (r.ok()) s.refinement = std::move(*r);
+  return s;
+}
+
+// The depth of node n's subtree's deepest leaf below n (recursively, as an independent check of
+// the loader's walk).
+uint32_t subtreeDepth(const std::vector<uint32_t>& nodes, size_t n) {
+  if (nodes[8 * n + 7] != 0) return 0;
+  return 1 + std::max(subtreeDepth(nodes, n + 1), subtreeDepth(nodes, nodes[8 * n + 3]));
+}
+
+TEST(GlslRefineLayout, BuffersHoldLibvffValues) {
+  const SyntheticRefinement s = syntheticRefinement();
+  const RefinementView view = s.refinement.view();
+  ASSERT_FALSE(view.empty());
+  ASSERT_GT(view.unsureTexels, 0u);
+  auto b = gl::makeRefinementBuffers(s.field, view);
+  ASSERT_TRUE(b.ok()) << b.error().toString();
+  // The margin in object units is the CPU query's float product.
+  EXPECT_TRUE(sameBits(b->block.margin, view.margin * s.field.sphere.radius));
+  // Every texel's bit, where the shader reads it.
+  const uint64_t texels = uint64_t(s.field.mapCount) * s.field.mapResolution * s.field.mapResolution;
+  ASSERT_EQ(b->unsure.size(), (texels + 31) / 32);
+  uint64_t set = 0;
+  for (uint64_t x = 0; x < texels; ++x) {
+    const bool bit = (b->unsure[x >> 5] >> (x & 31)) & 1u;
+    ASSERT_EQ(bit, view.isUnsure(x)) << "texel " << x;
+    set += bit;
+  }
+  EXPECT_EQ(set, view.unsureTexels);
+  ASSERT_EQ(b->vertices.size(), view.positions.size());
+  for (size_t i = 0; i < view.positions.size(); ++i) ASSERT_TRUE(sameBits(b->vertices[i], view.positions[i]));
+  // The CPU query's BVH, word for word.
+  const RefinementBvh bvh = buildRefinementBvh(view);
+  EXPECT_EQ(b->nodes, bvh.nodes);
+  EXPECT_EQ(b->triangles, bvh.triangles);
+  EXPECT_EQ(b->block.nodeCount, bvh.nodes.size() / 8);
+  EXPECT_EQ(b->block.triangleCount, view.indices.size() / 3);
+  EXPECT_EQ(b->block.stackDepth, subtreeDepth(bvh.nodes, 0));
+  EXPECT_GT(b->block.stackDepth, 2u);
+  EXPECT_LE(b->block.stackDepth, gl::kRefineStack);
+}
+
+TEST(GlslRefineLayout, EmptyAndMismatchedRefinements) {
+  const SyntheticRefinement s = syntheticRefinement();
+  // No refinement: triangleCount 0 (the shader answers as kNearest), one word per buffer.
+  auto empty = gl::makeRefinementBuffers(s.field, RefinementView{});
+  ASSERT_TRUE(empty.ok()) << empty.error().toString();
+  EXPECT_EQ(empty->block.triangleCount, 0u);
+  EXPECT_EQ(empty->block.nodeCount, 0u);
+  EXPECT_FALSE(empty->unsure.empty() || empty->vertices.empty() || empty->nodes.empty() || empty->triangles.empty());
+  // Another field's refinement: FieldQuery::fromMaps's error.
+  FieldDesc other = s.field;
+  other.mapResolution = 32;
+  auto bad = gl::makeRefinementBuffers(other, s.refinement.view());
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.error().code, Code::kInvalidArgument);
+  auto cpu = FieldQuery::fromMaps(other, std::vector<uint8_t>(size_t(other.mapCount) * 32 * 32, 255), {},
+                                  s.refinement.view());
+  ASSERT_FALSE(cpu.ok());
+  EXPECT_EQ(cpu.error().code, bad.error().code);
 }
 
 }  // namespace
