@@ -285,8 +285,16 @@ def parse_sdf(text):
                      r"distance field (\w+), (.*)$", text, re.M)
     if not head:
         raise ParseError("vff-experiments sdf-bench output lacks its header line")
-    rows = []
+    rows, refined = [], []
     for r in md_rows(text):
+        if len(r) == 12 and r[0] != "mesh":  # the refined field's table
+            fit = not r[3].startswith("does not fit")
+            refined.append({"mesh": r[0], "mib": number(r[1]), "set": r[2], "field": r[3] if fit else "",
+                            "parts": r[4] if fit else "", "unsure": number(r[5]) if fit else 0,
+                            "rate": number(r[6]) if fit else 0, "sdfrate": number(r[7]) if fit else 0,
+                            "speed": number(r[8]) if fit else 0, "wrong": number(r[9]) if fit else 0,
+                            "sdfwrong": number(r[10]) if fit else 0, "fits": fit, "note": r[3] if not fit else ""})
+            continue
         if len(r) != 11 or r[0] == "mesh":
             continue
         voxel = re.match(r"voxel ([\d.e+-]+) R", r[3])
@@ -295,7 +303,8 @@ def parse_sdf(text):
                      "speed": number(r[8]), "fieldwrong": number(r[9]), "sdfwrong": number(r[10])})
     if not rows:
         raise ParseError("vff-experiments sdf-bench output has no table")
-    return {"rays": int(head.group(1)), "threads": int(head.group(2)), "values": head.group(4), "rows": rows}
+    return {"rays": int(head.group(1)), "threads": int(head.group(2)), "values": head.group(4), "rows": rows,
+            "refined": refined}
 
 
 def parse_three(text):
@@ -430,6 +439,21 @@ def sdf_table(d):
         lines.append(f"| {r['mesh']} | {r['mib']:.1f} | {r['set']} | {rate(r['embree'])} | {rate(r['fieldrate'])} | "
                      f"{rate(r['sdfrate'])} | {r['speed']:.1f}x | {r['fieldwrong']:.2f}% / {r['sdfwrong']:.2f}% | "
                      f"{faster}, {right} |")
+    return lines
+
+
+def refined_table(d):
+    lines = ["| mesh | memory MiB | ray set | refined field | maps + unsure bits + exact step, MiB | unsure texels | "
+             "refined, Mrays/s | distance field, Mrays/s | refined / SDF speed | wrong answers: refined / SDF | "
+             "10x faster, as often right |", "|---|---:|---|---|---|---:|---:|---:|---:|---:|---|"]
+    for r in d.get("refined", []):
+        if not r["fits"]:
+            lines.append(f"| {r['mesh']} | {r['mib']:.1f} | {r['set']} | {r['note']} | | | | | | | no |")
+            continue
+        ok = "yes" if r["speed"] >= 10 and r["wrong"] <= r["sdfwrong"] else "no"
+        lines.append(f"| {r['mesh']} | {r['mib']:.1f} | {r['set']} | {r['field']} | {r['parts']} | {r['unsure']:.1f}% | "
+                     f"{rate(r['rate'])} | {rate(r['sdfrate'])} | {r['speed']:.1f}x | "
+                     f"{r['wrong']:.3f}% / {r['sdfwrong']:.3f}% | {ok} |")
     return lines
 
 
@@ -592,6 +616,12 @@ def sections(machine, steps, heading, queries=None, only=None):
                 f"{d['threads']} threads, {d['rays']} rays per set)", "", *sdf_table(d), "",
                 "Wrong answers: rays answered otherwise than Embree (occluded or not); field / SDF speed above 1x: the "
                 "field is faster.", ""]
+        if d.get("refined"):
+            out += [f"{heading} Refined field against the distance field at the distance field's memory", "",
+                    *refined_table(d), "",
+                    "Refined: the maps answer the rays they are sure of, an exact ray cast through the object's "
+                    "triangles the rest (vff/refine.h); its memory counts the maps, one unsure bit a texel, the "
+                    "vertex positions and the triangle BVH.", ""]
     if "gpu" in steps:
         renderer = steps["gpu"]["gpu"]
         soft = ": Mesa's software rasteriser, on the CPU" if "llvmpipe" in renderer else ""

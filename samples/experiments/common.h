@@ -140,6 +140,7 @@ struct BakedQuery {
   std::string name;             // in file names: "4226x64x64", or a loaded file's name without .vff
   std::string description;      // in the table: the name, or "file.vff (4226x32x32 unorm8-diameter)"
   vff::bake::BakedField baked;  // owns the maps the query borrows
+  vff::Refinement refinement;   // refineQuery: owns the refinement the query borrows
   vff::FieldQuery query;
   vff::Instance instance;       // the field placed in the world
   double bakeSeconds = 0;
@@ -188,6 +189,9 @@ vff::Result<std::unique_ptr<BakedQuery>> bakeQuery(const World& world, const vff
 // be the loaded mesh's. Errors: those of File::open;
 // kInvalidArgument naming the mismatch (the caller exits 3); kUnsupported when `normals` are
 // needed and the file has none.
+// Adds a refinement of the world's object (vff/refine.h) to a baked field: its query then answers
+// Reconstruction::kRefined.
+vff::Status refineQuery(const World& world, BakedQuery* q, const vff::RefineOptions& options);
 vff::Result<std::unique_ptr<BakedQuery>> loadQuery(const World& world, const std::string& path, bool normals);
 // Parses "4226x64x64" (or "n32m64"): maps must be an octa-hemi2 count.
 bool parseFieldConfig(const std::string& text, FieldConfig* out);
@@ -281,6 +285,9 @@ struct Options {
   SdfValues sdfValues = SdfValues::kFp8;
   float sdfBand = SdfBuildOptions{}.bandVoxels;
   bool sdfUnsure = false;  // sdf-bench --unsure
+  bool sdfRefined = true;  // sdf-bench: the refined field's table (--no-refined: none)
+  bool refineProbe = false;  // sdf-bench --refine-probe (RefineOptions::probe)
+  float refineMargin = vff::RefineOptions{}.marginSpreads;  // sdf-bench --refine-margin
   // scene
   std::vector<std::string> objects;  // meshes besides --mesh (none: four procedural shapes)
 };

@@ -8,6 +8,7 @@
 #include "cli.h"
 #include "common.h"
 #include "vff/reader.h"
+#include "vff/refine.h"
 
 namespace vffx {
 
@@ -62,6 +63,18 @@ vff::Result<std::unique_ptr<BakedQuery>> bakeQuery(const World& world, const vff
   q->instance.field = &q->query;
   q->instance.transform = world.transform;
   return q;
+}
+
+vff::Status refineQuery(const World& world, BakedQuery* q, const vff::RefineOptions& options) {
+  auto r = vff::makeRefinement(q->baked.field, q->baked.distance, world.objectMesh.positions, world.objectMesh.indices,
+                               options);
+  if (!r) return std::move(r).error();
+  q->refinement = std::move(*r);
+  auto query = vff::FieldQuery::fromMaps(q->baked.field, q->baked.distance, q->baked.normals, q->refinement.view());
+  if (!query) return std::move(query).error();
+  q->query = std::move(*query);
+  q->instance.field = &q->query;
+  return {};
 }
 
 vff::Result<std::unique_ptr<BakedQuery>> loadQuery(const World& world, const std::string& path, bool normals) {

@@ -91,6 +91,14 @@ int main(int argc, char** argv) {
   app.add_flag("--unsure", o.sdfUnsure, "sdf-bench: a second table, where the field's wrong answers lie: on the rays "
                "whose interpolated visibility is strictly between 0 and 1 (the samples around the ray disagree), or on "
                "the rest");
+  app.add_flag("--refined,!--no-refined", o.sdfRefined, "sdf-bench: leave out the refined field's table (the field, its unsure "
+               "texels and the object's triangles at the distance field's memory)");
+  app.add_option("--refine-margin", o.refineMargin, "sdf-bench: the refined field's margin, in lateral spreads "
+                 "(RefineOptions::marginSpreads)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0f, 16.0f));
+  app.add_flag("--refine-probe", o.refineProbe, "sdf-bench: the refined field's texels whose neighbours disagree stay "
+               "unsure only when a ray through a corner of their cell meets the surface otherwise (RefineOptions::probe)");
   app.add_option("--instances", o.instanceCounts, "scene-bench: instance counts (one table row each)")
       ->capture_default_str()
       ->check(CLI::Range(1u, 1u << 20));
