@@ -285,7 +285,7 @@ struct Options {
   SdfValues sdfValues = SdfValues::kFp8;
   float sdfBand = SdfBuildOptions{}.bandVoxels;
   bool sdfUnsure = false;  // sdf-bench --unsure
-  bool sdfRefined = true;  // sdf-bench: the refined field's table (--no-refined: none)
+  bool sdfRefined = true;  // the refined field: sdf-bench's table, the image experiments' rows (--no-refined: none)
   bool refineProbe = false;  // sdf-bench --refine-probe (RefineOptions::probe)
   float refineMargin = vff::RefineOptions{}.marginSpreads;  // sdf-bench --refine-margin
   // scene

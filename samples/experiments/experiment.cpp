@@ -13,7 +13,7 @@ namespace vffx {
 namespace {
 
 const char* reconstructionName(vff::Reconstruction r) {
-  return r == vff::Reconstruction::kNearest ? "nearest" : "interpolated";
+  return r == vff::Reconstruction::kNearest ? "nearest" : r == vff::Reconstruction::kRefined ? "refined" : "interpolated";
 }
 
 std::string fixed(double v, int digits) {
@@ -162,6 +162,10 @@ int runImageExperiment(const Options& o, const ImageExperiment& e) {
     if (!baked) return vff::cli::reportError(kProg, o.mesh, baked.error());
     std::fprintf(stderr, "%s: %s: baked %s in %.2f s (%.2f MiB)\n", kProg, e.name.c_str(), (*baked)->name.c_str(),
                  (*baked)->bakeSeconds, (*baked)->payloadMiB());
+    // A refined bake answers kNearest and kInterpolated as before, and kRefined from its REFN data.
+    if (o.sdfRefined)
+      if (vff::Status st = refineQuery(*world, baked->get(), {.threads = threads}); !st)
+        return vff::cli::reportError(kProg, o.mesh, st.error());
     fields.push_back(std::move(*baked));
   }
   for (std::unique_ptr<BakedQuery>& f : files) {
@@ -193,7 +197,9 @@ int runImageExperiment(const Options& o, const ImageExperiment& e) {
     if (firstRange) strip.push_back(reference);
     for (const std::unique_ptr<BakedQuery>& field : fields) {
       const BakedQuery& c = *field;
-      for (vff::Reconstruction r : {vff::Reconstruction::kNearest, vff::Reconstruction::kInterpolated}) {
+      for (vff::Reconstruction r :
+           {vff::Reconstruction::kNearest, vff::Reconstruction::kInterpolated, vff::Reconstruction::kRefined}) {
+        if (r == vff::Reconstruction::kRefined && !c.query.refined()) continue;
         const Image img =
             renderImage(g, threads, stream, e.makeShader(*world, *exact, &c, nullptr, r, rays, range), &seconds);
         const std::string name = base + "-" + c.name + "-" + reconstructionName(r);
@@ -201,7 +207,10 @@ int runImageExperiment(const Options& o, const ImageExperiment& e) {
         if (firstRange && strip.size() < 3) strip.push_back(img);
         if (auto w = writeErrorMap(reference, img, mask, 8.0f, name + "-error.png"); !w)
           return vff::cli::reportError(kProg, "", w.error());
-        rows.push_back(measure(reference, img, {c.description + label, reconstructionName(r), c.payloadMiB(), 0, 0, seconds, false}));
+        // A refined row's memory: the maps, the unsure bits and the exact step.
+        const double mib = c.payloadMiB() +
+                           (r == vff::Reconstruction::kRefined ? double(c.query.refinementBytes()) / 1048576.0 : 0.0);
+        rows.push_back(measure(reference, img, {c.description + label, reconstructionName(r), mib, 0, 0, seconds, false}));
         std::fprintf(stderr, "%s: %s: %s%s %s in %.2f s, RMS %.2f\n", kProg, e.name.c_str(), c.name.c_str(), label,
                      reconstructionName(r), seconds, rows.back().rms);
       }

@@ -91,8 +91,9 @@ int main(int argc, char** argv) {
   app.add_flag("--unsure", o.sdfUnsure, "sdf-bench: a second table, where the field's wrong answers lie: on the rays "
                "whose interpolated visibility is strictly between 0 and 1 (the samples around the ray disagree), or on "
                "the rest");
-  app.add_flag("--refined,!--no-refined", o.sdfRefined, "sdf-bench: leave out the refined field's table (the field, its unsure "
-               "texels and the object's triangles at the distance field's memory)");
+  app.add_flag("--refined,!--no-refined", o.sdfRefined, "the refined field (vff/refine.h): sdf-bench's table of it at "
+               "the distance field's memory, the image experiments' 'refined' row of each baked field (--no-refined: "
+               "neither)");
   app.add_option("--refine-margin", o.refineMargin, "sdf-bench: the refined field's margin, in lateral spreads "
                  "(RefineOptions::marginSpreads)")
       ->capture_default_str()
