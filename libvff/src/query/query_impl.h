@@ -336,6 +336,46 @@ struct VFF_HIDDEN FieldQuery::Impl {  // (VFF_HIDDEN: not exported with its clas
   QueryHit refinedAt(const Ray& ray, uint32_t k, uint32_t i, uint32_t j, float t0, bool inside, float lo, float hi,
                      float len, bool anyHit, float* visibility) const noexcept;
   QueryHit exactHit(const Ray& ray, bool anyHit, float* visibility) const noexcept;
+  // The step of kRefined that answers a lookup at texel (i, j) of map k: the maps (as kNearest), a
+  // sure miss, or the exact cast. *s: the texel. (Inline, as texel(): the batches' loops call it.)
+  enum class RefineStep : uint8_t { kMaps, kMiss, kExact };
+  RefineStep refineStep(uint32_t k, uint32_t i, uint32_t j, float t0, bool inside, float lo, float hi,
+                        detail::Sample* s) const noexcept {
+    *s = texel(k, i, j);
+    if (inside) return RefineStep::kMaps;  // section 7.3's rays: the maps' answer
+    if (refine.isUnsure((uint64_t(k) * m + j) * m + i)) return RefineStep::kExact;
+    if (!s->hit) return RefineStep::kMiss;  // a sure miss: every texel around it misses too
+    // Near the start of the range (or behind an origin inside the sphere) or near its end, the hit
+    // may lie on the other side of it. (t: along the unit direction, as lo and hi.)
+    const float t = t0 + s->distance;
+    return t < lo + refineMargin || std::fabs(t - hi) < refineMargin ? RefineStep::kExact : RefineStep::kMaps;
+  }
+  // How far around the maps' hit an occlusion cast looks first, in margins: the depth steps the
+  // marking of unsure texels allows (RefineOptions::jumpMargins).
+  static constexpr float kRefineSearchMargins = 4.0f;
+  // Whether the exact cast finds any hit in the ray's range. Occlusion needs any hit: first look
+  // where the maps put one, a short stretch of the ray that the BVH culls to a few nodes; only when
+  // nothing is there, the whole range. Both are exact casts, so the answer is the whole range's.
+  bool exactOccluded(const Ray& ray, const detail::Sample& s, float t0, float len) const noexcept {
+    if (s.hit && s.distance > 0) {
+      const float t = t0 + s.distance, reach = kRefineSearchMargins * refineMargin;
+      const float from = std::max(ray.tmin, (t - reach) / len), to = std::min(ray.tmax, (t + reach) / len);
+      if (from <= to && bvh.occluded(ray.origin, ray.direction, from, to)) return true;
+    }
+    return bvh.occluded(ray.origin, ray.direction, ray.tmin, ray.tmax);
+  }
+  // refinedAt(...).hit for occlusion; objectRay() gives the ray, called only where a step needs it.
+  template <class RayFn>
+  bool refinedHitsAt(RayFn&& objectRay, uint32_t k, uint32_t i, uint32_t j, float t0, bool inside, float lo, float hi,
+                     float len) const noexcept {
+    detail::Sample s;
+    switch (refineStep(k, i, j, t0, inside, lo, hi, &s)) {
+      case RefineStep::kMiss: return false;
+      case RefineStep::kExact: return exactOccluded(objectRay(), s, t0, len);
+      case RefineStep::kMaps: break;
+    }
+    return t0 < 0 ? offHitsAt(objectRay(), k, i, j, t0, lo, hi) : hitsAt(k, i, j, t0, inside, lo, hi);
+  }
   // Whether the nearest lookup at texel (i, j) of map k hits within [lo, hi] (hitAt(...).hit).
   // *t: the hit's distance along the ray's unit direction.
   bool hitsAt(uint32_t k, uint32_t i, uint32_t j, float t0, bool inside, float lo, float hi,
@@ -349,10 +389,9 @@ struct VFF_HIDDEN FieldQuery::Impl {  // (VFF_HIDDEN: not exported with its clas
   // kHitOnly: emit(base, n, hits) per run of rays; otherwise emit(r, const QueryHit&, float
   // visibility) per ray (see the definition).
   // With `to`, the rays are in world space: the kernel and prepare() take them to object space.
-  // kRefined rays take the !kHitOnly path (refinedAt per ray; anyHit for occlusion).
+  // kRefined lookups take its steps (refinedHitsAt for kHitOnly, refinedAt otherwise).
   template <bool kHitOnly, class Emit>
-  void batchNearest(std::span<const Ray> rays, const QueryOptions& o, const detail::ToObject* to, Emit&& emit,
-                    bool anyHit = false) const noexcept;
+  void batchNearest(std::span<const Ray> rays, const QueryOptions& o, const detail::ToObject* to, Emit&& emit) const noexcept;
   // The batch calls of FieldQuery (x null: object-space rays) and of Instance (world-space rays, x
   // their transform). Nearest batches hand the transform to the group kernel, which applies it
   // lane by lane; interpolated batches take the rays to object space a few hundred at a time.

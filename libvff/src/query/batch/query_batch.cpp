@@ -94,13 +94,7 @@ void FieldQuery::Impl::intersectBatch(std::span<const Ray> rays, std::span<Query
 
 void FieldQuery::Impl::occludedBatch(std::span<const Ray> rays, std::span<uint8_t> out, const QueryOptions& o,
                                      const RigidTransform* x) const noexcept {
-  if (o.reconstruction == Reconstruction::kRefined && !bvh.empty()) {
-    withToObject(x, [&](const detail::ToObject* to) {
-      batchNearest<false>(rays, o, to, [&](size_t r, const QueryHit& h, float) { out[r] = h.hit ? 1 : 0; }, true);
-    });
-    return;
-  }
-  if (o.reconstruction != Reconstruction::kInterpolated) {
+  if (o.reconstruction != Reconstruction::kInterpolated) {  // (kRefined: batchNearest's refined steps)
     withToObject(x, [&](const detail::ToObject* to) {
       batchNearest<true>(rays, o, to,
                          [&](size_t base, size_t count, uint64_t hits) { writeHitBytes(hits, count, &out[base]); });
@@ -114,12 +108,6 @@ void FieldQuery::Impl::occludedBatch(std::span<const Ray> rays, std::span<uint8_
 
 void FieldQuery::Impl::visibilityBatch(std::span<const Ray> rays, std::span<float> out, const QueryOptions& o,
                                        const RigidTransform* x) const noexcept {
-  if (o.reconstruction == Reconstruction::kRefined && !bvh.empty()) {
-    withToObject(x, [&](const detail::ToObject* to) {
-      batchNearest<false>(rays, o, to, [&](size_t r, const QueryHit& h, float) { out[r] = h.hit ? 0.0f : 1.0f; }, true);
-    });
-    return;
-  }
   if (o.reconstruction != Reconstruction::kInterpolated) {
     withToObject(x, [&](const detail::ToObject* to) {
       batchNearest<true>(rays, o, to, [&](size_t base, size_t count, uint64_t hits) {

@@ -16,7 +16,7 @@ namespace vff {
 // whether ray base + r hits. Otherwise: emit(r, const QueryHit&, float visibility) per ray.
 template <bool kHitOnly, class Emit>
 void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOptions& o, const detail::ToObject* to,
-                                    Emit&& emit, bool anyHit) const noexcept {
+                                    Emit&& emit) const noexcept {
   const bool refined = o.reconstruction == Reconstruction::kRefined && !bvh.empty();
   auto objectRay = [&](size_t r) { return to ? to->ray(rays[r]) : rays[r]; };
   // A batch of one ray (an Embree callback for rtcIntersect1 or rtcOccluded1) takes the reference
@@ -34,7 +34,7 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
         Lookup l;
         const Ray ray = objectRay(base + r);
         const QueryHit h = !prepare(ray, o, &l) ? QueryHit{}
-                           : refined ? refinedAt(ray, l.k0, l.i, l.j, l.t0, l.inside, l.lo, l.hi, l.len, anyHit, &vis)
+                           : refined ? refinedAt(ray, l.k0, l.i, l.j, l.t0, l.inside, l.lo, l.hi, l.len, kHitOnly, &vis)
                                      : nearestAnswer(ray, l, &vis);
         if constexpr (kHitOnly) {
           hits |= uint64_t(h.hit) << r;
@@ -46,7 +46,8 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
     }
     return;
   }
-  const detail::GroupTables tables = detail::toObjectTables(groupTables(o, kHitOnly), to);
+  // (kRefined reads each lane's texel and window itself: the kernel does not decode its hits.)
+  const detail::GroupTables tables = detail::toObjectTables(groupTables(o, kHitOnly && !refined), to);
   forEachGroup(*kernel, rays, tables, [&](size_t base, size_t n, detail::Group& g) {
     // Every ray misses unless it reaches the sphere.
     if constexpr (!kHitOnly) detail::forEachClear(g.reached, n, [&](size_t r) { emit(base + r, QueryHit{}, 1.0f); });
@@ -78,6 +79,12 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
       const uint64_t left = tables.decodeHits ? g.redo : detail::packedBits(g.count);
       for (uint64_t todo = left & ~dead; todo != 0; todo &= todo - 1) {
         const uint32_t p = uint32_t(__builtin_ctzll(todo)), r = g.ray[p];
+        if (refined) {
+          if (refinedHitsAt([&] { return objectRay(base + r); }, g.k[p], g.i[p], g.j[p], g.t0[r], (g.inside >> r) & 1u,
+                            g.lo[r], g.hi[r], g.len[r]))
+            hits |= uint64_t(1) << r;
+          continue;
+        }
         // (t0 < 0: an off-object ray from inside the sphere, section 7.4)
         const bool hit = g.t0[r] < 0 ? offHitsAt(objectRay(base + r), g.k[p], g.i[p], g.j[p], g.t0[r], g.lo[r], g.hi[r])
                                      : hitsAt(g.k[p], g.i[p], g.j[p], g.t0[r], (g.inside >> r) & 1u, g.lo[r], g.hi[r]);
@@ -92,7 +99,7 @@ void FieldQuery::Impl::batchNearest(std::span<const Ray> rays, const QueryOption
         if ((dead >> p) & 1u) {
         } else if (refined) {
           h = refinedAt(objectRay(base + r), g.k[p], g.i[p], g.j[p], g.t0[r], (g.inside >> r) & 1u, g.lo[r], g.hi[r],
-                        g.len[r], anyHit, &vis);
+                        g.len[r], false, &vis);
         } else if (g.t0[r] < 0) {
           h = offHitAt(objectRay(base + r), g.k[p], g.i[p], g.j[p], g.t0[r], g.lo[r], g.hi[r], g.len[r], &vis);
         } else {
