@@ -26,7 +26,7 @@ static_assert(sizeof(BvhNode) == 32);
 
 class TriangleBvh {
  public:
-  static constexpr uint32_t kMaxLeaf = 4;
+  static constexpr uint32_t kMaxLeaf = 8;
   static constexpr uint32_t kMaxDepth = 80;
 
   TriangleBvh() = default;
