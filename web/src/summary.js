@@ -1,5 +1,5 @@
 // summary.js - the text `vff-inspect FILE` prints (tools/vff-inspect/text.cpp), from a decoded
-// file: format, sections, field, payload, layout, hit ratio, distance histogram and metadata. A
+// file: format, sections, field, payload, layout, hit ratio, distance histogram, refinement and metadata. A
 // partial result (spec/partial.md) says so, and its statistics count only its range's maps.
 import { ENCODING_NAMES, POSITION_NAMES, DIRECTION_NAMES } from './container.js';
 import { partialRange } from './meta.js';
@@ -140,6 +140,12 @@ export function summary(file, name) {
     `  slices:    ${L.sliceWidth} x ${L.sliceHeight} texels, ${L.sliceCount} slice${L.sliceCount === 1 ? '' : 's'}`,
     `  limits:    max texture size ${L.maxTextureSize}, max layers ${L.maxLayers}`,
     ...histogramLines(file, partial), '');
+  const R = file.refinement;
+  if (R) {  // REFN (format 1.3)
+    const texels = f.mapCount * f.mapResolution * f.mapResolution;
+    out.push(`refinement:  ${R.unsureTexels} unsure texels (${fixed(texels > 0 ? 100 * R.unsureTexels / texels : 0, 2)}%), ` +
+      `margin ${fixed(R.margin, 4)} R; exact step: ${R.positions.length / 3} vertices, ${R.indices.length / 3} triangles`, '');
+  }
   out.push(file.metadata ? `metadata:\n${dump(file.metadata.value)}` : 'metadata: none');
   return out.join('\n');
 }
