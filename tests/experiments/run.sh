@@ -136,8 +136,23 @@ case "$case" in
       || { head -1 stdout.txt; fail "sdf-bench header names no CPU"; }
     [ "$(grep -cE '^\| (knot|bowl)\.obj \| 290x16x16 \|' stdout.txt)" -eq 4 ] || { cat stdout.txt; fail "sdf-bench: not four rows"; }
     # Every rate positive; the share of wrong answers a percentage under 50 for both.
-    awk -F'|' '/^\| (knot|bowl)\.obj/ { if ($7 + 0 <= 0 || $8 + 0 <= 0 || $9 + 0 <= 0 || $11 + 0 >= 50 || $12 + 0 >= 50) bad = 1 }
+    awk -F'|' '/^\| (knot|bowl)\.obj/ && NF == 13 { if ($7 + 0 <= 0 || $8 + 0 <= 0 || $9 + 0 <= 0 || $11 + 0 >= 50 || $12 + 0 >= 50) bad = 1 }
                END { exit bad }' stdout.txt || { cat stdout.txt; fail "sdf-bench: implausible figures"; }
+    ;;
+  sdf_bench_refined_rows_fit_and_are_right_more_often)
+    # The refined field's table: a row per main row; its parts (maps, unsure bits, exact step) fit
+    # the distance field's memory, and it is wrong less often than the plain field of the main table.
+    "$exp" sdf-bench --mesh knot.obj --config 4226x16x16 --bench-rays 5000 --repeat 1 -j 2 \
+      >stdout.txt 2>stderr.txt || { cat stderr.txt; fail "sdf-bench failed"; }
+    grep -q "^| mesh | memory MiB | ray set | refined field | maps + unsure bits + exact step MiB |" stdout.txt \
+      || { cat stdout.txt; fail "no refined table"; }
+    awk -F'|' '
+      function n(x) { gsub(/[ %x]/, "", x); return x + 0 }
+      /^\| knot\.obj/ && NF == 13 { fw[$6] = n($11); ++main }
+      /^\| knot\.obj/ && NF == 14 { ++rows; split($6, p, "+")
+        if (n(p[1]) + n(p[2]) + n(p[3]) > n($3) + 0.01 || n($7) <= 0 || n($7) >= 100 || n($8) <= 0 || n($10) <= 0) bad = 1
+        if (n($11) >= fw[$4] || fw[$4] <= 0) bad = 1 }
+      END { exit bad || main != 2 || rows != 2 }' stdout.txt || { cat stdout.txt; fail "the refined rows do not fit or are not right more often"; }
     ;;
   sdf_bench_unsure_splits_the_wrong_answers)
     # --unsure: a second table, a row per main row; the field's wrong answers on the unsure rays and
