@@ -74,6 +74,29 @@ int renderSdfRows(const Options& o, const ImageExperiment& e, const World& world
   return 0;
 }
 
+// The fields an image experiment renders: the bakes of `configs` (refined unless --no-refined),
+// then the loaded `files` (moved). Non-zero: the exit code of a failed bake, reported.
+int gatherFields(const Options& o, const ImageExperiment& e, const World& world, const vff::bake::Scene& scene,
+                 const std::vector<FieldConfig>& configs, unsigned threads,
+                 std::vector<std::unique_ptr<BakedQuery>>& files, std::vector<std::unique_ptr<BakedQuery>>* fields) {
+  for (const FieldConfig& fc : configs) {
+    auto baked = bakeQuery(world, scene, fc, e.normals, threads);
+    if (!baked) return vff::cli::reportError(kProg, o.mesh, baked.error());
+    std::fprintf(stderr, "%s: %s: baked %s in %.2f s (%.2f MiB)\n", kProg, e.name.c_str(), (*baked)->name.c_str(),
+                 (*baked)->bakeSeconds, (*baked)->payloadMiB());
+    // A refined bake answers kNearest and kInterpolated as before, and kRefined from its REFN data.
+    if (o.sdfRefined)
+      if (vff::Status st = refineQuery(world, baked->get(), {.threads = threads}); !st)
+        return vff::cli::reportError(kProg, o.mesh, st.error());
+    fields->push_back(std::move(*baked));
+  }
+  for (std::unique_ptr<BakedQuery>& f : files) {
+    std::fprintf(stderr, "%s: %s: loaded %s (%.2f MiB)\n", kProg, e.name.c_str(), f->description.c_str(), f->payloadMiB());
+    fields->push_back(std::move(f));
+  }
+  return 0;
+}
+
 }  // namespace
 
 std::string formatTable(const std::vector<TableRow>& rows, bool contact) {
@@ -157,21 +180,7 @@ int runImageExperiment(const Options& o, const ImageExperiment& e) {
 
   // The fields: the bakes of --config, then the files of --field.
   std::vector<std::unique_ptr<BakedQuery>> fields;
-  for (const FieldConfig& fc : configs) {
-    auto baked = bakeQuery(*world, *scene, fc, e.normals, threads);
-    if (!baked) return vff::cli::reportError(kProg, o.mesh, baked.error());
-    std::fprintf(stderr, "%s: %s: baked %s in %.2f s (%.2f MiB)\n", kProg, e.name.c_str(), (*baked)->name.c_str(),
-                 (*baked)->bakeSeconds, (*baked)->payloadMiB());
-    // A refined bake answers kNearest and kInterpolated as before, and kRefined from its REFN data.
-    if (o.sdfRefined)
-      if (vff::Status st = refineQuery(*world, baked->get(), {.threads = threads}); !st)
-        return vff::cli::reportError(kProg, o.mesh, st.error());
-    fields.push_back(std::move(*baked));
-  }
-  for (std::unique_ptr<BakedQuery>& f : files) {
-    std::fprintf(stderr, "%s: %s: loaded %s (%.2f MiB)\n", kProg, e.name.c_str(), f->description.c_str(), f->payloadMiB());
-    fields.push_back(std::move(f));
-  }
+  if (const int rc = gatherFields(o, e, *world, *scene, configs, threads, files, &fields)) return rc;
 
   std::vector<TableRow> rows;
   std::vector<Image> strip;  // exact | first configuration nearest | interpolated | distance field

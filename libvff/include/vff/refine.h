@@ -103,6 +103,8 @@ struct RefinementBvh {
   std::vector<uint32_t> triangles;
 };
 VFF_EXPERIMENTAL RefinementBvh buildRefinementBvh(const RefinementView& refinement);
+// The depth no such BVH exceeds (root at depth 1): a cast's stack of this many entries suffices.
+inline constexpr uint32_t kRefinementBvhMaxDepth = 80;
 
 // The REFN section's raw bytes (spec/format.md section 14) for a field. Errors as makeRefinement's,
 // for a view that does not match the field.

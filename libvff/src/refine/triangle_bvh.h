@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "vff/direction.h"
+#include "vff/refine.h"
 
 namespace vff::detail {
 
@@ -27,7 +28,7 @@ static_assert(sizeof(BvhNode) == 32);
 class TriangleBvh {
  public:
   static constexpr uint32_t kMaxLeaf = 8;
-  static constexpr uint32_t kMaxDepth = 80;
+  static constexpr uint32_t kMaxDepth = kRefinementBvhMaxDepth;
 
   TriangleBvh() = default;
   // Borrows positions (x, y, z per vertex), which must outlive the BVH; copies the indices into

@@ -54,8 +54,8 @@ struct RefineBlock {
 static_assert(sizeof(RefineBlock) == 16, "RefineBlock must match the std140 block");
 
 // VFF_REFINE_STACK's default in the shader: the depth the CPU's builder never exceeds
-// (TriangleBvh::kMaxDepth). loadRefinement refuses a deeper BVH.
-inline constexpr uint32_t kRefineStack = 80;
+// (vff::kRefinementBvhMaxDepth). loadRefinement refuses a deeper BVH.
+inline constexpr uint32_t kRefineStack = kRefinementBvhMaxDepth;
 
 // What loadRefinement uploads, computed without GL (tests check it against libvff).
 struct RefinementBuffers {
