@@ -90,7 +90,7 @@ vff::Result<std::unique_ptr<BakedQuery>> bakeRefined(const World& world, const v
 }
 
 // One row of the refined field's table: its parts' memory, unsure texels, speed against the
-// distance field (rates in Mrays/s) and wrong answers against Embree's (`ref`).
+// distance field (both rates in the same unit) and wrong answers against Embree's (`ref`).
 std::string refinedRow(const std::string& mesh, const std::string& set, uint64_t sdfBytes, uint64_t meshBytes,
                        const BakedQuery* refined, const std::vector<uint8_t>& ref, const std::vector<uint8_t>& byRefined,
                        uint64_t wrongSdf, double refinedRate, double sdfRate) {

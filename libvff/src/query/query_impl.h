@@ -335,7 +335,7 @@ struct VFF_HIDDEN FieldQuery::Impl {  // (VFF_HIDDEN: not exported with its clas
   // the maps where the field is sure, else exact (anyHit: the first hit found, for occlusion).
   QueryHit refinedAt(const Ray& ray, uint32_t k, uint32_t i, uint32_t j, float t0, bool inside, float lo, float hi,
                      float len, bool anyHit, float* visibility) const noexcept;
-  QueryHit exactHit(const Ray& ray, bool anyHit, float* visibility) const noexcept;
+  QueryHit exactHit(const Ray& ray, float* visibility) const noexcept;  // the first hit
   // The step of kRefined that answers a lookup at texel (i, j) of map k: the maps (as kNearest), a
   // sure miss, or the exact cast. *s: the texel. (Inline, as texel(): the batches' loops call it.)
   enum class RefineStep : uint8_t { kMaps, kMiss, kExact };

@@ -13,12 +13,10 @@ Status FieldQuery::Impl::setRefinement(const RefinementView& r) {
   return {};
 }
 
-QueryHit FieldQuery::Impl::exactHit(const Ray& ray, bool anyHit, float* visibility) const noexcept {
+QueryHit FieldQuery::Impl::exactHit(const Ray& ray, float* visibility) const noexcept {
   QueryHit out;
   if (visibility) *visibility = 1.0f;
-  if (anyHit) {
-    out.hit = bvh.occluded(ray.origin, ray.direction, ray.tmin, ray.tmax);
-  } else if (float t = 0; bvh.intersect(ray.origin, ray.direction, ray.tmin, ray.tmax, &t, &out.normal)) {
+  if (float t = 0; bvh.intersect(ray.origin, ray.direction, ray.tmin, ray.tmax, &t, &out.normal)) {
     out.hit = true;
     out.t = t;
     out.point = ray.origin + ray.direction * t;
@@ -40,7 +38,7 @@ QueryHit FieldQuery::Impl::refinedAt(const Ray& ray, uint32_t k, uint32_t i, uin
                     : hitAt(ray, k, i, j, t0, inside, lo, hi, len, visibility);
     case RefineStep::kExact: break;
   }
-  if (!anyHit) return exactHit(ray, false, visibility);
+  if (!anyHit) return exactHit(ray, visibility);
   QueryHit out;
   out.hit = exactOccluded(ray, s, t0, len);
   if (visibility) *visibility = out.hit ? 0.0f : 1.0f;
