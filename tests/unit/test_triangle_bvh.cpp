@@ -1,5 +1,7 @@
-// The refined query's exact step (libvff/src/refine/triangle_bvh.h) against a test of every
-// triangle: the same first hit and the same occlusion, for random rays through a triangle soup.
+// The refined query's exact step against a test of every triangle: the binary BVH
+// (libvff/src/refine/triangle_bvh.h, the one the GPU walks) finds the same first hit and the same
+// occlusion for random rays through a triangle soup, and the wide BVH the CPU casts through
+// (wide_bvh.h) answers exactly as the binary one.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -7,6 +9,7 @@
 #include <vector>
 
 #include "refine/triangle_bvh.h"
+#include "refine/wide_bvh.h"
 
 namespace vff::detail {
 namespace {
@@ -31,18 +34,25 @@ bool bruteForce(const std::vector<float>& p, const std::vector<uint32_t>& ix, Ve
   return found;
 }
 
-TEST(TriangleBvh, MatchesATestOfEveryTriangle) {
+// Small triangles scattered in a cube, a few large ones.
+void soup(uint32_t triangles, std::vector<float>* p, std::vector<uint32_t>* ix) {
   std::mt19937 g(5);
   std::uniform_real_distribution<float> u(-1, 1), s(0.02f, 0.3f);
-  std::vector<float> p;
-  std::vector<uint32_t> ix;
-  for (uint32_t t = 0; t < 3000; ++t) {  // small triangles scattered in a cube, a few large ones
+  for (uint32_t t = 0; t < triangles; ++t) {
     const float cx = u(g), cy = u(g), cz = u(g), size = t % 100 == 0 ? 1.0f : s(g);
     for (int v = 0; v < 3; ++v) {
-      p.insert(p.end(), {cx + size * u(g), cy + size * u(g), cz + size * u(g)});
-      ix.push_back(uint32_t(ix.size()));
+      p->insert(p->end(), {cx + size * u(g), cy + size * u(g), cz + size * u(g)});
+      ix->push_back(uint32_t(ix->size()));
     }
   }
+}
+
+TEST(TriangleBvh, MatchesATestOfEveryTriangle) {
+  std::mt19937 g(5);
+  std::uniform_real_distribution<float> u(-1, 1);
+  std::vector<float> p;
+  std::vector<uint32_t> ix;
+  soup(3000, &p, &ix);
   const TriangleBvh bvh(p, ix);
   ASSERT_FALSE(bvh.empty());
   int hits = 0;
@@ -64,6 +74,63 @@ TEST(TriangleBvh, MatchesATestOfEveryTriangle) {
     }
   }
   EXPECT_GT(hits, 1000);
+}
+
+// Random rays, and axis-parallel ones starting on the planes of the triangles' vertices (the box
+// tests' NaN case: a ray on a box's face): the same hits, the same t to the bit, the same normal.
+void expectWideAnswersAsBinary(uint32_t triangles) {
+  std::vector<float> p;
+  std::vector<uint32_t> ix;
+  soup(triangles, &p, &ix);
+  const TriangleBvh bin(p, ix);
+  const WideBvh wide(bin);
+  ASSERT_FALSE(wide.empty());
+  std::mt19937 g(11);
+  std::uniform_real_distribution<float> u(-1, 1);
+  int hits = 0;
+  for (int r = 0; r < 6000; ++r) {
+    Vec3 o{3 * u(g), 3 * u(g), 3 * u(g)}, d{u(g) - o.x, u(g) - o.y, u(g) - o.z};
+    if (r % 3 == 0) {  // along an axis, through a vertex: on the planes of boxes' faces
+      const int axis = r / 3 % 3;
+      const float* v = &p[3 * size_t(g() % (p.size() / 3))];
+      float oa[3] = {v[0], v[1], v[2]}, da[3] = {0.0f, r % 2 ? -0.0f : 0.0f, 0.0f};
+      oa[axis] += 3.0f;
+      da[axis] = -1.0f;
+      o = {oa[0], oa[1], oa[2]};
+      d = {da[0], da[1], da[2]};
+    }
+    const float tmin = r % 5 == 0 ? 0.5f : 0.0f, tmax = r % 2 ? INFINITY : 2.0f;
+    float tb = 0, tw = 0;
+    Vec3 nb, nw;
+    const bool b = bin.intersect(o, d, tmin, tmax, &tb, &nb);
+    ASSERT_EQ(b, wide.intersect(o, d, tmin, tmax, &tw, &nw)) << "ray " << r;
+    ASSERT_EQ(bin.occluded(o, d, tmin, tmax), wide.occluded(o, d, tmin, tmax)) << "ray " << r;
+    ASSERT_EQ(b, bin.occluded(o, d, tmin, tmax)) << "ray " << r;
+    if (!b) continue;
+    ++hits;
+    ASSERT_EQ(tb, tw) << "ray " << r;
+    ASSERT_EQ(nb.x, nw.x) << "ray " << r;
+    ASSERT_EQ(nb.y, nw.y) << "ray " << r;
+    ASSERT_EQ(nb.z, nw.z) << "ray " << r;
+  }
+  EXPECT_GT(hits, triangles < 10 ? 5 : 1000);
+}
+
+TEST(WideBvh, AnswersAsTheBinaryBvh) { expectWideAnswersAsBinary(3000); }
+TEST(WideBvh, AnswersAsTheBinaryBvhForOneLeaf) { expectWideAnswersAsBinary(5); }
+TEST(WideBvh, AnswersAsTheBinaryBvhForOneTriangle) { expectWideAnswersAsBinary(1); }
+
+// Four children a node: fewer, larger nodes, and fewer bytes than the binary BVH's.
+TEST(WideBvh, HoldsFewerBytesThanTheBinaryBvh) {
+  std::vector<float> p;
+  std::vector<uint32_t> ix;
+  soup(3000, &p, &ix);
+  const TriangleBvh bin(p, ix);
+  const WideBvh wide(bin);
+  const uint64_t binNodes = bin.nodes().size_bytes(), wideNodes = wide.bytes() - bin.triangles().size_bytes();
+  EXPECT_LT(wideNodes, binNodes) << wide.nodeCount() << " wide nodes, " << bin.nodes().size()
+                                                        << " binary";
+  EXPECT_LE(wide.nodeCount(), bin.nodes().size() / 3 + 1);
 }
 
 }  // namespace

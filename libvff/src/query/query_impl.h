@@ -24,7 +24,7 @@
 #include "vff/query.h"
 
 #include "query/fast_lookup.h"
-#include "refine/triangle_bvh.h"
+#include "refine/wide_bvh.h"
 #include "query/batch/query_group.h"
 
 namespace vff {
@@ -160,7 +160,7 @@ struct VFF_HIDDEN FieldQuery::Impl {  // (VFF_HIDDEN: not exported with its clas
   // Reconstruction::kRefined (vff/refine.h): the unsure bits, the margin in object units, the BVH.
   RefinementView refine;
   float refineMargin = 0;
-  detail::TriangleBvh bvh;
+  detail::WideBvh bvh;
   Status setRefinement(const RefinementView& r);
   uint64_t hugePages = 0;  // bytes of the maps on huge pages (build(): adviseMapRuns)
 

@@ -3,13 +3,19 @@
 // where it is not.
 #include "query/query_impl.h"
 
+#include <string>
+
 namespace vff {
 
 Status FieldQuery::Impl::setRefinement(const RefinementView& r) {
   if (r.empty()) return {};
+  if (r.indices.size() / 3 >= detail::WideBvh::kMaxTriangles)
+    return makeError(Code::kUnsupported, "the refinement holds " + std::to_string(r.indices.size() / 3) +
+                                             " triangles; a refined query takes fewer than 2^28");
   refine = r;
   refineMargin = r.margin * radius;
-  bvh = detail::TriangleBvh(r.positions, r.indices);
+  // The binary BVH is only the wide one's scaffold: the CPU casts through the wide one.
+  bvh = detail::WideBvh(detail::TriangleBvh(r.positions, r.indices));
   return {};
 }
 

@@ -159,7 +159,7 @@ TriangleBvh::TriangleBvh(std::span<const float> positions, std::span<const uint3
     for (int v = 0; v < 3; ++v) tris_[3 * t + v] = indices[3 * size_t(ordered[t].tri) + v];
 }
 
-// Möller-Trumbore, two-sided: the hit's t when the ray meets the triangle within (tmin, tmax].
+// A depth-first walk, nearer child first, the triangles tested by triangleHit.
 template <bool kAny>
 bool TriangleBvh::cast(Vec3 o, Vec3 d, float tmin, float tmax, float* tOut, uint32_t* triOut) const noexcept {
   if (nodes_.empty() || !(tmax >= tmin)) return false;
@@ -203,20 +203,10 @@ bool TriangleBvh::cast(Vec3 o, Vec3 d, float tmin, float tmax, float* tOut, uint
       }
     } else {
       for (uint32_t t = n.first; t < n.first + n.count; ++t) {
-        const Vec3 v0 = vert(tris_[3 * size_t(t)]), v1 = vert(tris_[3 * size_t(t) + 1]), v2 = vert(tris_[3 * size_t(t) + 2]);
-        const Vec3 e1 = sub(v1, v0), e2 = sub(v2, v0);
-        const Vec3 pv = cross(d, e2);
-        const float det = dot3(e1, pv);
-        if (det == 0.0f) continue;
-        const float invDet = 1.0f / det;
-        const Vec3 tv = sub(o, v0);
-        const float u = dot3(tv, pv) * invDet;
-        if (!(u >= 0.0f && u <= 1.0f)) continue;
-        const Vec3 qv = cross(tv, e1);
-        const float v = dot3(d, qv) * invDet;
-        if (!(v >= 0.0f && u + v <= 1.0f)) continue;
-        const float th = dot3(e2, qv) * invDet;
-        if (!(th >= tmin && th <= best)) continue;
+        float th = 0;
+        if (!triangleHit(o, d, vert(tris_[3 * size_t(t)]), vert(tris_[3 * size_t(t) + 1]), vert(tris_[3 * size_t(t) + 2]),
+                         tmin, best, &th))
+          continue;
         if constexpr (kAny) return true;
         best = th;
         found = true;
@@ -235,6 +225,14 @@ bool TriangleBvh::cast(Vec3 o, Vec3 d, float tmin, float tmax, float* tOut, uint
   }
 }
 
+Vec3 triangleNormal(Vec3 v0, Vec3 v1, Vec3 v2, Vec3 d) noexcept {
+  Vec3 n = cross(sub(v1, v0), sub(v2, v0));
+  const float len = std::sqrt(dot3(n, n));
+  n = len > 0 ? Vec3{n.x / len, n.y / len, n.z / len} : Vec3{};
+  if (dot3(n, d) > 0) n = {-n.x, -n.y, -n.z};
+  return n;
+}
+
 bool TriangleBvh::occluded(Vec3 o, Vec3 d, float tmin, float tmax) const noexcept {
   return cast<true>(o, d, tmin, tmax, nullptr, nullptr);
 }
@@ -244,11 +242,8 @@ bool TriangleBvh::intersect(Vec3 o, Vec3 d, float tmin, float tmax, float* t, Ve
   if (!cast<false>(o, d, tmin, tmax, t, &tri)) return false;
   const float* p = pos_.data();
   auto vert = [p](uint32_t v) { return Vec3{p[3 * size_t(v)], p[3 * size_t(v) + 1], p[3 * size_t(v) + 2]}; };
-  const Vec3 v0 = vert(tris_[3 * size_t(tri)]);
-  Vec3 n = cross(sub(vert(tris_[3 * size_t(tri) + 1]), v0), sub(vert(tris_[3 * size_t(tri) + 2]), v0));
-  const float len = std::sqrt(dot3(n, n));
-  n = len > 0 ? Vec3{n.x / len, n.y / len, n.z / len} : Vec3{};
-  if (dot3(n, d) > 0) n = {-n.x, -n.y, -n.z};
+  const uint32_t* v = &tris_[3 * size_t(tri)];
+  const Vec3 n = triangleNormal(vert(v[0]), vert(v[1]), vert(v[2]), d);
   *normal = n;
   return true;
 }

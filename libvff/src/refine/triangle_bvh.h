@@ -17,6 +17,33 @@
 
 namespace vff::detail {
 
+// The triangle test both BVHs cast with (Möller-Trumbore, two-sided): whether the ray o + t d meets
+// triangle (v0, v1, v2) at a t within [tmin, tmax], *t that t. One definition, so that the binary
+// BVH (whose arrays the GPU walks) and the wide one (the CPU's casts) answer alike.
+inline bool triangleHit(Vec3 o, Vec3 d, Vec3 v0, Vec3 v1, Vec3 v2, float tmin, float tmax, float* t) noexcept {
+  auto sub = [](Vec3 a, Vec3 b) { return Vec3{a.x - b.x, a.y - b.y, a.z - b.z}; };
+  auto cross = [](Vec3 a, Vec3 b) { return Vec3{a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; };
+  auto dot = [](Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; };
+  const Vec3 e1 = sub(v1, v0), e2 = sub(v2, v0);
+  const Vec3 pv = cross(d, e2);
+  const float det = dot(e1, pv);
+  if (det == 0.0f) return false;
+  const float invDet = 1.0f / det;
+  const Vec3 tv = sub(o, v0);
+  const float u = dot(tv, pv) * invDet;
+  if (!(u >= 0.0f && u <= 1.0f)) return false;
+  const Vec3 qv = cross(tv, e1);
+  const float v = dot(d, qv) * invDet;
+  if (!(v >= 0.0f && u + v <= 1.0f)) return false;
+  const float th = dot(e2, qv) * invDet;
+  if (!(th >= tmin && th <= tmax)) return false;
+  *t = th;
+  return true;
+}
+
+// The unit geometric normal of triangle (v0, v1, v2), facing against d.
+Vec3 triangleNormal(Vec3 v0, Vec3 v1, Vec3 v2, Vec3 d) noexcept;
+
 struct BvhNode {
   float lo[3];
   uint32_t first;  // leaf: first triangle; inner: index of the second child
@@ -44,6 +71,7 @@ class TriangleBvh {
   uint64_t bytes() const noexcept { return nodes_.size() * sizeof(BvhNode) + tris_.size() * 4; }
   std::span<const BvhNode> nodes() const noexcept { return nodes_; }
   std::span<const uint32_t> triangles() const noexcept { return tris_; }
+  std::span<const float> positions() const noexcept { return pos_; }
 
  private:
   template <bool kAny>
