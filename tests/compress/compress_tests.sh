@@ -178,6 +178,30 @@ test_bc4_keeps_hits_and_matches_the_baker() {
   [[ $(dist_checksum "$WORK/bbd.vff") == $(dist_checksum "$WORK/b.vff") ]] || fail "--bc4 changed a bc4 file's blocks"
 }
 
+# A refined field keeps its refinement (REFN): as it is where the maps decode as before (the
+# decompressed copy is the refined bake byte for byte), and with --bc4 marked again on the new maps,
+# exactly as a refined bc4 bake marks them.
+refn() {  # the refinement's unsure texels and the REFN section's checksum of a stored-block file
+  "$VFF_INSPECT" "$1" --format json | python3 -c "import json,sys; d=json.load(sys.stdin); print(d['refinement']['unsureTexels'], [s['checksum'] for s in d['sections'] if s['tag']=='REFN'][0])"
+}
+test_refinement_kept_or_remade_for_bc4() {
+  bake "$WORK/r.vff" --refine
+  compress "$WORK/r.vff" "$WORK/rz.vff" --format json
+  expect_rc 0
+  [[ $(json "d['refinement']['remade']") == False ]] || fail "a lossless rewrite remade the refinement"
+  valid "$WORK/rz.vff"
+  compress -d "$WORK/rz.vff" "$WORK/rzd.vff" -q
+  expect_rc 0
+  cmp "$WORK/rzd.vff" "$WORK/r.vff" || fail "compress and decompress changed a refined field"
+  compress --bc4 "$WORK/r.vff" "$WORK/rb.vff" --level 3
+  expect_rc 0
+  expect_out_re "refinement remade for the new maps from its own triangles and margin: [0-9]+ unsure texels \(were [0-9]+\)"
+  valid "$WORK/rb.vff"
+  compress -d "$WORK/rb.vff" "$WORK/rbd.vff" -q
+  bake "$WORK/b.vff" --refine --encoding bc4-diameter
+  [[ $(refn "$WORK/rbd.vff") == "$(refn "$WORK/b.vff")" ]] || fail "--bc4 marked other texels than a refined bc4 bake"
+}
+
 test_bc4_unsupported_sources() {
   bake "$WORK/a.vff" --encoding unorm16-diameter
   compress --bc4 "$WORK/a.vff" "$WORK/z.vff"

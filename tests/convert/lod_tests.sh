@@ -395,6 +395,40 @@ PY
   expect_out "| ply.vff (26x8x8 unorm8-diameter) | nearest |"
 }
 
+# A refined field's refinement (REFN) follows its maps: kept by a repack, marked again on new maps
+# from its own triangles (for bc4, exactly as a refined bc4 bake marks them; for smaller maps, the
+# same bytes on any thread count), left out with a warning where the output cannot hold it.
+refn() {  # the refinement's unsure texels and the REFN section's checksum (stored blocks)
+  "$VFF_INSPECT" "$1" --format json | python3 -c "import json,sys; d=json.load(sys.stdin); r=d['refinement']; print(r and r['unsureTexels'], [s['checksum'] for s in d['sections'] if s['tag']=='REFN'])"
+}
+test_refinement_follows_the_maps() {
+  needs_bake || return 0
+  "$MESHGEN" torus-knot "$WORK/knot.obj" >/dev/null || fail "mesh generator"
+  "$VFF_BAKE" "$WORK/knot.obj" -o "$WORK/r.vff" -n 3 -m 16 --refine -q || fail "bake"
+  convert "$WORK/r.vff" "$WORK/g.vff" --gutter 2
+  expect_rc 0
+  expect_out_re "refinement: [0-9]+ unsure texels, 8192 triangles"
+  [[ $(refn "$WORK/g.vff") == "$(refn "$WORK/r.vff")" ]] || fail "a repack changed the refinement"
+  convert "$WORK/r.vff" "$WORK/c.vff" --encoding bc4-diameter -q
+  expect_rc 0
+  "$VFF_BAKE" "$WORK/knot.obj" -o "$WORK/b.vff" -n 3 -m 16 --refine --encoding bc4-diameter -q || fail "bake"
+  [[ $(refn "$WORK/c.vff") == "$(refn "$WORK/b.vff")" ]] || fail "bc4: other unsure texels than a refined bc4 bake"
+  convert "$WORK/r.vff" "$WORK/l1.vff" --map-size 8 -j 1
+  expect_rc 0
+  expect_out_re "refinement remade for the new maps from its own triangles: [0-9]+ unsure texels \(were [0-9]+\)"
+  valid "$WORK/l1.vff"
+  convert "$WORK/r.vff" "$WORK/l2.vff" --map-size 8 -j 2 -q
+  cmp "$WORK/l1.vff" "$WORK/l2.vff" || fail "the remade refinement depends on the thread count"
+  [[ $(refn "$WORK/l1.vff") != "None []" ]] || fail "the smaller maps lost the refinement"
+  convert "$WORK/r.vff" "$WORK/bit.vff" --encoding bit1 -q
+  expect_rc 0
+  expect_err "the refinement (REFN) is left out: a bit1 field holds no distances to refine"
+  [[ $(refn "$WORK/bit.vff") == "None []" ]] || fail "a bit1 field kept a refinement"
+  convert "$WORK/r.vff" "$WORK/r.exr" -q
+  expect_rc 0
+  expect_err "the refinement (REFN) is not exported: EXR holds the maps only"
+}
+
 # ---- Runner --------------------------------------------------------------------------------------------
 [[ $# -eq 1 && $1 == test_* ]] || { echo "usage: $0 test_NAME" >&2; exit 2; }
 run_test "$1"

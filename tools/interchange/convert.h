@@ -21,6 +21,7 @@ struct FieldData {
   uint32_t mapsPerBlock = 0;      // the source's G as a WriteOptions value (0: the writer's automatic G)
   std::vector<uint8_t> distance;  // mapCount * distanceMapBytes
   std::vector<uint8_t> normals;   // mapCount * normalMapBytes, empty without a normal field
+  Refinement refinement;          // the source's REFN (vff/refine.h), empty for none
 };
 
 // What the EXR and OpenVDB writers read of a field's packed layout: the map size, the gutter,

@@ -29,9 +29,20 @@ struct Bc4Report {
   double sumSquared = 0;    // sum of (new - old)^2, for the RMS
 };
 
+// The input's refinement (REFN, vff/refine.h), if it has one: copied where the maps are kept as
+// they decode, remade from its own triangles and margin where --bc4 changed them (the unsure texels
+// are those of the new maps).
+struct RefinementReport {
+  bool present = false;
+  bool remade = false;
+  uint32_t unsureBefore = 0;
+  uint32_t unsureAfter = 0;
+};
+
 struct Report {
   PlaneReport planes[2];
   Bc4Report bc4;
+  RefinementReport refinement;
   uint64_t fileBytes = 0;
   double seconds = 0;
 };
@@ -40,7 +51,7 @@ struct Report {
 // are taken from `in`), streaming one source block at a time so memory stays at a few blocks.
 // With `bc4`, the distance plane of an unorm8-diameter field is re-encoded as bc4-diameter (the
 // field, its layout (2d-array, no gutter) and `options` must already say so). Then reads `out`
-// back and fills `report`.
+// back and fills `report`. A refinement is kept (see RefinementReport).
 Status rewrite(const File& in, const std::string& out, const FieldDesc& field, const WriteOptions& options,
                bool bc4, Report* report);
 

@@ -196,6 +196,10 @@ void printReport(const Options& o, const std::string& input, const std::string& 
                         {"distance", planeJson(report.planes[0])}};
     if (report.planes[1].present) j["normal"] = planeJson(report.planes[1]);
     if (report.bc4.done) j["bc4"] = bc4Json(report.bc4);
+    if (report.refinement.present)
+      j["refinement"] = {{"remade", report.refinement.remade},
+                         {"unsureTexelsBefore", report.refinement.unsureBefore},
+                         {"unsureTexels", report.refinement.unsureAfter}};
     std::printf("%s\n", j.dump(2).c_str());
   } else if (!o.quiet) {
     std::printf("%s: %s -> %s (%s, filter %s, %.2f s)\n", output.c_str(), vff::cli::formatBytes(in.bytes().size()).c_str(),
@@ -210,6 +214,11 @@ void printReport(const Options& o, const std::string& input, const std::string& 
                   static_cast<unsigned long long>(b.changed), static_cast<unsigned long long>(b.hits), b.maxError,
                   b.hits ? std::sqrt(b.sumSquared / double(b.hits)) : 0.0);
     }
+    if (const auto& r = report.refinement; r.present && r.remade)
+      std::printf("  refinement remade for the new maps from its own triangles and margin: %u unsure texels (were %u)\n",
+                  r.unsureAfter, r.unsureBefore);
+    else if (r.present)
+      std::printf("  refinement kept (the maps decode as before): %u unsure texels\n", r.unsureAfter);
   }
 }
 
@@ -223,6 +232,7 @@ int main(int argc, char** argv) {
       "of unorm8-* fields also try the hits-med filter (format 1.1: a hit mask and median-predicted\n"
       "hit codes) and keep it where it is smaller. --decompress writes stored blocks (format 1.0), the\n"
       "form a GPU loader uploads without decoding. Layout, metadata and maps are kept exactly; the\n"
+      "refinement (REFN) is kept, or with --bc4 remade for the new maps from its own triangles; the\n"
       "output is written through a temporary file and a rename.\n"
       "  vff-compress in.vff out.vff\n"
       "  vff-compress --decompress in.vff out.vff\n"

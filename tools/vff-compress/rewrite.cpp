@@ -31,6 +31,25 @@ void toBc4(std::span<const uint8_t> codes, uint32_t m, std::vector<uint8_t>* blo
   }
 }
 
+// The refinement of `in`, set on the writer: as it is, or (remake) made again for the new maps from
+// its triangles, with its margin.
+Status keepRefinement(const File& in, const FieldDesc& field, std::span<const uint8_t> maps, bool remake, Writer* w,
+                      RefinementReport* r) {
+  const RefinementView& refinement = in.refinement();
+  if (refinement.empty()) return {};
+  r->present = true;
+  r->unsureBefore = refinement.unsureTexels;
+  r->unsureAfter = refinement.unsureTexels;
+  if (!remake) return w->setRefinement(refinement);
+  RefineOptions o;
+  o.marginSpreads = refinement.margin / refineSpread(field);
+  auto made = makeRefinement(field, maps, refinement.positions, refinement.indices, o);
+  if (!made) return std::move(made).error();
+  r->remade = true;
+  r->unsureAfter = made->unsureTexels;
+  return w->setRefinement(made->view());
+}
+
 }  // namespace
 
 Status rewrite(const File& in, const std::string& out, const FieldDesc& field, const WriteOptions& options, bool bc4,
@@ -38,7 +57,9 @@ Status rewrite(const File& in, const std::string& out, const FieldDesc& field, c
   const auto t0 = std::chrono::steady_clock::now();
   auto w = Writer::create(out, field, options);
   if (!w) return std::move(w).error();
-  std::vector<uint8_t> converted;
+  std::vector<uint8_t> converted, allConverted;  // with bc4 and a refinement: every new block, for makeRefinement
+  const RefinementView& refinement = in.refinement();
+  const bool remake = bc4 && !refinement.empty();
   for (Plane p : {Plane::kDistance, Plane::kNormal}) {
     if (!in.plane(p).present) continue;
     for (uint32_t b = 0; b < in.plane(p).blocks.size(); ++b) {
@@ -48,11 +69,13 @@ Status rewrite(const File& in, const std::string& out, const FieldDesc& field, c
       if (bc4 && p == Plane::kDistance) {
         toBc4(maps, field.mapResolution, &converted, &report->bc4);
         maps = converted;
+        if (remake) allConverted.insert(allConverted.end(), converted.begin(), converted.end());
       }
       if (Status st = w->writeMaps(p, maps); !st) return st;
     }
   }
   report->bc4.done = bc4;
+  if (Status st = keepRefinement(in, field, allConverted, remake, &*w, &report->refinement); !st) return st;
   if (Status st = w->finish(); !st) return st;
   report->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   auto back = File::open(out);

@@ -37,6 +37,9 @@ vff::Result<FieldData> loadVff(const std::string& path) {
   d.field = f->field();
   d.layout = f->layout();
   d.metadata = std::string(f->metadata());
+  if (const vff::RefinementView& r = f->refinement(); !r.empty())
+    d.refinement = {r.margin, {r.unsure.begin(), r.unsure.end()}, r.unsureTexels, {r.positions.begin(), r.positions.end()},
+                    {r.indices.begin(), r.indices.end()}};
   const vff::PlaneInfo& dist = f->plane(vff::Plane::kDistance);
   d.codec = dist.blocks.empty() ? vff::Codec::kStored : dist.blocks.front().codec;
   // G as a write option: 0 when every plane has the writer's automatic G (it differs per plane),
@@ -72,6 +75,7 @@ int saveVff(const Options& o, const FieldData& d) {
   w.mapsPerBlock = o.codec.mapsPerBlockGiven() ? o.codec.mapsPerBlock : (w.codec == d.codec ? d.mapsPerBlock : 0);
   w.layout = o.layout.limits({d.layout.target, d.layout.maxTextureSize, d.layout.maxLayers, d.layout.gutter});
   w.metadataJson = d.metadata;
+  w.refinement = d.refinement.view();
   // A field that does not fit the requested limits is a command-line problem: exit 1, naming the limit.
   auto layout = vff::computeLayout(d.field, w.layout);
   if (!layout) {
@@ -91,6 +95,31 @@ int saveVff(const Options& o, const FieldData& d) {
                 vff::distanceEncodingName(d.field.distanceEncoding), vff::cli::count(layout->sliceCount, "slice").c_str(),
                 layout->sliceWidth,
                 layout->sliceHeight, vff::layoutTargetName(layout->target), layout->gutter, vff::codecName(w.codec));
+  if (!o.quiet && !d.refinement.indices.empty())
+    std::printf("%s: refinement: %u unsure texels, %zu triangles\n", o.output.c_str(), d.refinement.unsureTexels,
+                d.refinement.indices.size() / 3);
+  return vff::cli::kExitSuccess;
+}
+
+// A refinement's unsure texels belong to the maps they were marked on: for new maps they are marked
+// again, from the refinement's own triangles, with its margin in the same multiple of the field's
+// spread. A bit1 field holds no distances to mark (the refinement is left out, with a warning).
+int remakeRefinement(const Options& o, const FieldData& from, FieldData* to) {
+  if (from.refinement.indices.empty()) return vff::cli::kExitSuccess;
+  if (to->field.distanceEncoding == vff::DistanceEncoding::kBit1) {
+    std::fprintf(stderr, "%s: warning: %s: the refinement (REFN) is left out: a bit1 field holds no distances to refine\n",
+                 kProg, o.input.c_str());
+    return vff::cli::kExitSuccess;
+  }
+  vff::RefineOptions r;
+  r.marginSpreads = from.refinement.margin / vff::refineSpread(from.field);
+  r.threads = o.threads;
+  auto made = vff::makeRefinement(to->field, to->distance, from.refinement.positions, from.refinement.indices, r);
+  if (!made) return vff::cli::reportError(kProg, o.input, made.error());
+  if (!o.quiet)
+    std::printf("refinement remade for the new maps from its own triangles: %u unsure texels (were %u)\n",
+                made->unsureTexels, from.refinement.unsureTexels);
+  to->refinement = std::move(*made);
   return vff::cli::kExitSuccess;
 }
 
@@ -122,6 +151,7 @@ int resampleMaps(const Options& o, FieldData* d) {
     out->metadata = std::move(*meta);
   }
   if (!o.quiet) std::printf("%s", vff::convert::describeResample(d->field, out->field, r, report).c_str());
+  if (int rc = remakeRefinement(o, *d, &*out); rc != vff::cli::kExitSuccess) return rc;
   *d = std::move(*out);
   return vff::cli::kExitSuccess;
 }
@@ -239,6 +269,9 @@ int main(int argc, char** argv) {
   if (auto rc = readInput(o, &d, &inputKind)) return *rc;
   if (o.resampling())
     if (int rc = resampleMaps(o, &d); rc != vff::cli::kExitSuccess) return rc;
+  if ((o.to == "exr" || o.to == "vdb") && !d.refinement.indices.empty())
+    std::fprintf(stderr, "%s: warning: %s: the refinement (REFN) is not exported: %s holds the maps only\n", kProg,
+                 o.input.c_str(), o.to == "vdb" ? "OpenVDB" : "EXR");
   if (o.to == "vdb") return toVdb(o, d, inputKind);
   return o.to == "exr" ? toExr(o, d) : saveVff(o, d);
 }
