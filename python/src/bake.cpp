@@ -51,6 +51,7 @@ uint32_t u32(int64_t v) { return uint32_t(std::min<int64_t>(v, UINT32_MAX)); }
 struct Options {
   bake::BakeOptions bake;
   WriteOptions write;
+  bool refine = false, refineProbe = false;  // vff-bake's --refine and --refine-probe
   py::object progress = py::none();
 };
 
@@ -81,6 +82,8 @@ Options optionsOf(const py::kwargs& kw) {
     else if (key == "max_layers") o.write.layout.maxLayers = uint32_t(intArg(v, "max_layers", 1, 65536));
     else if (key == "gutter") o.write.layout.gutter = uint32_t(intArg(v, "gutter", 0, 64));
     else if (key == "metadata") o.write.metadataJson = py::module_::import("json").attr("dumps")(v).cast<std::string>();
+    else if (key == "refine") o.refine = v.cast<bool>();
+    else if (key == "refine_probe") o.refineProbe = v.cast<bool>();
     else if (key == "progress") o.progress = py::reinterpret_borrow<py::object>(v);
     else throw py::type_error("bake: unexpected keyword argument '" + key + "'");
   }
@@ -92,6 +95,9 @@ Options optionsOf(const py::kwargs& kw) {
   if (filter == "hits-med") o.write.filter = Filter::kHitsMed;
   else if (filter != "none") throw py::value_error("filter: expected \"none\" or \"hits-med\", got \"" + filter + "\"");
   o.write.layout.target = spelled(vff::kLayoutTargets, target, "target");
+  if (o.refineProbe && !o.refine) throw py::value_error("refine_probe goes with refine=True");
+  if (o.refine && o.bake.encoding == DistanceEncoding::kBit1)
+    throw py::value_error("refine needs distances; encoding \"bit1\" has none");
   if (center.has_value() != (radius > 0)) throw py::value_error("center and radius go together (radius > 0)");
   if (center) {
     if (center->size() != 3) throw py::value_error("center: expected 3 numbers");
@@ -175,17 +181,27 @@ bake::Mesh meshOf(const py::object& vertices, const py::object& faces) {
   return mesh;
 }
 
-// Writes the baked field to `out` (atomically), or keeps it in memory; returns it opened.
-std::shared_ptr<PyFile> finish(const bake::BakedField& baked, const Options& o, const std::string& out) {
+// Writes the baked field to `out` (atomically), or keeps it in memory; returns it opened. With
+// refine, the refinement of `mesh` (makeRefinement) goes with it as REFN.
+std::shared_ptr<PyFile> finish(const bake::BakedField& baked, const bake::Mesh& mesh, Options o, const std::string& out) {
   Result<std::vector<uint8_t>> bytes = makeError(Code::kBadState, "not written");
   Status written;
+  Result<Refinement> refinement = Refinement{};
   {
     py::gil_scoped_release unlocked;
-    if (out.empty())
+    if (o.refine) {
+      refinement = makeRefinement(baked.field, baked.distance, mesh.positions, mesh.indices,
+                                  {.probe = o.refineProbe, .threads = o.bake.threads});
+      if (refinement) o.write.refinement = refinement->view();
+    }
+    if (!refinement)
+      written = refinement.error();
+    else if (out.empty())
       bytes = writeMemory(baked.field, baked.distance, baked.normals, o.write);
     else
       written = writeFile(out, baked.field, baked.distance, baked.normals, o.write);
   }
+  if (!refinement) check(refinement.error());
   if (!out.empty()) {
     check(written);
     return openFile(out, "all");
@@ -203,7 +219,9 @@ and radius (the bounding sphere; default the minimal enclosing one), codec ("sto
 zstd_level (1 to 22, 19), maps_per_block (0: about 256 KiB per block), filter ("none", "hits-med"),
 target ("2d-array", "3d"), max_texture_size (1 to 65536, 2048), max_layers (1 to 65536, 2048), gutter
 (0 to 64, 0), metadata (a dict
-stored as META), progress (a callable taking (maps done, maps total), called on the calling thread).
+stored as META), refine (False: also store the refinement, section REFN: unsure texels and the
+mesh, for FieldQuery's refined=True), refine_probe (False: with refine, test unsure texels with rays),
+progress (a callable taking (maps done, maps total), called on the calling thread).
 An integer outside its range (vff-bake's: map_size=0, threads=-1) raises ValueError naming it and
 the range. Ctrl-C stops the bake (KeyboardInterrupt); a mesh problem raises vff.MeshError.)doc";
 
@@ -214,7 +232,7 @@ void bindBake(py::module_& m) {
         Options o = optionsOf(kw);
         const bake::Mesh mesh = meshOf(vertices, faces);
         const bake::BakedField baked = bakeMesh(mesh, o);
-        return finish(baked, o, out.is_none() ? std::string() : out.cast<std::string>());
+        return finish(baked, mesh, o, out.is_none() ? std::string() : out.cast<std::string>());
       },
       py::arg("vertices"), py::arg("faces"), py::arg("out") = py::none(),
       (std::string(R"doc(
@@ -239,7 +257,7 @@ Writes it to `out` (atomically) when given; returns the field as a vff.File (in 
                                                                 {"format", info.format}}}}.dump();
         }
         const bake::BakedField baked = bakeMesh(loaded, o);
-        return finish(baked, o, out);
+        return finish(baked, loaded, o, out);
       },
       py::arg("path"), py::arg("out"),
       (std::string(R"doc(

@@ -191,10 +191,17 @@ inline void checkRays(const RayBatch& b) {
   throw py::value_error("ray " + std::to_string(bad) + ": " + rayProblem(r).value_or("refused"));
 }
 
+// The reconstruction the keywords ask for. refined: Reconstruction::kRefined (vff/refine.h), which
+// answers as nearest on a field without a refinement.
+inline Reconstruction reconstructionOf(bool interpolated, bool refined) {
+  if (interpolated && refined) throw py::value_error("interpolated and refined: give one reconstruction, not both");
+  return refined ? Reconstruction::kRefined : interpolated ? Reconstruction::kInterpolated : Reconstruction::kNearest;
+}
+
 // (threads is taken as any integer so that a negative one is a ValueError naming it, not pybind11's
 // "incompatible function arguments".)
 inline RayBatch batchOf(const py::object& origins, const py::object& directions, const py::object& tmin,
-                 const py::object& tmax, bool interpolated, float intraBias, const std::string& rayOrigin, int64_t threads) {
+                 const py::object& tmax, bool interpolated, bool refined, float intraBias, const std::string& rayOrigin, int64_t threads) {
   if (threads < 0 || threads > int64_t(UINT32_MAX))
     throw py::value_error("threads: expected an integer >= 0 (0: all cores), got " + std::to_string(threads));
   py::array o = vectors(origins, "origins"), d = vectors(directions, "directions");
@@ -210,7 +217,7 @@ inline RayBatch batchOf(const py::object& origins, const py::object& directions,
   b.tmax = bound(tmax, "tmax", std::numeric_limits<float>::infinity(), b.n);
   if (b.tmin.array) b.tminData = static_cast<const uint8_t*>(b.tmin.array->data()), b.tminStride = b.tmin.array->strides(0);
   if (b.tmax.array) b.tmaxData = static_cast<const uint8_t*>(b.tmax.array->data()), b.tmaxStride = b.tmax.array->strides(0);
-  b.options.reconstruction = interpolated ? Reconstruction::kInterpolated : Reconstruction::kNearest;
+  b.options.reconstruction = reconstructionOf(interpolated, refined);
   b.options.intraBias = intraBias;
   b.options.origin = rayOriginOf(rayOrigin);
   b.threads = vff::parallel::resolveThreads(unsigned(threads));
@@ -330,9 +337,9 @@ inline Vec3 vec3(const py::object& o, const char* name) {
   return {v[0], v[1], v[2]};
 }
 
-inline QueryOptions optionsOf(bool interpolated, float intraBias, const std::string& rayOrigin) {
+inline QueryOptions optionsOf(bool interpolated, bool refined, float intraBias, const std::string& rayOrigin) {
   QueryOptions qo;
-  qo.reconstruction = interpolated ? Reconstruction::kInterpolated : Reconstruction::kNearest;
+  qo.reconstruction = reconstructionOf(interpolated, refined);
   qo.intraBias = intraBias;
   qo.origin = rayOriginOf(rayOrigin);
   return qo;

@@ -35,60 +35,60 @@ py::tuple sitesBatch(const Target& target, const RayBatch& b) {
 template <class Py, class Get>
 void addQueries(py::class_<Py>& c, Get get) {
   c.def("intersect", [get](const Py& self, const py::object& o, const py::object& d, const py::object& tmin, const py::object& tmax,
-                           bool interpolated, float intraBias, const std::string& rayOrigin, int64_t threads, const py::object& out) {
-        return intersectBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, intraBias, rayOrigin, threads), out);
+                           bool interpolated, bool refined, float intraBias, const std::string& rayOrigin, int64_t threads, const py::object& out) {
+        return intersectBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, refined, intraBias, rayOrigin, threads), out);
       },
       py::arg("origins"), py::arg("directions"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(), py::kw_only(),
-      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("threads") = 0u, py::arg("out") = py::none(),
+      py::arg("interpolated") = false, py::arg("refined") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("threads") = 0u, py::arg("out") = py::none(),
       (std::string(kBatchDoc) + "\nReturns a vff.Hits: hit (N,) bool, t (N,) float32 (inf for a miss), point (N, 3) and "
                                 "normal (N, 3) float32 (NaN where there is none), inside (N,) bool. out: the Hits of an "
                                 "earlier call of the same length, filled again instead of new arrays (fresh arrays "
                                 "cost the first touch of their memory; a loop over batches saves it).").c_str());
   c.def("occluded", [get](const Py& self, const py::object& o, const py::object& d, const py::object& tmin, const py::object& tmax,
-                          bool interpolated, float intraBias, const std::string& rayOrigin, int64_t threads) {
-        return occludedBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, intraBias, rayOrigin, threads));
+                          bool interpolated, bool refined, float intraBias, const std::string& rayOrigin, int64_t threads) {
+        return occludedBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, refined, intraBias, rayOrigin, threads));
       },
       py::arg("origins"), py::arg("directions"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(), py::kw_only(),
-      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("threads") = 0u,
+      py::arg("interpolated") = false, py::arg("refined") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("threads") = 0u,
       (std::string(kBatchDoc) + "\nReturns an (N,) bool array: the ray hits the object within [tmin, tmax].").c_str());
   c.def("visibility", [get](const Py& self, const py::object& o, const py::object& d, const py::object& tmin, const py::object& tmax,
-                            bool interpolated, float intraBias, const std::string& rayOrigin, int64_t threads) {
-        return visibilityBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, intraBias, rayOrigin, threads));
+                            bool interpolated, bool refined, float intraBias, const std::string& rayOrigin, int64_t threads) {
+        return visibilityBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, refined, intraBias, rayOrigin, threads));
       },
       py::arg("origins"), py::arg("directions"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(), py::kw_only(),
-      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("threads") = 0u,
+      py::arg("interpolated") = false, py::arg("refined") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("threads") = 0u,
       (std::string(kBatchDoc) + "\nReturns an (N,) float32 array: the probability that each ray reaches tmax unoccluded "
                                 "(0 or 1 with nearest).").c_str());
   c.def("sites", [get](const Py& self, const py::object& o, const py::object& d, const py::object& tmin, const py::object& tmax,
-                       bool interpolated, float intraBias, const std::string& rayOrigin, int64_t threads) {
-        return sitesBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, intraBias, rayOrigin, threads));
+                       bool interpolated, bool refined, float intraBias, const std::string& rayOrigin, int64_t threads) {
+        return sitesBatch(get(self), batchOf(o, d, tmin, tmax, interpolated, refined, intraBias, rayOrigin, threads));
       },
       py::arg("origins"), py::arg("directions"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(), py::kw_only(),
-      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("threads") = 0u,
+      py::arg("interpolated") = false, py::arg("refined") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("threads") = 0u,
       (std::string(kBatchDoc) + "\nWhich map and texel answer each ray (libvff's LookupSite, as vff-query's columns "
                                 "sample, i, j): returns (sample, texel), (N,) int32 and (N, 2) int32 [i, j] (texel (i, "
                                 "j) is element [j, i] of File.distances(sample)); -1 for a ray that makes no lookup. "
                                 "The nearest reconstruction reads exactly that texel; the interpolated one centres "
                                 "its blend on it.").c_str());
-  c.def("intersect_ray", [get](const Py& self, const py::object& o, const py::object& d, float tmin, float tmax, bool interpolated,
+  c.def("intersect_ray", [get](const Py& self, const py::object& o, const py::object& d, float tmin, float tmax, bool interpolated, bool refined,
                                float intraBias, const std::string& rayOrigin) {
-        return hitTuple(get(self).intersect(checkedRay(Ray{vec3(o, "origin"), vec3(d, "direction"), tmin, tmax}), optionsOf(interpolated, intraBias, rayOrigin)));
+        return hitTuple(get(self).intersect(checkedRay(Ray{vec3(o, "origin"), vec3(d, "direction"), tmin, tmax}), optionsOf(interpolated, refined, intraBias, rayOrigin)));
       },
       py::arg("origin"), py::arg("direction"), py::arg("tmin") = 0.0f, py::arg("tmax") = std::numeric_limits<float>::infinity(),
-      py::kw_only(), py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object",
+      py::kw_only(), py::arg("interpolated") = false, py::arg("refined") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object",
       "One ray, through libvff's one-ray call: (hit, t, point, normal, inside) with point and normal as (x, y, z) tuples.");
-  c.def("occluded_ray", [get](const Py& self, const py::object& o, const py::object& d, float tmin, float tmax, bool interpolated,
+  c.def("occluded_ray", [get](const Py& self, const py::object& o, const py::object& d, float tmin, float tmax, bool interpolated, bool refined,
                               float intraBias, const std::string& rayOrigin) {
-        return get(self).occluded(checkedRay(Ray{vec3(o, "origin"), vec3(d, "direction"), tmin, tmax}), optionsOf(interpolated, intraBias, rayOrigin));
+        return get(self).occluded(checkedRay(Ray{vec3(o, "origin"), vec3(d, "direction"), tmin, tmax}), optionsOf(interpolated, refined, intraBias, rayOrigin));
       },
       py::arg("origin"), py::arg("direction"), py::arg("tmin") = 0.0f, py::arg("tmax") = std::numeric_limits<float>::infinity(),
-      py::kw_only(), py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", "One ray: libvff's one-ray occluded().");
-  c.def("visibility_ray", [get](const Py& self, const py::object& o, const py::object& d, float tmin, float tmax, bool interpolated,
+      py::kw_only(), py::arg("interpolated") = false, py::arg("refined") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", "One ray: libvff's one-ray occluded().");
+  c.def("visibility_ray", [get](const Py& self, const py::object& o, const py::object& d, float tmin, float tmax, bool interpolated, bool refined,
                                 float intraBias, const std::string& rayOrigin) {
-        return get(self).visibility(checkedRay(Ray{vec3(o, "origin"), vec3(d, "direction"), tmin, tmax}), optionsOf(interpolated, intraBias, rayOrigin));
+        return get(self).visibility(checkedRay(Ray{vec3(o, "origin"), vec3(d, "direction"), tmin, tmax}), optionsOf(interpolated, refined, intraBias, rayOrigin));
       },
       py::arg("origin"), py::arg("direction"), py::arg("tmin") = 0.0f, py::arg("tmax") = std::numeric_limits<float>::infinity(),
-      py::kw_only(), py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", "One ray: libvff's one-ray visibility().");
+      py::kw_only(), py::arg("interpolated") = false, py::arg("refined") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", "One ray: libvff's one-ray visibility().");
 }
 
 
@@ -121,7 +121,11 @@ Keeps its File alive.)doc");
          py::arg("file"), "Makes the query of an open vff.File (decoding its compressed blocks once).")
       .def_property_readonly("file", [](const PyQuery& q) { return q.owner; }, "The vff.File it reads.")
       .def_property_readonly("payload_bytes", [](const PyQuery& q) { return q.query.payloadBytes(); }, "Bytes of the maps it reads.")
-      .def_property_readonly("has_normals", [](const PyQuery& q) { return q.query.hasNormals(); }, "The field has normals.");
+      .def_property_readonly("has_normals", [](const PyQuery& q) { return q.query.hasNormals(); }, "The field has normals.")
+      .def_property_readonly("refined", [](const PyQuery& q) { return q.query.refined(); },
+                             "The field has a refinement (vff-bake --refine): refined=True casts its unsure rays exactly.")
+      .def_property_readonly("refinement_bytes", [](const PyQuery& q) { return q.query.refinementBytes(); },
+                             "Bytes the refinement takes: unsure bits, positions and the exact step's BVH (0 without one).");
   addQueries(fq, [](const PyQuery& q) -> const FieldQuery& { return q.query; });
 
   py::class_<PyInstance> in(m, "Instance", R"doc(

@@ -128,69 +128,69 @@ T sceneRay(const PyScene& self, const Ray& ray, const QueryOptions& qo, const py
 
 void addSceneQueries(py::class_<PyScene>& c) {
   c.def("intersect", [](const PyScene& self, const py::object& o, const py::object& d, const py::object& tmin,
-                        const py::object& tmax, bool interpolated, float intraBias, const std::string& rayOrigin,
+                        const py::object& tmax, bool interpolated, bool refined, float intraBias, const std::string& rayOrigin,
                         const py::object& sources, int64_t threads, const py::object& out) {
         const Scene& scene = committedScene(self);
-        const RayBatch b = batchOf(o, d, tmin, tmax, interpolated, intraBias, rayOrigin, threads);
+        const RayBatch b = batchOf(o, d, tmin, tmax, interpolated, refined, intraBias, rayOrigin, threads);
         const std::vector<uint32_t> src = sourcesOf(sources, scene, b.n);
         return sceneIntersect(SceneTarget{&scene, src.empty() ? nullptr : src.data()}, b, out);
       },
       py::arg("origins"), py::arg("directions"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(), py::kw_only(),
-      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("sources") = py::none(), py::arg("threads") = 0u, py::arg("out") = py::none(),
+      py::arg("interpolated") = false, py::arg("refined") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("sources") = py::none(), py::arg("threads") = 0u, py::arg("out") = py::none(),
       (std::string(kBatchDoc) + kSourcesDoc + "\nReturns a vff.Hits as Instance.intersect does, the nearest hit of any instance (of "
                                 "hits at the same t, the lowest id's), with instance: (N,) int32, the id of the "
                                 "instance hit, -1 for a miss. out: the Hits of an earlier Scene.intersect of the same "
                                 "length, filled again. Raises vff.OperationError (bad-state) before a commit().").c_str());
   c.def("occluded", [](const PyScene& self, const py::object& o, const py::object& d, const py::object& tmin,
-                       const py::object& tmax, bool interpolated, float intraBias, const std::string& rayOrigin,
+                       const py::object& tmax, bool interpolated, bool refined, float intraBias, const std::string& rayOrigin,
                        const py::object& sources, int64_t threads) {
         const Scene& scene = committedScene(self);
-        const RayBatch b = batchOf(o, d, tmin, tmax, interpolated, intraBias, rayOrigin, threads);
+        const RayBatch b = batchOf(o, d, tmin, tmax, interpolated, refined, intraBias, rayOrigin, threads);
         const std::vector<uint32_t> src = sourcesOf(sources, scene, b.n);
         return occludedBatch(SceneTarget{&scene, src.empty() ? nullptr : src.data()}, b);
       },
       py::arg("origins"), py::arg("directions"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(), py::kw_only(),
-      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("sources") = py::none(), py::arg("threads") = 0u,
+      py::arg("interpolated") = false, py::arg("refined") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("sources") = py::none(), py::arg("threads") = 0u,
       (std::string(kBatchDoc) + kSourcesDoc + "\nReturns an (N,) bool array: some instance reports the ray occluded.").c_str());
   c.def("visibility", [](const PyScene& self, const py::object& o, const py::object& d, const py::object& tmin,
-                       const py::object& tmax, bool interpolated, float intraBias, const std::string& rayOrigin,
+                       const py::object& tmax, bool interpolated, bool refined, float intraBias, const std::string& rayOrigin,
                        const py::object& sources, int64_t threads) {
         const Scene& scene = committedScene(self);
-        const RayBatch b = batchOf(o, d, tmin, tmax, interpolated, intraBias, rayOrigin, threads);
+        const RayBatch b = batchOf(o, d, tmin, tmax, interpolated, refined, intraBias, rayOrigin, threads);
         const std::vector<uint32_t> src = sourcesOf(sources, scene, b.n);
         return visibilityBatch(SceneTarget{&scene, src.empty() ? nullptr : src.data()}, b);
       },
       py::arg("origins"), py::arg("directions"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(), py::kw_only(),
-      py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("sources") = py::none(), py::arg("threads") = 0u,
+      py::arg("interpolated") = false, py::arg("refined") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object", py::arg("sources") = py::none(), py::arg("threads") = 0u,
       (std::string(kBatchDoc) + kSourcesDoc + "\nReturns an (N,) float32 array: the product, in id order, of the instances' "
                                 "visibility (instances the ray never comes near give exactly 1).").c_str());
   c.def("intersect_ray", [](const PyScene& self, const py::object& o, const py::object& d, float tmin, float tmax,
-                            bool interpolated, float intraBias, const std::string& rayOrigin, const py::object& source) {
-        const SceneHit h = sceneRay<SceneHit>(self, rayOf(o, d, tmin, tmax), optionsOf(interpolated, intraBias, rayOrigin), source, &Scene::intersect,
+                            bool interpolated, bool refined, float intraBias, const std::string& rayOrigin, const py::object& source) {
+        const SceneHit h = sceneRay<SceneHit>(self, rayOf(o, d, tmin, tmax), optionsOf(interpolated, refined, intraBias, rayOrigin), source, &Scene::intersect,
                              &Scene::intersectFrom);
         py::tuple t = hitTuple(h);
         return py::make_tuple(t[0], t[1], t[2], t[3], t[4], h.instance == kNoInstance ? -1 : int64_t(h.instance));
       },
       py::arg("origin"), py::arg("direction"), py::arg("tmin") = 0.0f, py::arg("tmax") = std::numeric_limits<float>::infinity(),
-      py::kw_only(), py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object",
+      py::kw_only(), py::arg("interpolated") = false, py::arg("refined") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object",
       py::arg("source") = py::none(),
       "One ray, through libvff's one-ray call: (hit, t, point, normal, inside, instance), instance -1 for a miss. "
       "source: the instance the ray starts on, -1 for none (see the batch's sources), or None.");
   c.def("occluded_ray", [](const PyScene& self, const py::object& o, const py::object& d, float tmin, float tmax,
-                           bool interpolated, float intraBias, const std::string& rayOrigin, const py::object& source) {
-        return sceneRay<bool>(self, rayOf(o, d, tmin, tmax), optionsOf(interpolated, intraBias, rayOrigin), source, &Scene::occluded,
+                           bool interpolated, bool refined, float intraBias, const std::string& rayOrigin, const py::object& source) {
+        return sceneRay<bool>(self, rayOf(o, d, tmin, tmax), optionsOf(interpolated, refined, intraBias, rayOrigin), source, &Scene::occluded,
                              &Scene::occludedFrom);
       },
       py::arg("origin"), py::arg("direction"), py::arg("tmin") = 0.0f, py::arg("tmax") = std::numeric_limits<float>::infinity(),
-      py::kw_only(), py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object",
+      py::kw_only(), py::arg("interpolated") = false, py::arg("refined") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object",
       py::arg("source") = py::none(), "One ray: libvff's one-ray occluded(). source: the instance the ray starts on, -1 for none (see the batch's sources), or None.");
   c.def("visibility_ray", [](const PyScene& self, const py::object& o, const py::object& d, float tmin, float tmax,
-                             bool interpolated, float intraBias, const std::string& rayOrigin, const py::object& source) {
-        return sceneRay<float>(self, rayOf(o, d, tmin, tmax), optionsOf(interpolated, intraBias, rayOrigin), source, &Scene::visibility,
+                             bool interpolated, bool refined, float intraBias, const std::string& rayOrigin, const py::object& source) {
+        return sceneRay<float>(self, rayOf(o, d, tmin, tmax), optionsOf(interpolated, refined, intraBias, rayOrigin), source, &Scene::visibility,
                              &Scene::visibilityFrom);
       },
       py::arg("origin"), py::arg("direction"), py::arg("tmin") = 0.0f, py::arg("tmax") = std::numeric_limits<float>::infinity(),
-      py::kw_only(), py::arg("interpolated") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object",
+      py::kw_only(), py::arg("interpolated") = false, py::arg("refined") = false, py::arg("intra_bias") = -1.0f, py::arg("ray_origin") = "on-object",
       py::arg("source") = py::none(), "One ray: libvff's one-ray visibility(). source: the instance the ray starts on, -1 for none (see the batch's sources), or None.");
   c.def("candidates", [](const PyScene& self, const py::object& o, const py::object& d, float tmin, float tmax) {
         return take(committedScene(self).candidates(rayOf(o, d, tmin, tmax)));

@@ -102,32 +102,34 @@ class _BatchQueries:
     #   ok = np.isfinite(o).all(1) & np.isfinite(d).all(1) & d.any(1)
     # threads: an integer >= 0 (0: all cores); a negative one raises ValueError.
     def intersect(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
-                  tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object",
+                  tmax: Bound = None, *, interpolated: bool = False, refined: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object",
                   threads: int = 0, out: Optional[Hits] = None) -> Hits: ...
     def occluded(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
-                 tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object",
+                 tmax: Bound = None, *, interpolated: bool = False, refined: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object",
                  threads: int = 0) -> npt.NDArray[np.bool_]: ...
     def visibility(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
-                   tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object",
+                   tmax: Bound = None, *, interpolated: bool = False, refined: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object",
                    threads: int = 0) -> npt.NDArray[np.float32]: ...
 
 class _Queries(_BatchQueries):
     def sites(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
-              tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object",
+              tmax: Bound = None, *, interpolated: bool = False, refined: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object",
               threads: int = 0) -> Tuple[npt.NDArray[np.int32], npt.NDArray[np.int32]]: ...
     # The one-ray calls refuse the same rays as the batches (ValueError "ray: the direction is zero").
     def intersect_ray(self, origin: Vec3, direction: Vec3, tmin: float = 0.0, tmax: float = ..., *,
-                      interpolated: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object") -> HitTuple: ...
+                      interpolated: bool = False, refined: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object") -> HitTuple: ...
     def occluded_ray(self, origin: Vec3, direction: Vec3, tmin: float = 0.0, tmax: float = ..., *,
-                     interpolated: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object") -> bool: ...
+                     interpolated: bool = False, refined: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object") -> bool: ...
     def visibility_ray(self, origin: Vec3, direction: Vec3, tmin: float = 0.0, tmax: float = ..., *,
-                       interpolated: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object") -> float: ...
+                       interpolated: bool = False, refined: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object") -> float: ...
 
 class FieldQuery(_Queries):
     def __init__(self, file: File) -> None: ...
     file: File
     payload_bytes: int
     has_normals: bool
+    refined: bool
+    refinement_bytes: int
 
 class Instance(_Queries):
     def __init__(self, field: FieldQuery, rotation: Optional[npt.ArrayLike] = None, translation: Vec3 = (0, 0, 0),
@@ -158,25 +160,25 @@ class Scene:
     def __len__(self) -> int: ...
     # sources: per ray, the id of the instance it starts on, -1 for none (spec/geometry.md 7.3, 7.4).
     def intersect(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
-                  tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0,
+                  tmax: Bound = None, *, interpolated: bool = False, refined: bool = False, intra_bias: float = -1.0,
                   ray_origin: RayOrigin = "on-object", sources: Optional[npt.NDArray[np.integer]] = None,
                   threads: int = 0, out: Optional[Hits] = None) -> Hits: ...
     def occluded(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
-                 tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0,
+                 tmax: Bound = None, *, interpolated: bool = False, refined: bool = False, intra_bias: float = -1.0,
                  ray_origin: RayOrigin = "on-object", sources: Optional[npt.NDArray[np.integer]] = None,
                  threads: int = 0) -> npt.NDArray[np.bool_]: ...
     def visibility(self, origins: npt.NDArray[np.float32], directions: npt.NDArray[np.float32], tmin: Bound = None,
-                   tmax: Bound = None, *, interpolated: bool = False, intra_bias: float = -1.0,
+                   tmax: Bound = None, *, interpolated: bool = False, refined: bool = False, intra_bias: float = -1.0,
                    ray_origin: RayOrigin = "on-object", sources: Optional[npt.NDArray[np.integer]] = None,
                    threads: int = 0) -> npt.NDArray[np.float32]: ...
     def intersect_ray(self, origin: Vec3, direction: Vec3, tmin: float = 0.0, tmax: float = ..., *,
-                      interpolated: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object",
+                      interpolated: bool = False, refined: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object",
                       source: Optional[int] = None) -> SceneHitTuple: ...
     def occluded_ray(self, origin: Vec3, direction: Vec3, tmin: float = 0.0, tmax: float = ..., *,
-                     interpolated: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object",
+                     interpolated: bool = False, refined: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object",
                      source: Optional[int] = None) -> bool: ...
     def visibility_ray(self, origin: Vec3, direction: Vec3, tmin: float = 0.0, tmax: float = ..., *,
-                       interpolated: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object",
+                       interpolated: bool = False, refined: bool = False, intra_bias: float = -1.0, ray_origin: RayOrigin = "on-object",
                        source: Optional[int] = None) -> float: ...
     def candidates(self, origin: Vec3, direction: Vec3, tmin: float = 0.0, tmax: float = ...) -> list[int]: ...
 

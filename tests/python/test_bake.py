@@ -73,6 +73,59 @@ def test_bake_answers_the_spheres():
     assert np.median(np.sum(radial * h.normal[on_ball], axis=1)) > 0.95
 
 
+def ray_mesh(o, d, v, f, chunk=128):
+    """Whether rays o + t d (t >= 0) meet triangles (v, f): Moller-Trumbore over every triangle."""
+    a, e1, e2 = v[f[:, 0]], v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]
+    out = np.zeros(len(o), bool)
+    for s in range(0, len(o), chunk):
+        oo, dd = o[s:s + chunk, None, :], d[s:s + chunk, None, :]
+        p = np.cross(dd, e2)
+        det = np.sum(e1 * p, -1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            inv = 1.0 / det
+            tv = oo - a
+            u = np.sum(tv * p, -1) * inv
+            q = np.cross(tv, e1)
+            w = np.sum(dd * q, -1) * inv
+            t = np.sum(e2 * q, -1) * inv
+        out[s:s + chunk] = np.any((det != 0) & (u >= 0) & (w >= 0) & (u + w <= 1) & (t >= 0), axis=1)
+    return out
+
+
+def test_bake_refined_answers_as_the_mesh(tmp_path):
+    # refine=True stores the refinement (REFN); refined=True then answers the rays the maps are
+    # unsure of by casting through the mesh: hit or miss as the triangles say, far more often than
+    # the nearest maps.
+    ball, moon = ((0.5, -0.25, 2.0), 0.6), ((1.6, -0.25, 2.0), 0.1)
+    v1, f1 = uv_sphere(ball[1], 12, 24, center=ball[0])
+    v2, f2 = uv_sphere(moon[1], 6, 12, center=moon[0])
+    v, f = np.vstack([v1, v2]), np.vstack([f1, f2 + len(v1)])
+    field = vff.bake(v, f, count=4, map_size=16, refine=True)
+    assert field.validate() == []
+    q = vff.FieldQuery(field)
+    assert q.refined and q.refinement_bytes > 0
+    rng = np.random.default_rng(4)
+    n = 3000
+    dirs = rng.normal(size=(n, 3))
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    origins = (np.array(field.center) + 3.0 * field.radius * dirs).astype(np.float32)
+    target = np.array(field.center) + rng.uniform(-1, 1, (n, 3)) * field.radius
+    d = (target - origins).astype(np.float32)
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    exact = ray_mesh(origins.astype(np.float64), d.astype(np.float64), v.astype(np.float64), f)
+    assert 0.1 < exact.mean() < 0.9
+    wrong_nearest = np.count_nonzero(q.occluded(origins, d) != exact)
+    wrong_refined = np.count_nonzero(q.occluded(origins, d, refined=True) != exact)
+    assert wrong_refined <= max(1, wrong_nearest // 10), (wrong_refined, wrong_nearest)
+    assert np.array_equal(q.intersect(origins, d, refined=True).hit, q.occluded(origins, d, refined=True))
+    plain = vff.FieldQuery(vff.bake(v, f, count=4, map_size=16))
+    assert not plain.refined
+    with pytest.raises(ValueError, match="refine_probe goes with refine=True"):
+        vff.bake(v, f, count=1, map_size=4, refine_probe=True)
+    with pytest.raises(ValueError, match="refine needs distances"):
+        vff.bake(v, f, count=1, map_size=8, encoding="bit1", refine=True)
+
+
 def test_bake_file_and_rewrites(tmp_path):
     v, f = uv_sphere(rings=8, segments=16)
     obj = tmp_path / "ball.obj"

@@ -11,27 +11,29 @@ FIELDS = ["u8d-zstd-normals-meta", "u8c-stored-normals-3d-gutter1", "u16d-zstd-n
           "bc4-zstd-normals-slices"]
 
 
-def one_ray_answers(target, o, d, interpolated=False):
-    rows = [target.intersect_ray(o[i], d[i], interpolated=interpolated) for i in range(len(o))]
+def one_ray_answers(target, o, d, interpolated=False, refined=False):
+    kw = dict(interpolated=interpolated, refined=refined)
+    rows = [target.intersect_ray(o[i], d[i], **kw) for i in range(len(o))]
     hit = np.array([r[0] for r in rows])
     t = np.array([r[1] for r in rows], np.float32)
     point = np.array([r[2] for r in rows], np.float32)
     normal = np.array([r[3] for r in rows], np.float32)
-    vis = np.array([target.visibility_ray(o[i], d[i], interpolated=interpolated) for i in range(len(o))], np.float32)
-    occ = np.array([target.occluded_ray(o[i], d[i], interpolated=interpolated) for i in range(len(o))])
+    vis = np.array([target.visibility_ray(o[i], d[i], **kw) for i in range(len(o))], np.float32)
+    occ = np.array([target.occluded_ray(o[i], d[i], **kw) for i in range(len(o))])
     return hit, t, point, normal, vis, occ
 
 
-def check_batch_equals_one_ray(target, o, d, interpolated):
-    hit, t, point, normal, vis, occ = one_ray_answers(target, o, d, interpolated)
-    h = target.intersect(o, d, interpolated=interpolated, threads=3)
+def check_batch_equals_one_ray(target, o, d, interpolated, refined=False):
+    hit, t, point, normal, vis, occ = one_ray_answers(target, o, d, interpolated, refined)
+    kw = dict(interpolated=interpolated, refined=refined)
+    h = target.intersect(o, d, threads=3, **kw)
     assert h.hit.dtype == np.bool_ and h.t.dtype == np.float32 and h.point.shape == (len(o), 3)
     assert np.array_equal(h.hit, hit)
     assert np.array_equal(h.t, t)
     assert np.array_equal(h.point, point, equal_nan=True)
     assert np.array_equal(h.normal, normal, equal_nan=True)
-    assert np.array_equal(target.visibility(o, d, interpolated=interpolated, threads=2), vis)
-    assert np.array_equal(target.occluded(o, d, interpolated=interpolated), occ)
+    assert np.array_equal(target.visibility(o, d, threads=2, **kw), vis)
+    assert np.array_equal(target.occluded(o, d, **kw), occ)
     assert hit.any() and not hit.all()
 
 
@@ -47,6 +49,23 @@ def test_batch_equals_one_ray_interpolated():
         f = vff.open(str(VECTORS / "valid" / (name + ".vff")))
         o, d = rays_around(f.center, f.radius, 400, 2)
         check_batch_equals_one_ray(vff.FieldQuery(f), o, d, True)
+
+
+def test_batch_equals_one_ray_refined():
+    for name in ["u8d-refined", "u8c-zstd-normals-meta-refined"]:
+        f = vff.open(str(VECTORS / "valid" / (name + ".vff")))
+        q = vff.FieldQuery(f)
+        assert q.refined and q.refinement_bytes > 0
+        o, d = rays_around(f.center, f.radius, 500, 4)
+        check_batch_equals_one_ray(q, o, d, False, refined=True)
+        inst = vff.Instance.from_axis_angle(q, (1, 0, 0.5), 0.4, translation=(0, 2, 0))
+        (c, r) = inst.world_sphere
+        o, d = rays_around(c, r, 300, 5)
+        check_batch_equals_one_ray(inst, o, d, False, refined=True)
+    plain = vff.FieldQuery(vff.open(str(VECTORS / "valid" / "u8d-zstd-normals-meta.vff")))
+    assert not plain.refined and plain.refinement_bytes == 0
+    with pytest.raises(ValueError, match="give one reconstruction, not both"):
+        plain.intersect_ray((0, 0, 5), (0, 0, -1), interpolated=True, refined=True)
 
 
 def test_instance_batch_equals_one_ray():

@@ -21,7 +21,7 @@ test_help() {
   query --help
   expect_rc 0
   for opt in --ray --input --output --format --interpolated --visibility --tmin --tmax --rotate --translate --scale \
-    --threads --checksums --no-sites --columns --ray-origin "Exit codes:" "3  invalid input file"; do expect_out "$opt"; done
+    --threads --checksums --no-sites --columns --ray-origin --refined "Exit codes:" "3  invalid input file"; do expect_out "$opt"; done
 }
 
 # Nearest answers, split over threads in batches, equal the one-ray calls on every encoding.
@@ -45,6 +45,26 @@ test_interpolated_equals_one_ray() {
     expect_rc 0
     same "$WORK/want.csv" "$WORK/out"
   done
+}
+
+# --refined answers as the one-ray kRefined calls on the refined vectors (some rays take the exact
+# step: the answers differ from nearest's), and is refused where it cannot apply.
+test_refined_equals_one_ray() {
+  for f in u8d-refined u8c-zstd-normals-meta-refined; do
+    "$REFERENCE" rays "$VECTORS/$f.vff" 600 13 >"$WORK/rays.csv"
+    "$REFERENCE" answer "$VECTORS/$f.vff" "$WORK/rays.csv" --refined --visibility >"$WORK/want.csv"
+    "$REFERENCE" answer "$VECTORS/$f.vff" "$WORK/rays.csv" --visibility >"$WORK/nearest.csv"
+    query "$VECTORS/$f.vff" -i "$WORK/rays.csv" -o "$WORK/got.csv" --refined --visibility -j 3
+    expect_rc 0
+    same "$WORK/want.csv" "$WORK/got.csv"
+    ! cmp -s "$WORK/got.csv" "$WORK/nearest.csv" || fail "$f: --refined answered every ray as nearest does"
+  done
+  query "$VECTORS/u8d-zstd-normals-meta.vff" --ray 0 0 5 0 0 -1 --refined
+  expect_rc 1
+  expect_err "--refined needs a refined field (vff-bake --refine); $VECTORS/u8d-zstd-normals-meta.vff has no REFN section"
+  query "$VECTORS/u8d-refined.vff" --ray 0 0 5 0 0 -1 --refined --interpolated
+  expect_rc 1
+  expect_err "excludes"
 }
 
 # Rays that start off the object (--ray-origin off-object, spec/geometry.md 7.4), nearest and

@@ -2,7 +2,7 @@
 //
 //   vff_query_reference rays FIELD N SEED > rays.csv       N rays around FIELD's sphere (CSV lines)
 //   vff_query_reference describe FIELD                     "MAPS M": its map count and resolution
-//   vff_query_reference answer FIELD rays.csv [--interpolated] [--visibility] [--off-object] [--rotate AX AY AZ A]
+//   vff_query_reference answer FIELD rays.csv [--interpolated | --refined] [--visibility] [--off-object] [--rotate AX AY AZ A]
 //                       [--translate X Y Z] [--scale S]    the answers as vff-query's CSV
 // The answers come from FieldQuery/Instance::intersect, ::site and ::visibility on one ray at a time, so the
 // tests compare vff-query's batches (split over threads) with the one-ray path.
@@ -59,6 +59,7 @@ int answer(int argc, char** argv) {
   bool placed = false;
   for (int i = 4; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--interpolated")) qo.reconstruction = vff::Reconstruction::kInterpolated;
+    else if (!std::strcmp(argv[i], "--refined")) qo.reconstruction = vff::Reconstruction::kRefined;
     else if (!std::strcmp(argv[i], "--visibility")) visibility = true;
     else if (!std::strcmp(argv[i], "--off-object")) qo.origin = vff::RayOrigin::kOffObject;
     else if (!std::strcmp(argv[i], "--rotate") && i + 4 < argc) {

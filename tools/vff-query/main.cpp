@@ -49,6 +49,7 @@ struct Options {
   std::string output = "-";
   std::string format;
   bool interpolated = false;
+  bool refined = false;
   bool visibility = false;
   float tmin = 0.0f;
   float tmax = std::numeric_limits<float>::infinity();
@@ -94,7 +95,12 @@ void addOptions(CLI::App& app, Options& o) {
       ->capture_default_str();
   app.add_option("--format", o.format, "answers as csv, jsonl or npy (default: npy for an output named *.npy, else csv)")
       ->check(CLI::IsMember({"csv", "jsonl", "npy"}));
-  app.add_flag("--interpolated", o.interpolated, "interpolated reconstruction (default: the paper's nearest)");
+  auto* interpolated =
+      app.add_flag("--interpolated", o.interpolated, "interpolated reconstruction (default: the paper's nearest)");
+  app.add_flag("--refined", o.refined,
+               "refined reconstruction: the rays the maps are unsure of cast through the field's triangles (a field "
+               "baked with vff-bake --refine)")
+      ->excludes(interpolated);
   app.add_flag("--visibility", o.visibility, "add a column: the ray's visibility (0..1; 0 or 1 with nearest)");
   app.add_option("--tmin", o.tmin, "the rays' tmin, unless a ray gives its own")->capture_default_str();
   app.add_option("--tmax", o.tmax, "the rays' tmax, unless a ray gives its own (default: inf)");
@@ -518,7 +524,7 @@ std::optional<int> printTiming(const Options& o, const Run& r, const std::option
   std::fprintf(stderr,
                "vff-query: timing: %s, %s, %s: field %.4f s, read %.4f s, query and write %.4f s, total %.4f s "
                "(%.1f Mrays/s); batch, answers kept, warm: %.4f s (%.1f Mrays/s); batch alone, warm: %.4f s (%.1f Mrays/s)\n",
-               cli::count(src.size, "ray").c_str(), cli::count(r.threads, "thread").c_str(), o.interpolated ? "interpolated" : "nearest", sec(at.open, at.read), sec(at.read, at.query),
+               cli::count(src.size, "ray").c_str(), cli::count(r.threads, "thread").c_str(), o.refined ? "refined" : o.interpolated ? "interpolated" : "nearest", sec(at.open, at.read), sec(at.read, at.query),
                sec(at.query, at.end), sec(at.open, at.end), n / std::max(1e-9, sec(at.open, at.end)), keptBatch,
                n / std::max(1e-9, keptBatch), batch, n / std::max(1e-9, batch));
   return std::nullopt;
@@ -551,6 +557,10 @@ int run(int argc, char** argv) {
   if (!file) return cli::reportError(kProg, o.field, file.error());
   auto q = FieldQuery::fromFile(*file);
   if (!q) return cli::reportError(kProg, o.field, q.error());
+  if (o.refined && !q->refined()) {
+    cli::usageError(kProg, "--refined needs a refined field (vff-bake --refine); " + o.field + " has no REFN section");
+    return cli::kExitUsage;
+  }
   std::optional<Instance> inst;
   if (auto rc = placeField(o, &*q, &inst)) return *rc;
 
@@ -559,7 +569,9 @@ int run(int argc, char** argv) {
   if (auto rc = readRays(o, &in)) return *rc;
 
   QueryOptions qo;
-  qo.reconstruction = o.interpolated ? Reconstruction::kInterpolated : Reconstruction::kNearest;
+  qo.reconstruction = o.refined        ? Reconstruction::kRefined
+                      : o.interpolated ? Reconstruction::kInterpolated
+                                       : Reconstruction::kNearest;
   qo.intraBias = o.intraBias;
   qo.origin = o.rayOrigin == "off-object" ? RayOrigin::kOffObject : RayOrigin::kOnObject;
   std::vector<Column> columns;
