@@ -3,8 +3,11 @@
 // same rays in the same run as the baseline.
 //
 //   vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size 512] [--spp 256] [--threads N] [--scene N]
-//                 [--sdf [--sdf-size N] [--sdf-spp N]]
+//                 [--sdf [--sdf-size N] [--sdf-spp N]] [--api gl|vulkan]
 //
+// --api vulkan adds the field's queries/s through the Vulkan pipeline (vk_bench.h, gpu/vulkan: the
+// same vff_query.glsl as SPIR-V) on the GL table's rays, printed after it with the Vulkan device's
+// name (built where Vulkan and glslangValidator are found).
 // --scene N adds the scene benchmark (scene_bench.h): the ground AO under N instances of the field
 // through gpu/glsl/vff_scene.glsl against the CPU vff::Scene, and a frame's instance update.
 // --sdf adds the distance-field peer (sdf_bench.h): the same AO through gpu/glsl/vff_sdf.glsl at the
@@ -41,6 +44,9 @@
 #ifdef VFF_GPU_BENCH_SDF
 #include "sdf_bench.h"
 #endif
+#ifdef VFF_GPU_BENCH_VULKAN
+#include "vk_bench.h"
+#endif
 #include "vff/bake/baker.h"
 #include "vff/bake/mesh.h"
 #include "vff/bake/procedural.h"
@@ -74,9 +80,9 @@ void main() {
 
 int usage() {
 #ifdef VFF_GPU_BENCH_SDF
-  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--ao-distance R] [--threads N] [--scene N] [--sdf [--sdf-size N] [--sdf-spp N]]\n");
+  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--ao-distance R] [--threads N] [--scene N] [--sdf [--sdf-size N] [--sdf-spp N]] [--api gl|vulkan]\n");
 #else
-  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--ao-distance R] [--threads N] [--scene N]\n");
+  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--ao-distance R] [--threads N] [--scene N] [--api gl|vulkan]\n");
 #endif
   return 1;
 }
@@ -91,6 +97,7 @@ struct BenchOptions {
   bool sdf = false;        // --sdf: also the distance-field peer at equal memory
   int sdfSize = 0, sdfSpp = 0;  // its image and rays per pixel (0: --size and --spp)
   bool meshGiven = false;  // --mesh was given
+  bool vulkan = false;     // --api vulkan: also the queries through the Vulkan pipeline
   unsigned threads = vff::parallel::resolveThreads(0);
 };
 
@@ -126,6 +133,8 @@ int parseOptions(int argc, char** argv, BenchOptions* o) {
       o->sdfSize = std::atoi(v);
     } else if (a == "--sdf-spp" && (v = next())) {
       o->sdfSpp = std::atoi(v);
+    } else if (a == "--api" && (v = next()) && (std::strcmp(v, "gl") == 0 || std::strcmp(v, "vulkan") == 0)) {
+      o->vulkan = std::strcmp(v, "vulkan") == 0;
     } else if (a == "--threads" && (v = next())) {
       o->threads = unsigned(std::max(1, std::atoi(v)));
     } else {
@@ -143,6 +152,12 @@ int parseOptions(int argc, char** argv, BenchOptions* o) {
 #ifndef VFF_GPU_BENCH_SDF
   if (o->sdf) {
     std::fprintf(stderr, "vff-gpu-bench: error: --sdf: built without the samples (VFF_BUILD_SAMPLES), no distance field\n");
+    return 1;
+  }
+#endif
+#ifndef VFF_GPU_BENCH_VULKAN
+  if (o->vulkan) {
+    std::fprintf(stderr, "vff-gpu-bench: error: --api vulkan: built without Vulkan (libvulkan-dev, glslangValidator)\n");
     return 1;
   }
 #endif
@@ -380,6 +395,15 @@ int main(int argc, char** argv) {
   }
 
   benchQueries(f, *gpu, *cpu, rayProg, o.threads);
+#ifdef VFF_GPU_BENCH_VULKAN
+  if (o.vulkan) {
+    auto makeRays = [&f](size_t n, uint64_t seed, std::vector<Ray>* rays) {
+      std::vector<float> unused;
+      makeRandomRays(f, n, seed, rays, &unused);
+    };
+    if (const int code = harness::benchVulkanQueries(*file, *cpu, makeRays); code != 0) return code;
+  }
+#endif
   benchAo(f, groundY, *gpu, *cpu, aoProg, o);
   if (o.sceneInstances > 0) {
     const harness::SceneBenchOptions so{.instances = o.sceneInstances, .size = o.size, .spp = o.spp,
