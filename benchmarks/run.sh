@@ -15,7 +15,8 @@
 #   compression  vff-compress --benchmark: the hits-med codec against zstd, xz and OpenEXR's
 #   gpu          vff-gpu-bench, where a headless OpenGL 4.3 context opens (it names the renderer),
 #                with --sdf: the ground AO by the field's GLSL and by a distance field's GLSL at
-#                equal memory, against the exact image
+#                equal memory, against the exact image; with --api vulkan where a Vulkan device answers:
+#                the same queries through the Vulkan pipeline (gpu/vulkan)
 #   python       benchmarks/python_query.py, where the Python module is built: a million rays through
 #                vff-query (.npy in and out, end to end) and through the Python batch, each against
 #                the C++ batch on the same rays and field in the same run
@@ -153,6 +154,9 @@ elif [[ -x $gpubench ]]; then
   # --sdf where the bench was built with the distance-field peer (its usage names the option).
   gpusdf=()
   if [[ $("$gpubench" --help 2>&1) == *--sdf* ]]; then gpusdf=(--mesh "$mesh" --sdf "${gpusdfargs[@]}"); fi
+  # --api vulkan where the bench was built with the Vulkan path and a Vulkan device answers.
+  if [[ $("$gpubench" --help 2>&1) == *"--api gl|vulkan"* ]] && command -v vulkaninfo >/dev/null &&
+    vulkaninfo --summary >/dev/null 2>&1; then gpusdf+=(--api vulkan); fi
   skip_if="no headless OpenGL" step gpu "$gpubench" --field "$raw/field.vff" "${gpusdf[@]}" "${gpuargs[@]}"
 else
   echo "vff-gpu-bench is not built (no OpenGL or EGL development files)" >"$raw/gpu.skip"
