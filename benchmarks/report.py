@@ -483,6 +483,24 @@ def sdf_summary(d):
     return lines
 
 
+def refined_summary(d):
+    """The README's short form of the refined table: a row per mesh and memory that fits."""
+    lines = ["| mesh | memory MiB | refined / SDF speed (ao / aimed) | wrong answers, refined (ao / aimed) | "
+             "wrong answers, SDF (ao / aimed) |", "|---|---:|---:|---:|---:|"]
+    groups = {}
+    for r in d.get("refined", []):
+        groups.setdefault((r["mesh"], r["mib"]), {})[r["set"]] = r
+    for (mesh, mib), g in groups.items():
+        sets = [g[k] for k in ("ao", "aimed") if k in g]
+        if not all(r["fits"] for r in sets):
+            lines.append(f"| {mesh} | {mib:.1f} | {sets[0]['note']} | | |")
+            continue
+        lines.append(f"| {mesh} | {mib:.1f} | " + " / ".join(f"{r['speed']:.1f}x" for r in sets) + " | " +
+                     " / ".join(f"{r['wrong']:.3f}%" for r in sets) + " | " +
+                     " / ".join(f"{r['sdfwrong']:.3f}%" for r in sets) + " |")
+    return lines
+
+
 def compression_table(c):
     lines = ["| codec | bytes / payload | bytes / zstd -19's | decompression, MB/s (1 core) |",
              "|---|---:|---:|---:|"]
@@ -788,6 +806,10 @@ def full_block(runs, newest, base):
                  f"{source}, {d['values']} values, {d['rays']} rays per set; command "
                  f"`{ssteps['sdf_cmd']}`. Speed above 1x: the field is faster; wrong answers: rays answered otherwise "
                  "than Embree.", "", *sdf_summary(d), ""]
+        if d.get("refined"):
+            main += ["The refined field (`vff-bake --refine`, `Reconstruction::kRefined`) at the distance field's "
+                     "memory (its maps, unsure bits and exact step together), from the same run:", "",
+                     *refined_summary(d), ""]
     tsteps, source = newest_with(runs, "three", base)
     if tsteps:
         t = tsteps["three"]
