@@ -21,7 +21,7 @@
 #include "ao_gl.h"
 #include "ao_scene.h"
 #include "baked_fields.h"
-#include "common/rng.h"
+#include "field_cases.h"
 #include "egl_context.h"
 #include "gl_test.h"
 #include "vff/bake/baker.h"
@@ -66,35 +66,6 @@ struct GpuOut {
   float nearest[4], nearestNormal[4], interp[4], interpNormal[4];
 };
 
-std::vector<GpuRay> makeRays(const FieldDesc& f, uint32_t count, uint64_t seed) {
-  test::Rng rng(seed);
-  const Vec3 c{f.sphere.center[0], f.sphere.center[1], f.sphere.center[2]};
-  const float R = f.sphere.radius;
-  std::vector<GpuRay> rays(count);
-  for (uint32_t r = 0; r < count; ++r) {
-    Vec3 o, d;
-    float tmin = 0, tmax = INFINITY;
-    if (r % 4 != 3) {  // mostly from outside: the interpolated path
-      const Vec3 a = rng.direction(), b = rng.direction();
-      const float s = R * (1.05f + 2.0f * rng.uniform()), s2 = R * 1.1f * std::cbrt(rng.uniform());
-      o = Vec3{c.x + a.x * s, c.y + a.y * s, c.z + a.z * s};
-      d = Vec3{c.x + b.x * s2 - o.x, c.y + b.y * s2 - o.y, c.z + b.z * s2 - o.z};
-      if (r % 8 == 2) d = Vec3{d.x * 2.5f, d.y * 2.5f, d.z * 2.5f};
-      if (r % 16 == 4) tmax = 1.5f * rng.uniform();
-    } else {
-      const Vec3 a = rng.direction();
-      const float s = R * 0.95f * std::cbrt(rng.uniform());
-      o = Vec3{c.x + a.x * s, c.y + a.y * s, c.z + a.z * s};
-      d = rng.direction();
-    }
-    if (r % 8 == 7) tmax = 0.6f * R * rng.uniform();  // (short rays from inside: the contact case)
-    // intraBias: 0, the default (-1), or VFF_OFF_OBJECT (-2: section 7.4) for half the rays from inside.
-    const float bias = r % 8 == 7 ? -2.0f : r % 3 == 0 ? 0.0f : -1.0f;
-    rays[r] = GpuRay{{o.x, o.y, o.z, 0}, {d.x, d.y, d.z, 0}, {tmin, tmax, bias, 0}};
-  }
-  return rays;
-}
-
 std::vector<GpuOut> runRays(const gl::GpuField& field, GLuint program, const std::vector<GpuRay>& rays) {
   GLuint bufs[2];
   glGenBuffers(2, bufs);
@@ -136,7 +107,7 @@ TEST_P(GpuField, NormalsAndInterpolatedMatchCpu) {
   ASSERT_NE(prog, 0u);
   auto cpu = FieldQuery::fromFile(*file);
   ASSERT_TRUE(cpu.ok()) << cpu.error().toString();
-  const std::vector<GpuRay> rays = makeRays(f, 8192, 77);
+  const std::vector<GpuRay> rays = gputest::interpolatedRays<GpuRay>(f, 8192, 77);  // field_cases.h
   const std::vector<GpuOut> out = runRays(*gpu, prog, rays);
   glDeleteProgram(prog);
 
@@ -249,20 +220,8 @@ TEST_P(GpuField, NormalsAndInterpolatedMatchCpu) {
   EXPECT_GT(iHits, rays.size() / 8);
 }
 
-std::vector<FieldCase> fieldCases() {
-  std::vector<FieldCase> cases;
-  for (auto p : {PositionScheme::kOctaHemi2, PositionScheme::kEqualAreaOctaGrid, PositionScheme::kSphericalFibonacci})
-    for (auto d : {DirectionScheme::kConcentricEqualArea, DirectionScheme::kHemiOctahedral})
-      cases.push_back({p, d, DistanceEncoding::kUnorm8Diameter});
-  cases.push_back({PositionScheme::kOctaHemi2, DirectionScheme::kHemiOctahedral, DistanceEncoding::kUnorm8Chord});
-  cases.push_back({PositionScheme::kSphericalFibonacci, DirectionScheme::kConcentricEqualArea,
-                   DistanceEncoding::kUnorm16Diameter, LayoutTarget::kTexture3D});
-  cases.push_back({PositionScheme::kEqualAreaOctaGrid, DirectionScheme::kConcentricEqualArea, DistanceEncoding::kBit1});
-  return cases;
-}
-
-INSTANTIATE_TEST_SUITE_P(Fields, GpuField, ::testing::ValuesIn(fieldCases()),
-                         [](const ::testing::TestParamInfo<FieldCase>& i) { return caseName(i.param); });
+// field_cases.h's, which the Vulkan suite (test_vk_query.cpp) runs too.
+INSTANTIATE_TEST_SUITE_P(Fields, GpuField, ::testing::ValuesIn(gputest::interpolatedCases()), gputest::caseParamName);
 
 // ---- Ground AO ---------------------------------------------------------------------------------------
 
