@@ -10,7 +10,7 @@ packages=(
   nlohmann-json3-dev
   libstb-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev glslang-tools
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
-  libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools
+  libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools spirv-cross
   clang libclang-rt-14-dev
   glmark2-data zstd xz-utils python3 universal-ctags
   python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-matplotlib

@@ -3,11 +3,13 @@
 // same rays in the same run as the baseline.
 //
 //   vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size 512] [--spp 256] [--threads N] [--scene N]
-//                 [--sdf [--sdf-size N] [--sdf-spp N]] [--api gl|vulkan]
+//                 [--sdf [--sdf-size N] [--sdf-spp N]] [--api gl|vulkan|vulkan-hlsl]
 //
 // --api vulkan adds the field's queries/s through the Vulkan pipeline (vk_bench.h, gpu/vulkan: the
 // same vff_query.glsl as SPIR-V) on the GL table's rays, printed after it with the Vulkan device's
-// name (built where Vulkan and glslangValidator are found).
+// name (built where Vulkan and glslangValidator are found). --api vulkan-hlsl runs the same table
+// with the kernel compiled from the generated HLSL (vff::vk::ShaderLanguage::kHlsl; built where
+// spirv-cross is found too).
 // --scene N adds the scene benchmark (scene_bench.h): the ground AO under N instances of the field
 // through gpu/glsl/vff_scene.glsl against the CPU vff::Scene, and a frame's instance update.
 // --sdf adds the distance-field peer (sdf_bench.h): the same AO through gpu/glsl/vff_sdf.glsl at the
@@ -80,9 +82,9 @@ void main() {
 
 int usage() {
 #ifdef VFF_GPU_BENCH_SDF
-  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--ao-distance R] [--threads N] [--scene N] [--sdf [--sdf-size N] [--sdf-spp N]] [--api gl|vulkan]\n");
+  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--ao-distance R] [--threads N] [--scene N] [--sdf [--sdf-size N] [--sdf-spp N]] [--api gl|vulkan|vulkan-hlsl]\n");
 #else
-  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--ao-distance R] [--threads N] [--scene N] [--api gl|vulkan]\n");
+  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--ao-distance R] [--threads N] [--scene N] [--api gl|vulkan|vulkan-hlsl]\n");
 #endif
   return 1;
 }
@@ -98,6 +100,7 @@ struct BenchOptions {
   int sdfSize = 0, sdfSpp = 0;  // its image and rays per pixel (0: --size and --spp)
   bool meshGiven = false;  // --mesh was given
   bool vulkan = false;     // --api vulkan: also the queries through the Vulkan pipeline
+  bool hlsl = false;       // --api vulkan-hlsl: that pipeline with the kernel built from HLSL
   unsigned threads = vff::parallel::resolveThreads(0);
 };
 
@@ -133,8 +136,10 @@ int parseOptions(int argc, char** argv, BenchOptions* o) {
       o->sdfSize = std::atoi(v);
     } else if (a == "--sdf-spp" && (v = next())) {
       o->sdfSpp = std::atoi(v);
-    } else if (a == "--api" && (v = next()) && (std::strcmp(v, "gl") == 0 || std::strcmp(v, "vulkan") == 0)) {
-      o->vulkan = std::strcmp(v, "vulkan") == 0;
+    } else if (a == "--api" && (v = next()) &&
+               (std::strcmp(v, "gl") == 0 || std::strcmp(v, "vulkan") == 0 || std::strcmp(v, "vulkan-hlsl") == 0)) {
+      o->vulkan = std::strcmp(v, "gl") != 0;
+      o->hlsl = std::strcmp(v, "vulkan-hlsl") == 0;
     } else if (a == "--threads" && (v = next())) {
       o->threads = unsigned(std::max(1, std::atoi(v)));
     } else {
@@ -401,7 +406,7 @@ int main(int argc, char** argv) {
       std::vector<float> unused;
       makeRandomRays(f, n, seed, rays, &unused);
     };
-    if (const int code = harness::benchVulkanQueries(*file, *cpu, makeRays); code != 0) return code;
+    if (const int code = harness::benchVulkanQueries(*file, *cpu, makeRays, o.hlsl); code != 0) return code;
   }
 #endif
   benchAo(f, groundY, *gpu, *cpu, aoProg, o);

@@ -33,17 +33,19 @@ std::vector<vk::QueryRay> toQueryRays(const std::vector<Ray>& rays) {
 
 }  // namespace
 
-int benchVulkanQueries(const File& file, const FieldQuery& cpu, const RayMaker& makeRays) {
+int benchVulkanQueries(const File& file, const FieldQuery& cpu, const RayMaker& makeRays, bool hlsl) {
   auto ctx = vk::Context::create();  // a GPU first where there is one; VFF_VK_VALIDATION=1 checks the run
   if (!ctx) return fail(ctx.error());
   auto gpu = vk::loadField(*ctx, file);
   if (!gpu) return fail(gpu.error());
-  auto pipe = vk::QueryPipeline::create(*ctx, gpu->kind());
+  vk::PipelineOptions po;
+  po.language = hlsl ? vk::ShaderLanguage::kHlsl : vk::ShaderLanguage::kGlsl;
+  auto pipe = vk::QueryPipeline::create(*ctx, gpu->kind(), po);
   if (!pipe) return fail(pipe.error());
   std::printf(
-      "\nVulkan: %s; field queries/s through vff::vk::QueryPipeline on the GL table's rays\n"
+      "\nVulkan: %s; field queries/s through vff::vk::QueryPipeline (kernel from %s) on the GL table's rays\n"
       "(wall time of the submissions: recording, dispatch and fence wait; best of 2)\n",
-      ctx->deviceName().c_str());
+      ctx->deviceName().c_str(), hlsl ? "HLSL" : "GLSL");
   std::printf("| rays | query | Vulkan rays/s | answers differing from the CPU by > 1e-4 |\n|---|---|---|---|\n");
   // 2^20 and 2^21 rays: the answers take 80 bytes a ray on the host.
   for (int logN = 20; logN <= 21; ++logN) {

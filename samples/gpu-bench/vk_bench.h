@@ -16,7 +16,9 @@ using RayMaker = std::function<void(size_t n, uint64_t seed, std::vector<Ray>* r
 // Prints the Vulkan device and a table of rays/s (2^20 and 2^21 rays, kNearest occluded and
 // kInterpolated visibility; the wall time of the submissions, in parts that fit the device's
 // maxStorageBufferRange, best of 2) with the count of answers
-// that differ from the CPU's by more than 1e-4. Returns an exit code (4 without a Vulkan device).
-int benchVulkanQueries(const File& file, const FieldQuery& cpu, const RayMaker& makeRays);
+// that differ from the CPU's by more than 1e-4. `hlsl`: the kernel built from the generated HLSL
+// (vff::vk::ShaderLanguage::kHlsl) instead of the GLSL's. Returns an exit code (4 without a Vulkan
+// device, or with hlsl where the build has no HLSL kernels).
+int benchVulkanQueries(const File& file, const FieldQuery& cpu, const RayMaker& makeRays, bool hlsl = false);
 
 }  // namespace vff::harness

@@ -32,12 +32,16 @@ struct VffVkAnswer {
 layout(std430, binding = 4) readonly buffer VffVkRays { VffVkRay vffVkRays[]; };
 layout(std430, binding = 5) writeonly buffer VffVkAnswers { VffVkAnswer vffVkAnswers[]; };
 // which: bit 0 kNearest, bit 1 kInterpolated (the other's members are left zero); firstRay: the
-// ray of invocation 0 (a batch beyond the device's work-group count limit runs in several dispatches).
-layout(push_constant) uniform VffVkPush { uint which; uint firstRay; } vffVkPush;
+// ray of invocation 0 (a batch beyond the device's work-group count limit runs in several dispatches);
+// rayCount: the rays in the batch. The count is passed rather than taken from vffVkRays.length():
+// in the HLSL generated from this shader that is ByteAddressBuffer.GetDimensions, which glslang's
+// HLSL front end answers in 4-byte words where HLSL defines bytes, so the HLSL kernel would stop at a
+// quarter of the rays.
+layout(push_constant) uniform VffVkPush { uint which; uint firstRay; uint rayCount; } vffVkPush;
 
 void main() {
   uint id = gl_GlobalInvocationID.x + vffVkPush.firstRay;
-  if (id >= uint(vffVkRays.length())) return;
+  if (id >= vffVkPush.rayCount) return;
   VffVkRay r = vffVkRays[id];
   VffVkAnswer o;
   o.flags = 0u;

@@ -20,6 +20,15 @@ extern const uint32_t kQuerySpirvTexture3D[];
 extern const size_t kQuerySpirvTexture3DWords;
 extern const uint32_t kQuerySpirvBc4[];
 extern const size_t kQuerySpirvBc4Words;
+#if VFF_VK_HLSL
+// The HLSL kernels (CMakeLists.txt, make_hlsl.cmake): spirv-cross's HLSL of the above, compiled by glslang's HLSL front end.
+extern const uint32_t kQuerySpirvHlslArray2D[];
+extern const size_t kQuerySpirvHlslArray2DWords;
+extern const uint32_t kQuerySpirvHlslTexture3D[];
+extern const size_t kQuerySpirvHlslTexture3DWords;
+extern const uint32_t kQuerySpirvHlslBc4[];
+extern const size_t kQuerySpirvHlslBc4Words;
+#endif
 }  // namespace detail
 
 namespace {
@@ -28,7 +37,21 @@ constexpr uint32_t kRaysBinding = 4;
 constexpr uint32_t kAnswersBinding = 5;
 constexpr uint32_t kGroupSize = 64;  // local_size_x of the shader
 
-std::pair<const uint32_t*, size_t> spirv(MapsKind kind) {
+std::pair<const uint32_t*, size_t> spirv(MapsKind kind, ShaderLanguage language) {
+#if VFF_VK_HLSL
+  if (language == ShaderLanguage::kHlsl) {
+    switch (kind) {
+      case MapsKind::kTexture3D:
+        return {detail::kQuerySpirvHlslTexture3D, detail::kQuerySpirvHlslTexture3DWords};
+      case MapsKind::kBc4:
+        return {detail::kQuerySpirvHlslBc4, detail::kQuerySpirvHlslBc4Words};
+      default:
+        return {detail::kQuerySpirvHlslArray2D, detail::kQuerySpirvHlslArray2DWords};
+    }
+  }
+#else
+  (void)language;
+#endif
   switch (kind) {
     case MapsKind::kTexture3D:
       return {detail::kQuerySpirvTexture3D, detail::kQuerySpirvTexture3DWords};
@@ -44,6 +67,7 @@ std::pair<const uint32_t*, size_t> spirv(MapsKind kind) {
 struct QueryPipeline::State {
   VkDevice device = VK_NULL_HANDLE;
   MapsKind kind = MapsKind::kArray2D;
+  ShaderLanguage language = ShaderLanguage::kGlsl;
   VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
   VkPipelineLayout layout = VK_NULL_HANDLE;
   VkShaderModule module = VK_NULL_HANDLE;
@@ -65,6 +89,14 @@ QueryPipeline::~QueryPipeline() = default;
 MapsKind QueryPipeline::kind() const noexcept {
   return s_->kind;
 }
+ShaderLanguage QueryPipeline::language() const noexcept {
+  return s_->language;
+}
+
+bool QueryPipeline::available(ShaderLanguage language) noexcept {
+  if (language == ShaderLanguage::kGlsl) return true;
+  return language == ShaderLanguage::kHlsl && VFF_VK_HLSL != 0;
+}
 
 namespace {
 
@@ -81,7 +113,7 @@ Status makeLayouts(QueryPipeline::State& s) {
     s.setLayout = VK_NULL_HANDLE;
     return vkError(r, "vkCreateDescriptorSetLayout");
   }
-  VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, 8};
+  VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, 12};  // which, firstRay, rayCount
   auto pi = detail::vkStruct<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
   pi.setLayoutCount = 1;
   pi.pSetLayouts = &s.setLayout;
@@ -96,14 +128,18 @@ Status makeLayouts(QueryPipeline::State& s) {
 
 }  // namespace
 
-Result<QueryPipeline> QueryPipeline::create(const Context& ctx, MapsKind kind) {
+Result<QueryPipeline> QueryPipeline::create(const Context& ctx, MapsKind kind, const PipelineOptions& options) {
+  if (!available(options.language))
+    return makeError(Code::kUnsupported,
+                     "vff_vk: this build has no HLSL kernels (spirv-cross was not found when it was configured)");
   QueryPipeline p;
   p.s_ = std::make_unique<State>();
   State& s = *p.s_;
   s.device = ctx.device();
   s.kind = kind;
+  s.language = options.language;
   if (Status st = makeLayouts(s); !st) return st.error();
-  const auto [code, words] = spirv(kind);
+  const auto [code, words] = spirv(kind, options.language);
   auto mi = detail::vkStruct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
   mi.codeSize = words * 4;
   mi.pCode = code;
@@ -213,8 +249,9 @@ Result<std::vector<QueryAnswer>> QueryPipeline::run(const Context& ctx, const Gp
                              0, nullptr, 0, nullptr);
       }
       for (uint64_t first = 0; first < rays.size(); first += chunk) {
-        const uint32_t push[2] = {which, uint32_t(first)};
-        vkCmdPushConstants(cb, s.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, 8, push);
+        // rayCount fits: the answers' buffer is within maxStorageBufferRange (checked above).
+        const uint32_t push[3] = {which, uint32_t(first), uint32_t(rays.size())};
+        vkCmdPushConstants(cb, s.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), push);
         const uint64_t n = std::min<uint64_t>(rays.size() - first, chunk);
         vkCmdDispatch(cb, uint32_t((n + kGroupSize - 1) / kGroupSize), 1, 1);
       }
