@@ -22,6 +22,13 @@
 
 namespace vff::gputest {
 
+// The normals and kInterpolated suites' tolerances (test_gpu_field.cpp, test_vk_query.cpp): normals
+// of agreeing hits; a tie of the vote (visibility this near 0.5); t, as a fraction of R; visibility.
+inline constexpr double kNormalEps = 1e-5;
+inline constexpr double kVoteEps = 1e-4;
+inline constexpr double kInterpT = 1e-4;
+inline constexpr double kInterpVis = 1e-4;
+
 // kNearest: the three position schemes x both direction schemes x the four uncompressed encodings,
 // the 3D target once per encoding family, bc4-diameter (2D arrays only) once per direction scheme.
 inline std::vector<FieldCase> nearestCases() {

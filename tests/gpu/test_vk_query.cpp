@@ -40,10 +40,7 @@
 namespace vff {
 namespace {
 
-constexpr double kNormalEps = 1e-5;
-constexpr double kVoteEps = 1e-4;
-constexpr double kInterpT = 1e-4;  // fraction of R
-constexpr double kInterpVis = 1e-4;
+using gputest::kInterpT, gputest::kInterpVis, gputest::kNormalEps, gputest::kVoteEps;  // field_cases.h
 
 using vk::QueryAnswer;
 using vk::QueryRay;

@@ -164,8 +164,6 @@ template <bool kAny>
 bool TriangleBvh::cast(Vec3 o, Vec3 d, float tmin, float tmax, float* tOut, uint32_t* triOut) const noexcept {
   if (nodes_.empty() || !(tmax >= tmin)) return false;
   const Vec3 inv{1.0f / d.x, 1.0f / d.y, 1.0f / d.z};
-  const float* p = pos_.data();
-  auto vert = [p](uint32_t v) { return Vec3{p[3 * size_t(v)], p[3 * size_t(v) + 1], p[3 * size_t(v) + 2]}; };
   // Entry distance of the ray into a node's box within [tmin, best], or +inf.
   auto enter = [&](const BvhNode& n, float best) {
     float t0 = tmin, t1 = best;
@@ -202,15 +200,11 @@ bool TriangleBvh::cast(Vec3 o, Vec3 d, float tmin, float tmax, float* tOut, uint
         continue;
       }
     } else {
-      for (uint32_t t = n.first; t < n.first + n.count; ++t) {
-        float th = 0;
-        if (!triangleHit(o, d, vert(tris_[3 * size_t(t)]), vert(tris_[3 * size_t(t) + 1]), vert(tris_[3 * size_t(t) + 2]),
-                         tmin, best, &th))
-          continue;
+      uint32_t tri = 0;
+      if (leafHit<kAny>(o, d, pos_.data(), tris_.data(), n.first, n.count, tmin, &best, &tri)) {
         if constexpr (kAny) return true;
-        best = th;
         found = true;
-        *triOut = t;
+        *triOut = tri;
       }
     }
     // Next: the nearest postponed node that the ray still enters before the best hit.

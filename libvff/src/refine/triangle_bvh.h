@@ -41,6 +41,26 @@ inline bool triangleHit(Vec3 o, Vec3 d, Vec3 v0, Vec3 v1, Vec3 v2, float tmin, f
   return true;
 }
 
+// A leaf of either BVH: triangles [first, first + count) of `tris` (three vertex indices each into
+// positions p) against the ray within [tmin, *best]. Returns whether one is hit; then *best and
+// *tri are the nearest one's (kAny: the first one found's).
+template <bool kAny>
+inline bool leafHit(Vec3 o, Vec3 d, const float* p, const uint32_t* tris, uint32_t first, uint32_t count, float tmin,
+                    float* best, uint32_t* tri) noexcept {
+  auto vert = [p](uint32_t v) { return Vec3{p[3 * size_t(v)], p[3 * size_t(v) + 1], p[3 * size_t(v) + 2]}; };
+  bool found = false;
+  for (uint32_t t = first; t < first + count; ++t) {
+    const uint32_t* v = &tris[3 * size_t(t)];
+    float th = 0;
+    if (!triangleHit(o, d, vert(v[0]), vert(v[1]), vert(v[2]), tmin, *best, &th)) continue;
+    *best = th;
+    *tri = t;
+    found = true;
+    if constexpr (kAny) return true;
+  }
+  return found;
+}
+
 // The unit geometric normal of triangle (v0, v1, v2), facing against d.
 Vec3 triangleNormal(Vec3 v0, Vec3 v1, Vec3 v2, Vec3 d) noexcept;
 

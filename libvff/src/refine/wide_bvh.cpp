@@ -129,8 +129,6 @@ template <bool kAny>
 bool WideBvh::cast(Vec3 o, Vec3 d, float tmin, float tmax, float* tOut, uint32_t* triOut) const noexcept {
   if (nodes_.empty() || !(tmax >= tmin)) return false;
   const Slabs slabs(o, d);
-  const float* p = pos_.data();
-  auto vert = [p](uint32_t v) { return Vec3{p[3 * size_t(v)], p[3 * size_t(v) + 1], p[3 * size_t(v) + 2]}; };
   struct Entry {
     uint32_t ref;
     float t;  // where the ray enters the node's box
@@ -161,13 +159,9 @@ bool WideBvh::cast(Vec3 o, Vec3 d, float tmin, float tmax, float* tOut, uint32_t
         continue;
       }
     } else {
-      const uint32_t first = (ref & ~kLeaf) >> 3, count = (ref & 7u) + 1;
-      for (uint32_t tri = first; tri < first + count; ++tri) {
-        const uint32_t* v = &tris_[3 * size_t(tri)];
-        float th = 0;
-        if (!triangleHit(o, d, vert(v[0]), vert(v[1]), vert(v[2]), tmin, best, &th)) continue;
+      uint32_t tri = 0;
+      if (leafHit<kAny>(o, d, pos_.data(), tris_.data(), (ref & ~kLeaf) >> 3, (ref & 7u) + 1, tmin, &best, &tri)) {
         if constexpr (kAny) return true;
-        best = th;
         found = true;
         *triOut = tri;
       }
