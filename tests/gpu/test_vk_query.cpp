@@ -36,6 +36,7 @@
 #include "vff/vk/context.h"
 #include "vff/vk/field.h"
 #include "vff/vk/query.h"
+#include "vk_env.h"
 
 namespace vff {
 namespace {
@@ -45,56 +46,7 @@ using gputest::kInterpT, gputest::kInterpVis, gputest::kNormalEps, gputest::kVot
 using vk::QueryAnswer;
 using vk::QueryRay;
 using vk::ShaderLanguage;
-
-const char* languageName(ShaderLanguage l) {
-  return l == ShaderLanguage::kHlsl ? "HLSL" : "GLSL";
-}
-
-// The case's context: a CPU device first (lavapipe, as the GL tests' llvmpipe), validation on.
-// Each gtest case runs in its own process (gtest_discover_tests), so this is one context a case.
-struct VkEnv {
-  Result<vk::Context> ctx = makeError(Code::kBadState, "not created");
-  std::string skip;  // why the case cannot run
-};
-
-VkEnv& vkEnv() {
-  static VkEnv env = [] {
-    VkEnv e;
-    vk::ContextOptions o;
-    o.validation = true;
-    o.preferCpu = true;
-    e.ctx = vk::Context::create(o);
-    if (!e.ctx)
-      e.skip = "no Vulkan device: " + e.ctx.error().toString();
-    else if (!e.ctx->validationEnabled())
-      e.skip = "no Vulkan validation layer: " + e.ctx->validationNote();
-    else
-      std::printf("[ vk ] device: %s\n", e.ctx->deviceName().c_str());
-    return e;
-  }();
-  return env;
-}
-
-#define VFF_REQUIRE_VK()                                     \
-  do {                                                       \
-    if (!vkEnv().skip.empty()) GTEST_SKIP() << vkEnv().skip; \
-  } while (0)
-
-// The HLSL kernels are built only where spirv-cross was found (gpu/vulkan/CMakeLists.txt).
-#define VFF_REQUIRE_LANGUAGE(language)                                                                    \
-  do {                                                                                                    \
-    if (!vk::QueryPipeline::available(language))                                                          \
-      GTEST_SKIP() << languageName(language)                                                              \
-                   << " kernels not built: spirv-cross was not found when vff_vk was configured";         \
-  } while (0)
-
-// Every case ends here: nothing reported by the validation layer.
-void expectNoValidationMessages() {
-  const vk::Context& c = *vkEnv().ctx;
-  std::printf("[ vk ] validation: %u errors, %u warnings\n", c.validationErrors(), c.validationWarnings());
-  EXPECT_EQ(c.validationErrors(), 0u) << c.validationLog();
-  EXPECT_EQ(c.validationWarnings(), 0u) << c.validationLog();
-}
+using vktest::expectNoValidationMessages, vktest::languageName, vktest::vkEnv;  // vk_env.h
 
 // Uploads the field and runs the rays; ADD_FAILUREs and returns empty on a setup failure.
 std::vector<QueryAnswer> runVk(const File& file, ShaderLanguage language, const std::vector<QueryRay>& rays) {

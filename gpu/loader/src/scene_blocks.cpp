@@ -1,7 +1,8 @@
 // scene_blocks.cpp - what the scene loader (vff/gl/scene_loader.h) uploads, computed without GL:
-// the field table and shared positions (planScene), the instance table (makeSceneInstances), and
-// the scene shader's text (sceneShaderSource).
+// the field table and shared positions (planScene), the instance table (makeSceneInstances), the
+// nodes buffer (makeSceneNodes), and the scene shader's text (sceneShaderSource).
 #include <algorithm>
+#include <cstring>
 #include <string>
 #include <unordered_map>
 #include <utility>
@@ -88,6 +89,22 @@ Result<std::vector<SceneInstanceBlock>> makeSceneInstances(const Scene& scene, c
     b.scale = x.scale;
   }
   return out;
+}
+
+Result<std::vector<uint8_t>> makeSceneNodes(const SceneHierarchy& h, uint32_t instanceCount) {
+  if (3 * h.depth + 1 > kSceneStack)
+    return makeError(Code::kUnsupported, "scene: the hierarchy has " + std::to_string(h.depth) +
+                                             " levels; the shader's stack (VFF_SCENE_STACK " +
+                                             std::to_string(kSceneStack) + ") holds " +
+                                             std::to_string((kSceneStack - 1) / 3));
+  std::vector<uint8_t> nodes(sizeof(SceneNodesHeader) + h.nodes.size() * sizeof(SceneNode));
+  SceneNodesHeader head;
+  head.nodeCount = uint32_t(h.nodes.size());
+  head.maxRadius = h.maxRadius;
+  head.instanceCount = instanceCount;
+  std::memcpy(nodes.data(), &head, sizeof head);
+  if (!h.nodes.empty()) std::memcpy(nodes.data() + sizeof head, h.nodes.data(), h.nodes.size() * sizeof(SceneNode));
+  return nodes;
 }
 
 std::string sceneShaderSource(const std::string& sceneGlsl, const std::string& queryGlsl) {

@@ -4,7 +4,6 @@
 #include <GL/glcorearb.h>
 
 #include <algorithm>
-#include <cstring>
 #include <string>
 #include <utility>
 #include <vector>
@@ -49,27 +48,16 @@ void GpuScene::bind(const SceneBindings& b) const noexcept {
 Status GpuScene::update(const Scene& scene) {
   auto h = scene.hierarchy();
   if (!h) return std::move(h).error();
-  if (3 * h->depth + 1 > kSceneStack)
-    return makeError(Code::kUnsupported, "scene: the hierarchy has " + std::to_string(h->depth) +
-                                             " levels; the shader's stack (VFF_SCENE_STACK " +
-                                             std::to_string(kSceneStack) + ") holds " +
-                                             std::to_string((kSceneStack - 1) / 3));
   auto inst = makeSceneInstances(scene, *h, s_.queries);
   if (!inst) return std::move(inst).error();
-  std::vector<uint8_t> nodes(sizeof(SceneNodesHeader) + h->nodes.size() * sizeof(SceneNode));
-  SceneNodesHeader head;
-  head.nodeCount = uint32_t(h->nodes.size());
-  head.maxRadius = h->maxRadius;
-  head.instanceCount = uint32_t(inst->size());
-  std::memcpy(nodes.data(), &head, sizeof head);
-  if (!h->nodes.empty())
-    std::memcpy(nodes.data() + sizeof head, h->nodes.data(), h->nodes.size() * sizeof(SceneNode));
+  auto nodes = makeSceneNodes(*h, uint32_t(inst->size()));
+  if (!nodes) return std::move(nodes).error();
   glGetError();  // a caller's stale error is not ours
   GLint saved = 0;
   glGetIntegerv(GL_SHADER_STORAGE_BUFFER_BINDING, &saved);
   Status s = fillBuffer(&s_.instances, &s_.instancesSize, inst->data(), inst->size() * sizeof(SceneInstanceBlock),
                         "uploading the scene's instances");
-  if (s) s = fillBuffer(&s_.nodes, &s_.nodesSize, nodes.data(), nodes.size(), "uploading the scene's hierarchy");
+  if (s) s = fillBuffer(&s_.nodes, &s_.nodesSize, nodes->data(), nodes->size(), "uploading the scene's hierarchy");
   glBindBuffer(GL_SHADER_STORAGE_BUFFER, GLuint(saved));
   if (s) s_.instanceCount = uint32_t(inst->size());
   return s;

@@ -7,12 +7,14 @@
 #include <utility>
 #include <vector>
 
-#include "vk_objects.h"
+#include "compute.h"
+#include "upload.h"
 
 namespace vff::vk {
 
 using detail::Buffer;
 using detail::Image;
+using namespace detail;  // upload.h, compute.h
 
 struct GpuField::State {
   VkDevice device = VK_NULL_HANDLE;
@@ -78,13 +80,8 @@ void GpuField::write(VkDescriptorSet set) const noexcept {
   vkUpdateDescriptorSets(s_->device, 4, w, 0, nullptr);
 }
 
+namespace detail {
 namespace {
-
-// One plane's upload: the bytes to copy (staged in one buffer) and where each piece goes.
-struct PlaneUpload {
-  std::vector<uint8_t> bytes;
-  std::vector<VkBufferImageCopy> regions;
-};
 
 // Appends `data` at an offset aligned for any texel block (copies need a multiple of the block
 // size and of 4).
@@ -105,28 +102,30 @@ VkBufferImageCopy region(VkDeviceSize offset, uint32_t x, uint32_t y, uint32_t s
   return r;
 }
 
-// What the GL loader's uploadDistance / uploadNormals send, as copy regions: each map from the
-// file's bytes into its tile when `perMap`, else every composed slice (`width` texels wide).
-Result<PlaneUpload> planeUpload(const File& file, Plane plane, bool perMap, uint32_t width, bool is3D) {
+}  // namespace
+
+// upload.h's (the single field's and the scene's).
+Status appendPlane(const File& file, Plane plane, bool perMap, uint32_t width, bool is3D, uint32_t baseSlice,
+                   PlaneUpload& u) {
   const FieldDesc& field = file.field();
   const LayoutDesc& layout = file.layout();
-  PlaneUpload u;
   if (perMap) {
     const uint32_t m = field.mapResolution;
     for (uint32_t k = 0; k < field.mapCount; ++k) {
       auto map = file.mapData(plane, k);
       if (!map) return map.error();
       const TilePlacement at = placeMap(layout, k);
-      u.regions.push_back(region(append(u, map->data(), map->size()), at.x, at.y, at.slice, m, m, is3D));
+      u.regions.push_back(region(append(u, map->data(), map->size()), at.x, at.y, baseSlice + at.slice, m, m, is3D));
     }
-    return u;
+    return {};
   }
   std::vector<uint8_t> slice(file.sliceBytes(plane));
   for (uint32_t s = 0; s < layout.sliceCount; ++s) {
     if (Status st = file.readSlice(plane, s, slice); !st) return st.error();
-    u.regions.push_back(region(append(u, slice.data(), slice.size()), 0, 0, s, width, layout.sliceHeight, is3D));
+    u.regions.push_back(
+        region(append(u, slice.data(), slice.size()), 0, 0, baseSlice + s, width, layout.sliceHeight, is3D));
   }
-  return u;
+  return {};
 }
 
 // Copies the staged bytes into the image and leaves it ready for the compute shader.
@@ -213,13 +212,9 @@ Status makeSampler(const Context& ctx, VkSampler* sampler) {
   return {};
 }
 
-// A buffer holding `size` bytes from `data`.
-Result<Buffer> makeFilledBuffer(const Context& ctx, const void* data, size_t size, VkBufferUsageFlags usage) {
-  auto b = detail::makeHostBuffer(ctx, size, usage);
-  if (!b) return b.error();
-  if (size) std::memcpy(b->mapped, data, size);
-  return b;
-}
+}  // namespace detail
+
+namespace {
 
 // The normal plane (or the 1 x 1 x 1 placeholder) into s.normalImage.
 Status loadNormals(const Context& ctx, const File& file, GpuField::State& s) {
@@ -235,9 +230,8 @@ Status loadNormals(const Context& ctx, const File& file, GpuField::State& s) {
       return makeError(Code::kUnsupported,
                        "unexpected normal slice size " + std::to_string(file.sliceBytes(Plane::kNormal)) + " bytes");
     d = {VK_FORMAT_R16G16_SINT, layout.sliceWidth, layout.sliceHeight, layout.sliceCount, is3D};
-    auto pu = planeUpload(file, Plane::kNormal, layout.gutter == 0, layout.sliceWidth, is3D);
-    if (!pu) return pu.error();
-    u = std::move(*pu);
+    if (Status st = appendPlane(file, Plane::kNormal, layout.gutter == 0, layout.sliceWidth, is3D, 0, u); !st)
+      return st;
     s.textureBytes += file.sliceBytes(Plane::kNormal) * layout.sliceCount;
   }
   auto image = detail::makeImage(ctx, d);
@@ -276,9 +270,9 @@ Result<GpuField> loadField(const Context& ctx, const File& file) {
   // maps are whole blocks), else composed slices (bit1 packs eight texels a byte, so its tiles need
   // not start on a byte).
   const bool perMap = *format == VK_FORMAT_BC4_UNORM_BLOCK || (layout.gutter == 0 && !bit1);
-  auto upload = planeUpload(file, Plane::kDistance, perMap, width, is3D);
-  if (!upload) return upload.error();
-  if (Status st = uploadImage(ctx, s.maps, *upload); !st) return st.error();
+  detail::PlaneUpload upload;
+  if (Status st = detail::appendPlane(file, Plane::kDistance, perMap, width, is3D, 0, upload); !st) return st.error();
+  if (Status st = detail::uploadImage(ctx, s.maps, upload); !st) return st.error();
   s.textureBytes += file.sliceBytes(Plane::kDistance) * layout.sliceCount;
   if (Status st = loadNormals(ctx, file, s); !st) return st.error();
   auto fieldBuffer = makeFilledBuffer(ctx, &s.block, sizeof(gl::FieldBlock), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);

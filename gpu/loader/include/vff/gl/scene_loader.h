@@ -108,6 +108,11 @@ Result<ScenePlan> planScene(std::span<const FieldDesc> fields, std::span<const L
 Result<std::vector<SceneInstanceBlock>> makeSceneInstances(const Scene& scene, const SceneHierarchy& hierarchy,
                                                            std::span<const FieldQuery* const> fields);
 
+// The nodes buffer of a hierarchy (no GL calls): SceneNodesHeader (instanceCount instances), then
+// the nodes. Errors: kUnsupported when the hierarchy could need more than the shader's stack
+// (kSceneStack).
+Result<std::vector<uint8_t>> makeSceneNodes(const SceneHierarchy& hierarchy, uint32_t instanceCount);
+
 // The compute/fragment shader text for a scene: vff_scene.glsl's text with its
 // `#include "vff_query.glsl"` line replaced by vff_query.glsl's text (GL has no #include).
 std::string sceneShaderSource(const std::string& sceneGlsl, const std::string& queryGlsl);

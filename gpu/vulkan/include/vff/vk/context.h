@@ -26,7 +26,8 @@
 // for VK_ERROR_OUT_OF_*_MEMORY.
 //
 // Threading: a Context and everything made from it are used from one thread at a time. Move-only;
-// objects made from a Context (GpuField, QueryPipeline) must be destroyed before it.
+// objects made from a Context (GpuField, QueryPipeline, GpuScene, ScenePipeline) must be destroyed
+// before it.
 #pragma once
 
 #include <vulkan/vulkan.h>
