@@ -194,11 +194,9 @@ std::shared_ptr<PyFile> finish(const bake::BakedField& baked, const bake::Mesh& 
                                   {.probe = o.refineProbe, .threads = o.bake.threads});
       if (refinement) o.write.refinement = refinement->view();
     }
-    if (!refinement)
-      written = refinement.error();
-    else if (out.empty())
+    if (refinement && out.empty())
       bytes = writeMemory(baked.field, baked.distance, baked.normals, o.write);
-    else
+    else if (refinement)
       written = writeFile(out, baked.field, baked.distance, baked.normals, o.write);
   }
   if (!refinement) check(refinement.error());

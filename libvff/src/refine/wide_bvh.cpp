@@ -97,8 +97,11 @@ WideBvh::WideBvh(const TriangleBvh& b) : pos_(b.positions()), tris_(b.triangles(
       while (n < 4) {
         int open = -1;
         double largest = -1;
-        for (int c = 0; c < n; ++c)
-          if (bin[kids[c]].count == 0 && halfArea(bin[kids[c]]) > largest) largest = halfArea(bin[kids[c]]), open = c;
+        for (int c = 0; c < n; ++c) {
+          if (bin[kids[c]].count != 0) continue;
+          const double area = halfArea(bin[kids[c]]);
+          if (area > largest) largest = area, open = c;
+        }
         if (open < 0) break;
         const uint32_t inner = kids[open];
         kids[open] = inner + 1;
