@@ -34,6 +34,14 @@ test_node_scene_description() { need_node; node_test test/scene_description.test
 # web/src/vff_query_es.js is exactly what web/tools/gen-glsl-es.mjs makes from gpu/glsl/vff_query.glsl.
 test_glsl_es_generated() { need_node; node_test test/glsl.test.js; }
 
+# gpu/wgsl/ and web/src/vff_wgsl.js are exactly what web/tools/gen-wgsl.mjs makes from gpu/glsl and
+# the Vulkan kernels; the translator on small GLSL snippets, and its refusals.
+test_wgsl_generated() { need_node; node_test test/wgsl.test.js; }
+
+# In headless Chromium's WebGPU (SwiftShader): every generated WGSL file compiles, every kernel makes
+# a compute pipeline, and the helpers answer as the CPU. (The query against libvff: gpu-webgpu label.)
+test_browser_wgsl_compile() { need_chromium; node_test test/browser/wgsl_compile.browser.js; }
+
 # In headless Chromium: the decoder decodes the conformance vectors as under node.
 test_browser_decoder() { need_chromium; node_test test/browser/decoder.browser.js; }
 

@@ -43,9 +43,12 @@ export async function serve(extra = {}, options = {}) {
   return { server, url: `http://127.0.0.1:${server.address().port}` };
 }
 
-export async function launch() {
-  return chromium.launch({
-    executablePath: process.env.VFF_CHROMIUM_PATH ?? '/usr/bin/chromium',
-    args: ['--headless=new', '--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist'],
-  });
+/**
+ * Headless Chromium on SwiftShader; {webgpu: true} also turns on WebGPU (its SwiftShader adapter),
+ * with Vulkan compositing: without it a WebGPU canvas's first frame loses the GPU process.
+ */
+export async function launch({ webgpu = false } = {}) {
+  const args = ['--headless=new', '--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist'];
+  if (webgpu) args.push('--enable-unsafe-webgpu', '--enable-features=Vulkan', '--use-vulkan=swiftshader');
+  return chromium.launch({ executablePath: process.env.VFF_CHROMIUM_PATH ?? '/usr/bin/chromium', args });
 }
