@@ -1,9 +1,11 @@
-// field_cases.h - what the GL and Vulkan query suites run, defined once so that both APIs answer the
-// same questions: the baked cases (kNearest: nearestCases; normals and kInterpolated:
-// interpolatedCases), the valid conformance vectors and their gtest names, and the random rays.
+// field_cases.h - what the GL, Vulkan and WebGPU query suites run, defined once so that every API
+// answers the same questions: the baked cases (kNearest: nearestCases; normals and kInterpolated:
+// interpolatedCases), the valid conformance vectors and their gtest names, the random rays, and
+// the normals and kInterpolated comparison of one answer (compareInterpolated, reportInterpolated).
 //
 // The rays are built into any struct with float origin[4], direction[4] and range[4] (tmin, tmax,
-// intraBias, unused): the GL tests' std430 GpuRay and vff::vk::QueryRay are both that layout.
+// intraBias, unused): the GL tests' std430 GpuRay, vff::vk::QueryRay and wgsltest::QueryRay are
+// all that layout.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -11,6 +13,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <string>
 #include <system_error>
@@ -164,6 +168,84 @@ std::vector<GpuRay> interpolatedRays(const FieldDesc& f, uint32_t count, uint64_
     out[r] = GpuRay{{o.x, o.y, o.z, 0}, {d.x, d.y, d.z, 0}, {tmin, tmax, bias, 0}};
   }
   return out;
+}
+
+// ---- Normals and kInterpolated: one answer against FieldQuery ---------------------------------------
+
+inline double maxDiff3(const float* g, Vec3 c) {
+  return std::max({std::fabs(double(g[0]) - c.x), std::fabs(double(g[1]) - c.y), std::fabs(double(g[2]) - c.z)});
+}
+
+struct InterpCounts {
+  uint64_t rays = 0, nNormals = 0, nFlag = 0, iAgree = 0, iTie = 0, iHits = 0, fails = 0;
+  double nMax = 0, iMaxT = 0, iMaxVis = 0;
+  std::string first;
+  void fail(size_t r, const std::string& why) {
+    ++fails;
+    if (first.empty()) first = "ray " + std::to_string(r) + ": " + why;
+  }
+};
+
+// One ray: kNearest's normal, then kInterpolated's flag, t, visibility and normal. Answer: the
+// Vulkan kernel's layout (vff::vk::QueryAnswer: flags kHit, kHasNormal, kInterpHit,
+// kInterpHasNormal; t, normal, visibility, interpT, interpNormal).
+template <class GpuRay, class Answer>
+void compareInterpolated(const FieldQuery& cpu, const GpuRay& g, const Answer& o, float R, size_t r, InterpCounts& n) {
+  ++n.rays;
+  const Ray ray{{g.origin[0], g.origin[1], g.origin[2]},
+                {g.direction[0], g.direction[1], g.direction[2]},
+                g.range[0],
+                g.range[1]};
+  const Vec3 d = ray.direction;
+  const double len = std::sqrt(double(d.x * d.x + d.y * d.y + d.z * d.z));
+  QueryOptions qn;
+  qn.intraBias = g.range[2];
+  if (g.range[2] == -2.0f) qn.origin = RayOrigin::kOffObject;  // VFF_OFF_OBJECT
+  const QueryHit h = cpu.intersect(ray, qn);
+  if (((o.flags & Answer::kHit) != 0) != h.hit) {
+    ++n.nFlag;  // test_gpu_query-style boundary rays; the GL suite sees none on these fields
+  } else if (h.hit && std::fabs(double(o.t) - double(h.t)) * len <= 1e-5 * R) {
+    if (((o.flags & Answer::kHasNormal) != 0) != h.hasNormal) return n.fail(r, "hasNormal differs");
+    ++n.nNormals;
+    const double e = maxDiff3(o.normal, h.normal);
+    n.nMax = std::max(n.nMax, e);
+    if (e > kNormalEps) return n.fail(r, "nearest normal differs by " + std::to_string(e));
+  }
+  QueryOptions qi = qn;
+  qi.reconstruction = Reconstruction::kInterpolated;
+  const QueryHit hi = cpu.intersect(ray, qi);
+  const float vis = cpu.visibility(ray, qi);
+  const double dv = std::fabs(double(o.visibility) - double(vis));
+  n.iMaxVis = std::max(n.iMaxVis, dv);
+  if (dv > kInterpVis) return n.fail(r, "visibility " + std::to_string(o.visibility) + " vs " + std::to_string(vis));
+  if (((o.flags & Answer::kInterpHit) != 0) != hi.hit) {
+    if (std::fabs(double(vis) - 0.5) > kVoteEps) return n.fail(r, "interpolated hit flag differs");
+    ++n.iTie;
+    return;
+  }
+  ++n.iAgree;
+  if (!hi.hit) return;
+  ++n.iHits;
+  const double dt = std::fabs(double(o.interpT[0]) - double(hi.t)) * len / R;
+  n.iMaxT = std::max(n.iMaxT, dt);
+  if (dt > kInterpT) return n.fail(r, "interpolated t differs by " + std::to_string(dt) + " R");
+  if (((o.flags & Answer::kInterpHasNormal) != 0) != hi.hasNormal) return n.fail(r, "interpolated hasNormal differs");
+  if (hi.hasNormal && maxDiff3(o.interpNormal, hi.normal) > 1e-4) return n.fail(r, "interpolated normal differs");
+}
+
+// Prints the counts after `head` and checks what every suite requires of them.
+inline void reportInterpolated(const InterpCounts& n, const std::string& head, const std::string& label) {
+  std::printf(
+      "%s: kNearest: %llu normals compared, max diff %.3g, hit-flag mismatches %llu; kInterpolated: "
+      "%llu rays, agreement %.3f%%, vote ties %llu, failures %llu; %llu hits, max |t_gpu - t_cpu| = %.3g R, "
+      "max |vis_gpu - vis_cpu| = %.3g\n",
+      head.c_str(), (unsigned long long)n.nNormals, n.nMax, (unsigned long long)n.nFlag, (unsigned long long)n.rays,
+      100.0 * double(n.iAgree) / double(std::max<uint64_t>(n.rays, 1)), (unsigned long long)n.iTie,
+      (unsigned long long)n.fails, (unsigned long long)n.iHits, n.iMaxT, n.iMaxVis);
+  EXPECT_EQ(n.fails, 0u) << label << ": " << n.first;
+  EXPECT_EQ(n.nFlag, 0u) << label;
+  EXPECT_GT(n.nNormals, n.rays / 8) << label;
+  EXPECT_GT(n.iHits, n.rays / 8) << label;
 }
 
 }  // namespace vff::gputest

@@ -1,5 +1,5 @@
-// nearest_check.h - the kNearest comparison of the GL and Vulkan query suites, defined once: the
-// CPU's lookup step by step (cpuLookup), and one GPU answer classified against it (classify).
+// nearest_check.h - the kNearest comparison of the GL, Vulkan and WebGPU query suites, defined once:
+// the CPU's lookup step by step (cpuLookup), and one GPU answer classified against it (classify).
 //
 // A ray agrees when the lookup and the hit flag are the CPU's. A disagreement is allowed only where
 // the CPU shows the ray within a small epsilon of a boundary:
@@ -24,6 +24,7 @@
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "field_cases.h"
 #include "vff/vff.h"
@@ -240,6 +241,45 @@ inline void reportAgreement(const Agreement& a, const std::string& head, const s
       (unsigned long long)a.exactDistances, (unsigned long long)a.hits, a.maxTDiff);
   EXPECT_EQ(a.hard, 0u) << label << ": " << a.firstHard;
   EXPECT_LT(a.maxTDiff, 1e-5) << label;
+}
+
+// A GpuLookup from an answer of the Vulkan kernel's layout (vff::vk::QueryAnswer and the WebGPU
+// suite's copy of it: flags with kLooked and kHit, t, sampleIndex, texelI, texelJ, code, distance).
+template <class Answer>
+GpuLookup lookupOf(const Answer& g) {
+  return {(g.flags & Answer::kLooked) != 0,
+          (g.flags & Answer::kHit) != 0,
+          g.t,
+          g.sampleIndex,
+          g.texelI,
+          g.texelJ,
+          g.code,
+          g.distance};
+}
+
+// Every ray's answer (Answer: as lookupOf's) against the CPU lookup: the lookup is checked to be
+// the CPU query, each answer classified, the counts reported after `head` (reportAgreement).
+template <class GpuRay, class Answer>
+Agreement compareNearestAnswers(const File& file, const FieldQuery& cpu, const std::vector<GpuRay>& rays,
+                                const std::vector<Answer>& answers, const std::string& head, const std::string& label) {
+  Agreement a;
+  EXPECT_EQ(answers.size(), rays.size()) << label;
+  if (answers.size() != rays.size()) return a;
+  for (size_t r = 0; r < rays.size(); ++r) {
+    const CpuLookup c = cpuLookup(file, cpu.positions(), rays[r]);
+    expectLookupIsCpuQuery(cpu, rays[r], c, r);
+    classify(file, cpu.positions(), rays[r], c, lookupOf(answers[r]), r, a);
+  }
+  reportAgreement(a, head, label);
+  EXPECT_EQ(a.rays, uint64_t(rays.size())) << label;
+  return a;
+}
+
+// The baked fields' further bounds (not the conformance vectors'): boundary cases are rare, and
+// many lookups agree to the bit.
+inline void expectBakedAgreement(const Agreement& a, const std::string& label) {
+  EXPECT_GE(a.agree, a.rays * 99 / 100) << label;
+  EXPECT_GT(a.exactDistances, a.rays / 4) << label;
 }
 
 }  // namespace vff::gputest

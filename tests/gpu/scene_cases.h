@@ -1,6 +1,6 @@
 // scene_cases.h - the scene of the GPU scene suites and its comparison with the CPU vff::Scene,
-// shared by the GL suite (test_gpu_scene.cpp) and the Vulkan one (test_vk_scene.cpp), so that both
-// run the same fields, placements, rays and tolerances:
+// shared by the GL suite (test_gpu_scene.cpp), the Vulkan one (test_vk_scene.cpp) and the WebGPU one
+// (test_wgsl_scene.cpp), so that all run the same fields, placements, rays and tolerances:
 // 14 instances of three baked fields (a torus knot, a bowl and a box; three position schemes, both
 // direction schemes, unorm8-diameter with normals, unorm8-chord, bit1; gutters 1, 1 and 0), placed
 // by random rigid transforms with overlapping spheres; random world rays from outside the scene and
@@ -265,6 +265,35 @@ inline void compareWithLoop(const Scene& scene, const std::vector<GpuRay>& rays,
               std::min(n, rays.size()), hits, differing);
   EXPECT_GT(hits, 0u);
   EXPECT_LE(differing, uint32_t(kMaxDifferingShare * double(n)) + 1);
+}
+
+// The rays in a kernel's std430 VffVkSceneRay (vff::vk::SceneRay and the WebGPU suite's copy):
+// origin[3], source, direction[3], tmin, tmax, intraBias.
+template <class SceneRay>
+std::vector<SceneRay> toSceneRays(const std::vector<GpuRay>& rays) {
+  std::vector<SceneRay> out(rays.size());
+  for (size_t r = 0; r < rays.size(); ++r) {
+    const GpuRay& g = rays[r];
+    SceneRay& v = out[r];
+    for (int a = 0; a < 3; ++a) {
+      v.origin[a] = g.origin[a];
+      v.direction[a] = g.direction[a];
+    }
+    v.tmin = g.range[0];
+    v.tmax = g.range[1];
+    v.intraBias = g.range[2];
+    v.source = sourceOf(g);  // kNoSources is vff::vk::kSceneNoSources
+  }
+  return out;
+}
+
+// The empty scene's answers: every query misses (no hit, not occluded, visibility 1, no instance).
+inline uint32_t answeredRays(const std::vector<SceneOut>& g) {
+  uint32_t answered = 0;
+  for (const SceneOut& o : g)
+    answered += o.nearestHit != 0 || o.occluded != 0 || o.interpHit != 0 || o.visibility != 1.0f ||
+                o.nearestInstance != kNoInstance;
+  return answered;
 }
 
 inline std::vector<gl::SceneField> sceneFields(const Fields& f) {

@@ -41,8 +41,6 @@
 namespace vff {
 namespace {
 
-using gputest::kInterpT, gputest::kInterpVis, gputest::kNormalEps, gputest::kVoteEps;  // field_cases.h
-
 using vk::QueryAnswer;
 using vk::QueryRay;
 using vk::ShaderLanguage;
@@ -67,34 +65,16 @@ std::vector<QueryAnswer> runVk(const File& file, ShaderLanguage language, const 
 
 // ---- kNearest (nearest_check.h) ----------------------------------------------------------------------
 
-gputest::GpuLookup lookupOf(const QueryAnswer& g) {
-  return {(g.flags & QueryAnswer::kLooked) != 0,
-          (g.flags & QueryAnswer::kHit) != 0,
-          g.t,
-          g.sampleIndex,
-          g.texelI,
-          g.texelJ,
-          g.code,
-          g.distance};
-}
-
 gputest::Agreement compareNearest(const File& file, ShaderLanguage language, uint32_t rayCount, uint64_t seed,
                                   const std::string& label) {
-  gputest::Agreement a;
   auto cpu = FieldQuery::fromFile(file);
   EXPECT_TRUE(cpu.ok()) << cpu.error().toString();
-  if (!cpu) return a;
+  if (!cpu) return {};
   const std::vector<QueryRay> rays = gputest::nearestRays<QueryRay>(file.field(), rayCount, seed);
   const std::vector<QueryAnswer> out = runVk(file, language, rays);
-  if (out.size() != rays.size()) return a;
-  for (size_t r = 0; r < rays.size(); ++r) {
-    const gputest::CpuLookup c = gputest::cpuLookup(file, cpu->positions(), rays[r]);
-    gputest::expectLookupIsCpuQuery(*cpu, rays[r], c, r);
-    gputest::classify(file, cpu->positions(), rays[r], c, lookupOf(out[r]), r, a);
-  }
-  gputest::reportAgreement(a, "[ vk ] " + label + " (" + languageName(language) + "): kNearest", label);
-  EXPECT_EQ(a.rays, uint64_t(rayCount)) << label;
-  return a;
+  if (out.size() != rays.size()) return {};
+  return gputest::compareNearestAnswers(file, *cpu, rays, out,
+                                        "[ vk ] " + label + " (" + languageName(language) + "): kNearest", label);
 }
 
 // ---- The cases, in each shading language ---------------------------------------------------------
@@ -153,8 +133,7 @@ TEST_P(VkQuery, MatchesCpuNearest) {
   EXPECT_GT(file->layout().sliceCount, 1u);
   VFF_SKIP_IF_NO_BC4(*file);
   const gputest::Agreement a = compareNearest(*file, GetParam().language, 8192, 1234, caseName(GetParam().value));
-  EXPECT_GE(a.agree, a.rays * 99 / 100);  // boundary cases are rare
-  EXPECT_GT(a.exactDistances, a.rays / 4);
+  gputest::expectBakedAgreement(a, caseName(GetParam().value));
   expectNoValidationMessages();
 }
 
@@ -187,64 +166,6 @@ INSTANTIATE_TEST_SUITE_P(ValidHlsl, VkConformance,
 
 // ---- Normals and kInterpolated ----------------------------------------------------------------------
 
-double maxDiff3(const float* g, Vec3 c) {
-  return std::max({std::fabs(double(g[0]) - c.x), std::fabs(double(g[1]) - c.y), std::fabs(double(g[2]) - c.z)});
-}
-
-struct InterpCounts {
-  uint64_t nNormals = 0, nFlag = 0, iAgree = 0, iTie = 0, iHits = 0, fails = 0;
-  double nMax = 0, iMaxT = 0, iMaxVis = 0;
-  std::string first;
-  void fail(size_t r, const std::string& why) {
-    ++fails;
-    if (first.empty()) first = "ray " + std::to_string(r) + ": " + why;
-  }
-};
-
-// One ray: kNearest's normal, then kInterpolated's flag, t, visibility and normal.
-void compareInterpolated(const FieldQuery& cpu, const QueryRay& g, const QueryAnswer& o, float R, size_t r,
-                         InterpCounts& n) {
-  const Ray ray{{g.origin[0], g.origin[1], g.origin[2]},
-                {g.direction[0], g.direction[1], g.direction[2]},
-                g.range[0],
-                g.range[1]};
-  const double len = std::sqrt(double(gputest::dot3(ray.direction, ray.direction)));
-  QueryOptions qn;
-  qn.intraBias = g.range[2];
-  if (g.range[2] == -2.0f) qn.origin = RayOrigin::kOffObject;  // VFF_OFF_OBJECT
-  const QueryHit h = cpu.intersect(ray, qn);
-  if (((o.flags & QueryAnswer::kHit) != 0) != h.hit) {
-    ++n.nFlag;  // test_gpu_query-style boundary rays; the GL suite sees none on these fields
-  } else if (h.hit && std::fabs(double(o.t) - double(h.t)) * len <= 1e-5 * R) {
-    if (((o.flags & QueryAnswer::kHasNormal) != 0) != h.hasNormal) return n.fail(r, "hasNormal differs");
-    ++n.nNormals;
-    const double e = maxDiff3(o.normal, h.normal);
-    n.nMax = std::max(n.nMax, e);
-    if (e > kNormalEps) return n.fail(r, "nearest normal differs by " + std::to_string(e));
-  }
-  QueryOptions qi = qn;
-  qi.reconstruction = Reconstruction::kInterpolated;
-  const QueryHit hi = cpu.intersect(ray, qi);
-  const float vis = cpu.visibility(ray, qi);
-  const double dv = std::fabs(double(o.visibility) - double(vis));
-  n.iMaxVis = std::max(n.iMaxVis, dv);
-  if (dv > kInterpVis) return n.fail(r, "visibility " + std::to_string(o.visibility) + " vs " + std::to_string(vis));
-  if (((o.flags & QueryAnswer::kInterpHit) != 0) != hi.hit) {
-    if (std::fabs(double(vis) - 0.5) > kVoteEps) return n.fail(r, "interpolated hit flag differs");
-    ++n.iTie;
-    return;
-  }
-  ++n.iAgree;
-  if (!hi.hit) return;
-  ++n.iHits;
-  const double dt = std::fabs(double(o.interpT[0]) - double(hi.t)) * len / R;
-  n.iMaxT = std::max(n.iMaxT, dt);
-  if (dt > kInterpT) return n.fail(r, "interpolated t differs by " + std::to_string(dt) + " R");
-  if (((o.flags & QueryAnswer::kInterpHasNormal) != 0) != hi.hasNormal)
-    return n.fail(r, "interpolated hasNormal differs");
-  if (hi.hasNormal && maxDiff3(o.interpNormal, hi.normal) > 1e-4) return n.fail(r, "interpolated normal differs");
-}
-
 class VkField : public ::testing::TestWithParam<InLanguage<FieldCase>> {};
 
 TEST_P(VkField, NormalsAndInterpolatedMatchCpu) {
@@ -258,20 +179,12 @@ TEST_P(VkField, NormalsAndInterpolatedMatchCpu) {
   const std::vector<QueryRay> rays = gputest::interpolatedRays<QueryRay>(file->field(), 8192, 77);
   const std::vector<QueryAnswer> out = runVk(*file, GetParam().language, rays);
   ASSERT_EQ(out.size(), rays.size());
-  InterpCounts n;
+  gputest::InterpCounts n;
   for (size_t r = 0; r < rays.size(); ++r)
-    compareInterpolated(*cpu, rays[r], out[r], file->field().sphere.radius, r, n);
-  std::printf(
-      "[ vk ] %s (%s): kNearest: %llu normals compared, max diff %.3g, hit-flag mismatches %llu; kInterpolated: "
-      "%llu rays, agreement %.3f%%, vote ties %llu, failures %llu; %llu hits, max |t_gpu - t_cpu| = %.3g R, "
-      "max |vis_gpu - vis_cpu| = %.3g\n",
-      caseName(GetParam().value).c_str(), languageName(GetParam().language), (unsigned long long)n.nNormals, n.nMax, (unsigned long long)n.nFlag,
-      (unsigned long long)rays.size(), 100.0 * double(n.iAgree) / double(rays.size()), (unsigned long long)n.iTie,
-      (unsigned long long)n.fails, (unsigned long long)n.iHits, n.iMaxT, n.iMaxVis);
-  EXPECT_EQ(n.fails, 0u) << n.first;
-  EXPECT_EQ(n.nFlag, 0u);
-  EXPECT_GT(n.nNormals, rays.size() / 8);
-  EXPECT_GT(n.iHits, rays.size() / 8);
+    gputest::compareInterpolated(*cpu, rays[r], out[r], file->field().sphere.radius, r, n);
+  gputest::reportInterpolated(
+      n, "[ vk ] " + caseName(GetParam().value) + " (" + languageName(GetParam().language) + ")",
+      caseName(GetParam().value));
   expectNoValidationMessages();
 }
 

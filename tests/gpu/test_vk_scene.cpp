@@ -46,26 +46,9 @@ static_assert(sizeof(vk::SceneAnswer) == sizeof(SceneOut));
 static_assert(offsetof(vk::SceneAnswer, visibility) == offsetof(SceneOut, visibility));
 static_assert(offsetof(vk::SceneAnswer, normal) == offsetof(SceneOut, normal));
 
-std::vector<vk::SceneRay> toVk(const std::vector<GpuRay>& rays) {
-  std::vector<vk::SceneRay> out(rays.size());
-  for (size_t r = 0; r < rays.size(); ++r) {
-    const GpuRay& g = rays[r];
-    vk::SceneRay& v = out[r];
-    for (int a = 0; a < 3; ++a) {
-      v.origin[a] = g.origin[a];
-      v.direction[a] = g.direction[a];
-    }
-    v.tmin = g.range[0];
-    v.tmax = g.range[1];
-    v.intraBias = g.range[2];
-    v.source = sourceOf(g);  // kNoSources is vk::kSceneNoSources
-  }
-  return out;
-}
-
 // Runs the rays through the scene; ADD_FAILUREs and returns empty on a failure.
 std::vector<SceneOut> runVk(const vk::ScenePipeline& pipe, const vk::GpuScene& gpu, const std::vector<GpuRay>& rays) {
-  auto answers = pipe.run(*vkEnv().ctx, gpu, toVk(rays));
+  auto answers = pipe.run(*vkEnv().ctx, gpu, toSceneRays<vk::SceneRay>(rays));
   EXPECT_TRUE(answers.ok()) << answers.error().toString();
   if (!answers) return {};
   std::vector<SceneOut> out(answers->size());
@@ -139,11 +122,7 @@ TEST_P(VkScene, EmptySceneMissesEverything) {
       ASSERT_TRUE(gpu_.update(ctx(), empty).ok());
     }
     EXPECT_EQ(gpu_.instanceCount(), 0u);
-    uint32_t answered = 0;
-    for (const SceneOut& o : runVk(pipe_, gpu_, rays))
-      answered += o.nearestHit != 0 || o.occluded != 0 || o.interpHit != 0 || o.visibility != 1.0f ||
-                  o.nearestInstance != kNoInstance;
-    EXPECT_EQ(answered, 0u) << "pass " << pass;
+    EXPECT_EQ(answeredRays(runVk(pipe_, gpu_, rays)), 0u) << "pass " << pass;
   }
   // And the full scene again after it: the buffers grow back.
   ASSERT_TRUE(gpu_.update(ctx(), scene_).ok());
