@@ -42,6 +42,16 @@ test_wgsl_generated() { need_node; node_test test/wgsl.test.js; }
 # a compute pipeline, and the helpers answer as the CPU. (The query against libvff: gpu-webgpu label.)
 test_browser_wgsl_compile() { need_chromium; node_test test/browser/wgsl_compile.browser.js; }
 
+# In headless Chromium with WebGPU: the page draws the ground through WebGPU (the WGSL query), its
+# reference view matches the C++ render, its accumulated ground matches the WebGL2 one pixel for
+# pixel, and without WebGPU the page falls back to WebGL2.
+test_browser_webgpu_view() {
+  need_chromium
+  [[ -x ${VFF_BAKE:-} ]] || skip "vff-bake is not built (needs Embree)"
+  [[ -f /usr/share/glmark2/models/bunny.obj ]] || skip "no /usr/share/glmark2/models/bunny.obj (apt-get install glmark2-data)"
+  VFF_WORK="$WORK" node_test test/browser/webgpu_view.browser.js
+}
+
 # In headless Chromium: the decoder decodes the conformance vectors as under node.
 test_browser_decoder() { need_chromium; node_test test/browser/decoder.browser.js; }
 

@@ -49,6 +49,7 @@ export function fieldResources(result) {
   return {
     uniforms, defines, glsl: specialisedGlsl(uniforms.vffField.value, `${FIELD_STRUCT}\n${VFF_QUERY_GLSL_ES}`),
     center: new THREE.Vector3(...result.field.center), radius: result.field.radius,
+    source: g,  // the plain arrays, for the WebGPU ground (webgpu_ground.js)
     dispose() { maps.dispose(); normals?.dispose(); positions.dispose(); },
   };
 }

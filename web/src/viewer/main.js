@@ -3,6 +3,7 @@
 // three.js view, and offer PNG and JSON downloads. A new file, or a bad one, first clears all that
 // the previous file left. The file is read in the page and never sent anywhere.
 import { FieldView } from './view3d.js';
+import { openWebGpu } from './webgpu_ground.js';
 import { ContactSheet } from './sheet.js';
 import { fieldResources } from './field_three.js';
 import { problemText } from './problems.js';
@@ -36,9 +37,26 @@ const askTexel = (k, i, j) => new Promise((resolve) => { const id = ++texelId; t
 
 const view = new FieldView($('view'), $('view-box'), ({ frame, maxFrames, ms }) => {
   $('frames').textContent = state?.result?.ok ? `${frame} / ${maxFrames} frames accumulated (${ms.toFixed(0)} ms for the last)` : '';
+  showBackend();
 });
 const gl = view.renderer.getContext();
 const limits = { maxTextureSize: gl.getParameter(gl.MAX_TEXTURE_SIZE), maxLayers: gl.getParameter(gl.MAX_ARRAY_TEXTURE_LAYERS), max3d: gl.getParameter(gl.MAX_3D_TEXTURE_SIZE) };
+// The ground through WebGPU where the browser offers it (the object is WebGL2 either way); a file's
+// layout must then fit both APIs' limits. Files wait for the answer (loadBytes).
+// ?ground=webgpu takes a software adapter too; ?ground=webgl2 leaves WebGPU alone.
+const groundParam = new URLSearchParams(location.search).get('ground');
+const gpuOpened = (groundParam === 'webgl2' ? Promise.resolve({ reason: '?ground=webgl2' })
+  : openWebGpu({ allowFallback: groundParam === 'webgpu' })).then(async (gpu) => {
+  if (gpu.device) {
+    for (const k of Object.keys(limits)) limits[k] = Math.min(limits[k], gpu.limits[k]);
+    view.useWebGpu(gpu);
+  } else {
+    console.info(`vff viewer: the ground is drawn with WebGL2 (${gpu.reason})`);
+  }
+  showBackend();
+  return view.backend;
+});
+function showBackend() { $('backend').textContent = state?.result?.ok ? `· ground: ${view.backendName}` : ''; }
 const sheet = new ContactSheet($('sheet'), $('under'), askTexel);
 
 let state = null, loads = 0;
@@ -96,6 +114,7 @@ export async function loadBytes(bytes, name, options = {}) {
   clearPage();
   setProgress(0, `Decoding ${name}…`);
   await ready;
+  await gpuOpened;
   const copy = options.keepBytes === false && bytes.byteOffset === 0 && bytes.byteLength === bytes.buffer.byteLength ? bytes : bytes.slice();
   let result;
   try {
@@ -125,6 +144,7 @@ export async function loadBytes(bytes, name, options = {}) {
   }
   $('note').textContent = result.gpu.note;
   const placed = view.setField(fieldResources(result));
+  showBackend();
   $('save-png').disabled = false;
   setProgress(null, `${name}: ${result.field.mapCount} maps of ${result.field.mapResolution}²; the object stands on the ground at y = ${placed.groundY.toPrecision(5)}.`);
   return { ok: true, gl: true, problems: result.problems, groundY: placed.groundY, lowest: placed.lowest };
@@ -196,6 +216,8 @@ $('save-json').addEventListener('click', () => state && download(new Blob([jsonT
 // For the tests and the benchmark (web/test/browser/): the entry points and the view.
 window.vffViewer = {
   loadBytes, loadUrl, view, ready,
+  /** Resolves once WebGPU has answered (a device or none); view.backend says what draws the ground. */
+  gpuOpened,
   get state() { return state; },
   /** Draws one frame now (one accumulation step); returns the milliseconds until the GPU finished. */
   redraw() {
@@ -204,7 +226,7 @@ window.vffViewer = {
     gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));
     return performance.now() - t0;
   },
-  reference: (size, interpolated) => view.reference(size, interpolated),
+  reference: (size, interpolated, api) => view.reference(size, interpolated, api),
   objectPixels: () => view.objectPixels(),
 };
 

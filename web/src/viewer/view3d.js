@@ -1,11 +1,14 @@
 // view3d.js - the three.js view of a field: its object drawn from the field (impostor.js) standing
 // on the ground at the object's lowest point, the ground's AO and soft shadow accumulated over
 // frames while the view holds still, orbit controls (pointer, touch, arrow keys), sized to its
-// container at the device's pixel ratio, redrawn at most once per animation frame.
+// container at the device's pixel ratio, redrawn at most once per animation frame. Where the page
+// gives it a WebGPU device (useWebGpu), the ground is webgpu_ground.js's, in a canvas under this
+// one, and three.js draws the object and the grid over it; otherwise the ground is a WebGL2 pass.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { createVffImpostor } from '../../three-vff/src/impostor.js';
 import { accumulatePass, floatTarget, lowestPoint, referenceView } from './passes.js';
+import { WebGpuGround } from './webgpu_ground.js';
 
 const GROUND_VERTEX = `
 void main() { gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0); }`;
@@ -43,7 +46,8 @@ export class FieldView {
     this.canvas = canvas;
     this.container = container;
     this.onFrame = onFrame;
-    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+    // (alpha: over a WebGPU ground the canvas is cleared to transparent; otherwise to the sky.)
+    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true, alpha: true });
     this.renderer.setPixelRatio(window.devicePixelRatio || 1);
     this.renderer.outputColorSpace = THREE.LinearSRGBColorSpace;
     this.renderer.setClearColor(0xcfd8e3);
@@ -58,6 +62,8 @@ export class FieldView {
     this.frame = 0;
     this.raf = 0;
     this.field = null;
+    this.gpuGround = null;  // webgpu_ground.js's WebGpuGround, while the page has a WebGPU device
+    this.gpuField = false;  // whether the ground of this field is the WebGPU one
     this.targets = [];
     this.kept = [];     // this field's pass materials, retired with it
     this.retired = [];  // the previous field's materials, disposed once this field has drawn
@@ -77,7 +83,66 @@ export class FieldView {
     const size = this.renderer.getDrawingBufferSize(new THREE.Vector2());
     for (const t of this.targets) t.dispose();
     this.targets = [floatTarget(size.x, size.y, this.renderer), floatTarget(size.x, size.y, this.renderer)];
+    this.gpuGround?.resize(size.x, size.y);
     this.invalidate();
+  }
+
+  /**
+   * Draws the ground through WebGPU from now on (gpu: webgpu_ground.js's openWebGpu result with a
+   * device), in a canvas put under this one; null goes back to WebGL2. A lost device goes back too.
+   */
+  useWebGpu(gpu) {
+    if (this.gpuGround) {
+      this.gpuGround.canvas.remove();
+      this.gpuGround.dispose();
+      this.gpuGround = null;
+    }
+    if (gpu?.device) {
+      const under = document.createElement('canvas');
+      under.className = 'under';
+      under.setAttribute('aria-hidden', 'true');
+      this.container.prepend(under);
+      this.gpuGround = new WebGpuGround(gpu, under);
+      this.gpuLimits = gpu.limits;
+      gpu.device.lost.then((info) => {
+        if (this.gpuGround?.device !== gpu.device) return;
+        console.warn(`WebGPU device lost (${info.message}); the ground is drawn with WebGL2`);
+        this.useWebGpu(null);
+      });
+      const size = this.renderer.getDrawingBufferSize(new THREE.Vector2());
+      this.gpuGround.resize(size.x, size.y);
+    }
+    if (this.field) this.placeGround();
+    this.invalidate();
+  }
+
+  /** Which API draws the ground: 'webgpu' or 'webgl2', and the WebGPU adapter's name. */
+  get backend() { return this.gpuField ? 'webgpu' : 'webgl2'; }
+  get backendName() {
+    if (this.gpuField) return `WebGPU (${this.gpuGround.name})`;
+    const src = this.field?.source;
+    return this.gpuGround && src && !this.gpuGround.ready(src.is3d) && this.fitsWebGpu(src) ? 'WebGL2 (the WebGPU passes are compiling)' : 'WebGL2';
+  }
+
+  /** Whether a field's slices fit the WebGPU device's limits (else its ground stays WebGL2). */
+  fitsWebGpu(g) {
+    const l = this.gpuLimits, d = g.distance;
+    const side = g.is3d ? l.max3d : l.maxTextureSize;
+    return d.width <= side && d.height <= side && d.depth <= (g.is3d ? l.max3d : l.maxLayers);
+  }
+
+  /** The ground of the current field: the WebGPU one where it can be, else the WebGL2 mesh. */
+  placeGround() {
+    const g = this.gpuGround, src = this.field.source;
+    this.gpuField = !!g && !!src && this.fitsWebGpu(src) && g.ready(src.is3d);
+    // Until the passes are compiled (3D fields' on first use), WebGL2 draws the ground.
+    if (g && src && !g.ready(src.is3d) && this.fitsWebGpu(src))
+      g.compile(src.is3d).then(() => { if (this.field?.source === src && this.gpuGround === g) { this.placeGround(); this.invalidate(); } },
+        (e) => console.warn(`the WebGPU ground failed to compile (${e.message}); it stays WebGL2`));
+    this.gpuGround?.setField(this.gpuField ? this.field.source : null);
+    this.ground.visible = !this.gpuField;
+    this.scene.background = this.gpuField ? null : new THREE.Color(0xcfd8e3);
+    this.renderer.setClearColor(0xcfd8e3, this.gpuField ? 0 : 1);
   }
 
   /** Shows a field (field_three.js's resources); returns {groundY, lowest}. */
@@ -110,6 +175,7 @@ export class FieldView {
     this.grid.material.opacity = 0.35;
     this.scene.add(this.grid);
     this.accumulate = accumulatePass(field);
+    this.placeGround();
     this.camera.near = R / 100;
     this.camera.far = R * 200;
     this.controls.target.set(c.x, (this.groundY + c.y + R) / 2, c.z);
@@ -143,6 +209,8 @@ export class FieldView {
     // held while the next file loads (or after it fails).
     for (const m of this.retired) for (const u of Object.values(m.uniforms ?? {})) if (u.value?.isTexture) u.value = null;
     this.field?.dispose();
+    this.gpuGround?.setField(null);
+    this.gpuField = false;
     this.impostor = this.ground = this.grid = this.accumulate = this.field = null;
     this.invalidate();
   }
@@ -186,11 +254,28 @@ export class FieldView {
     if (!this.raf) this.raf = requestAnimationFrame(() => { this.raf = 0; this.draw(); });
   }
 
+  /** What the WebGPU ground's passes take for the current camera, light and options. */
+  groundParams() {
+    const o = this.options, g = this.groundMaterial.uniforms;
+    this.camera.updateMatrixWorld();
+    return {
+      invViewProjection: new THREE.Matrix4().multiplyMatrices(this.camera.projectionMatrix, this.camera.matrixWorldInverse).invert(),
+      light: lightDirection(o.lightAzimuth, o.lightElevation), lightAngle: o.lightAngle, color: g.uColor.value, fade: g.uFade.value,
+      sky: g.uSky.value, groundY: this.groundY, aim: this.controls.target, aoRange: 4 * this.field.radius,
+      frame: this.frame, aoRays: o.aoRaysPerFrame, shadowRays: o.shadowRaysPerFrame, interpolated: o.interpolated, show: o.show,
+    };
+  }
+
   /** Draws one frame now: one more accumulation step of the ground, then the scene. */
   draw() {
     const t0 = performance.now();
     const o = this.options, light = lightDirection(o.lightAzimuth, o.lightElevation);
-    if (this.field && this.frame < o.maxFrames) {
+    if (this.gpuField) {
+      const step = this.frame < o.maxFrames;
+      this.gpuGround.draw(this.groundParams(), step);
+      if (step) this.frame += 1;
+    }
+    if (!this.gpuField && this.field && this.frame < o.maxFrames) {
       const [prev, next] = this.targets;
       const u = this.accumulate.material.uniforms;
       this.camera.updateMatrixWorld();
@@ -226,7 +311,12 @@ export class FieldView {
   }
 
   /** The deterministic reference view of the ground AO (the tests' comparison with libvff). */
-  reference(size, interpolated) { return this.field ? referenceView(this.renderer, this.field, size, interpolated) : null; }
+  // (Through WebGPU where the ground is drawn with it: then a Promise of the same array.)
+  reference(size, interpolated, api = this.backend) {
+    if (!this.field) return null;
+    if (api === 'webgpu' && this.gpuField) return this.gpuGround.reference(this.field.center, this.field.radius, size, interpolated);
+    return referenceView(this.renderer, this.field, size, interpolated);
+  }
 
   /** The number of drawing-buffer pixels the object covers (drawn alone on black; for the tests). */
   objectPixels() {
@@ -246,9 +336,20 @@ export class FieldView {
     return n;
   }
 
-  /** The canvas as a PNG Blob (a fresh frame drawn first). */
+  /** The canvas as a PNG Blob (a fresh frame drawn first; over the WebGPU ground where there is one). */
   png() {
     this.renderer.render(this.scene, this.camera);
-    return new Promise((resolve) => this.canvas.toBlob(resolve, 'image/png'));
+    let out = this.canvas;
+    if (this.gpuField) {
+      out = document.createElement('canvas');
+      [out.width, out.height] = [this.canvas.width, this.canvas.height];
+      const c = out.getContext('2d');
+      // A WebGPU canvas keeps its image only until it is shown: shade the ground again (no new
+      // accumulation step) and copy it in the same task.
+      this.gpuGround.draw(this.groundParams(), false);
+      c.drawImage(this.gpuGround.canvas, 0, 0);
+      c.drawImage(this.canvas, 0, 0);
+    }
+    return new Promise((resolve) => out.toBlob(resolve, 'image/png'));
   }
 }
