@@ -29,15 +29,15 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BEGIN = "<!-- benchmarks:begin: made by `python3 benchmarks/report.py readme`; do not edit -->"
 END = "<!-- benchmarks:end -->"
 STEPS = ["bake", "query", "accuracy-ao", "accuracy-intra-ao", "accuracy-shadows", "accuracy-reflections",
-         "scene", "triangles", "compression", "sdf", "gpu", "python", "library", "three"]
+         "scene", "triangles", "compression", "sdf", "gpu", "webgpu", "python", "library", "three"]
 # Steps a results file may lack: the GPU bench (no headless OpenGL), the Python module (not built),
 # the distance field and the library bake (files from before they existed), the three.js frame time
-# (no node, web/node_modules or chromium).
-OPTIONAL = ("gpu", "python", "sdf", "library", "three")
+# and the WebGPU query (no node, web/node_modules or chromium; no WebGPU adapter).
+OPTIONAL = ("gpu", "webgpu", "python", "sdf", "library", "three")
 # run.sh --only NAME: the steps it runs.
 ONLY = {"bake": ["bake"], "query": ["query"], "accuracy": [s for s in STEPS if s.startswith("accuracy-")],
         "scene": ["scene"], "triangles": ["triangles"], "compression": ["compression"], "gpu": ["gpu"],
-        "sdf": ["sdf"], "python": ["python"], "library": ["library"], "three": ["three"]}
+        "sdf": ["sdf"], "python": ["python"], "library": ["library"], "three": ["three"], "webgpu": ["webgpu"]}
 
 
 class ParseError(Exception):
@@ -333,6 +333,25 @@ def parse_three(text):
             "rows": [{"effect": r[0], "ms": number(r[1]), "x": number(r[2])} for r in rows]}
 
 
+def parse_webgpu(text):
+    """web/tools/bench-webgpu.mjs: the adapter and each query's rays per second."""
+    head = re.search(r"^WebGPU: (.*?); field queries/s through the WGSL kernel \((.*?)\)", text, re.M)
+    rows = []
+    for line in text.splitlines():
+        m = re.match(r"^\| 2\^(\d+) \| ([^|]+?) \| ([\d.e+]+) \| ([\d.]+) \|$", line)
+        if m:
+            rows.append({"log2": int(m.group(1)), "query": m.group(2), "rate": float(m.group(3)), "check": float(m.group(4))})
+    if not head or not rows:
+        raise ParseError("bench-webgpu.mjs output lacks its adapter line or its table")
+    return {"adapter": head.group(1), "kernel": head.group(2), "rows": rows}
+
+
+def webgpu_table(w):
+    lines = ["| query | rays | WebGPU, Mrays/s | hit share or mean visibility |", "|---|---:|---:|---:|"]
+    lines += [f"| {r['query']} | 2^{r['log2']} | {rate(r['rate'] / 1e6)} | {r['check']:.4f} |" for r in w["rows"]]
+    return lines
+
+
 def three_table(t):
     lines = ["| effect | ms/frame | / field |", "|---|---:|---:|"]
     lines += [f"| {r['effect']} | {fmt(r['ms'], 1)} | {r['x']:.2f} |" for r in t["rows"]]
@@ -345,7 +364,7 @@ def three_heading(t):
             f"{t['instances']} moving instances)")
 
 
-PARSERS = {"three": parse_three, "sdf": parse_sdf, "library": parse_library, "bake": parse_bake, "scene": parse_scene, "triangles": parse_triangles, "query": parse_query,
+PARSERS = {"three": parse_three, "webgpu": parse_webgpu, "sdf": parse_sdf, "library": parse_library, "bake": parse_bake, "scene": parse_scene, "triangles": parse_triangles, "query": parse_query,
            "compression": parse_compression, "gpu": parse_gpu, "python": parse_python}
 
 
@@ -675,6 +694,12 @@ def sections(machine, steps, heading, queries=None, only=None):
             out += [f"{heading} GPU ground AO, field against a distance field at equal memory ({renderer}{soft}; "
                     f"{d['size']}x{d['size']}, {d['spp']} rays/px; CPU baseline on {d['threads']} threads)", "",
                     *gpu_sdf_table(d), ""]
+    if "webgpu" in steps:
+        w = steps["webgpu"]
+        wsoft = ": SwiftShader, on the CPU" if "swiftshader" in w["adapter"].lower() else ""
+        out += [f"{heading} GPU query through WebGPU ({w['adapter']}{wsoft})", "", *webgpu_table(w), "",
+                f"The WGSL generated from the same GLSL ({w['kernel']}) in headless Chromium, on ground-AO "
+                "rays; each answer carries both reconstructions and the lookup, 80 bytes a ray.", ""]
     if "python" in steps:
         p = steps["python"]
         out += [f"{heading} Python and vff-query against the C++ batch ({p['rays']} ao rays, {p['reconstruction']}, "

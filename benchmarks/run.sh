@@ -26,6 +26,9 @@
 #                bowl (a thin shell), both from vff-procedural-mesh; --sdf-rays rays per set
 #   library      benchmarks/library.sh: vff-library's pool (and Slurm, where SLURM_CONF is set)
 #                against the same bakes one after another, and the up-to-date re-run
+#   webgpu       web/tools/bench-webgpu.mjs, where node, web/node_modules and chromium are there and
+#                chromium offers a WebGPU adapter: the field's queries/s through the WGSL kernel
+#                generated from the GLSL (the adapter named: SwiftShader is the CPU)
 #   three        web/tools/bench-three.mjs, where node, web/node_modules and chromium are there: the
 #                three.js example scene (web/tools/make-example.mjs), one frame drawn by the field
 #                effect of @vff/three and by three-mesh-bvh's exact GPU ray casting at the same rays per
@@ -35,7 +38,7 @@
 # rounded tables (README.md and benchmarks/README.md copy it: python3 benchmarks/report.py readme) and the full output of
 # every command. --quick runs each at a tiny size: a check that the whole chain works, whose
 # figures mean nothing. --only STEP[,STEP...] runs those steps (bake, query, accuracy, scene, triangles,
-# compression, gpu, sdf, python, library, three): a reduced run, and its results file says so. Run it on
+# compression, gpu, webgpu, sdf, python, library, three): a reduced run, and its results file says so. Run it on
 # a quiet machine: the query figures move with the memory's load.
 # Exit codes: 0 written, 1 usage, 2 a file cannot be read or written, 4 a benchmark failed.
 set -euo pipefail
@@ -50,7 +53,7 @@ while [[ $# -gt 0 ]]; do
     --out) [[ $# -ge 2 ]] || usage; out="$2"; shift 2 ;;
     --quick) quick=1; shift ;;
     --only) [[ $# -ge 2 ]] || usage; only="$2"; shift 2
-      [[ $only =~ ^((bake|query|accuracy|scene|triangles|compression|gpu|sdf|python|library|three)(,|$))+$ ]] || usage ;;
+      [[ $only =~ ^((bake|query|accuracy|scene|triangles|compression|gpu|webgpu|sdf|python|library|three)(,|$))+$ ]] || usage ;;
     --sdf-memory) [[ $# -ge 2 ]] || usage; sdfmemory="$2"; shift 2 ;;
     --sdf-rays) [[ $# -ge 2 ]] || usage; sdfrays="$2"; shift 2 ;;
     -h|--help) echo "usage: $prog [--build DIR] [--mesh FILE] [--out FILE] [--quick] [--only STEP[,STEP...]] [--sdf-memory \"MiB ...\"] [--sdf-rays N]"; exit 0 ;;
@@ -86,6 +89,7 @@ if ((quick)); then
   sceneargs=(--config 290x16x16 --instances 1 10 --scene-rays 4096 --frames 1)
   triangleargs=(--config 290x16x16 --bench-rays 4096 --min-triangles 500 --max-triangles 8000 --repeat 1)
   gpuargs=(--size 64 --spp 4) gpusdfargs=() pyargs=(--quick) threeargs=(--size 48x32 --rays 1 --frames 1)
+  webgpuargs=(--log2 12 --repeat 1)
   sdfargs=(--config 290x16x16 --bench-rays 20000 --repeat 1)
 else
   # The paper's configuration: octa-hemi2 n = 32 (4226 maps) of 64 x 64, unorm8-diameter.
@@ -96,6 +100,7 @@ else
   gpuargs=() gpusdfargs=(--sdf-size 256 --sdf-spp 64) pyargs=()
   # Software rendering takes seconds a frame for either effect: a small frame.
   threeargs=(--size 160x120 --rays 4 --frames 3)
+  webgpuargs=(--log2 20,21 --repeat 2)
   # shellcheck disable=SC2206  # the memory list is words
   sdfargs=(--repeat 3 --sdf-memory $sdfmemory)
 fi
@@ -144,7 +149,7 @@ if want accuracy; then
 fi
 want scene && step scene "$experiments" scene-bench --mesh "$mesh" "${sceneargs[@]}"
 want triangles && step triangles "$experiments" triangle-bench --mesh "$mesh" "${triangleargs[@]}"
-if want compression || want gpu || want python; then "$bake" "$mesh" -o "$raw/field.vff" "${config[@]}" -q; fi
+if want compression || want gpu || want webgpu || want python; then "$bake" "$mesh" -o "$raw/field.vff" "${config[@]}" -q; fi
 want compression && step compression "$compress" --benchmark "$raw/field.vff" --repeat "$compressrepeat" --tmp "$raw"
 # The GPU bench where it is built and a headless OpenGL 4.3 context opens; otherwise the results
 # file says why it did not run.
@@ -180,6 +185,19 @@ else
 fi
 # The library bake: the pool and Slurm against the same bakes one after another (benchmarks/library.sh).
 want library && step library bash "$root/benchmarks/library.sh" --build "$build" $( ((quick)) && echo --quick)
+# The field's queries through WebGPU (the generated WGSL), where node, web/node_modules and chromium
+# are there and chromium offers an adapter; otherwise the results file says why it did not run.
+if ! want webgpu; then
+  :
+elif ! command -v node >/dev/null; then
+  echo "node is not installed (scripts/setup.sh installs nodejs)" >"$raw/webgpu.skip"
+elif [[ ! -d $root/web/node_modules/playwright-core ]]; then
+  echo "web/node_modules lacks playwright-core (npm ci in web/)" >"$raw/webgpu.skip"
+elif ! chromium="$(command -v "${VFF_CHROMIUM:-chromium}")"; then
+  echo "no chromium (apt-get install chromium)" >"$raw/webgpu.skip"
+else
+  VFF_CHROMIUM_PATH="$chromium" skip_if="^SKIP: " step webgpu node "$root/web/tools/bench-webgpu.mjs" --field "$raw/field.vff" "${webgpuargs[@]}"
+fi
 # The three.js example's frame time, where node, web/node_modules (with three-mesh-bvh and
 # playwright-core) and chromium are there; otherwise the results file says why it did not run.
 if ! want three; then

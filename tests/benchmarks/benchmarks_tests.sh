@@ -29,6 +29,14 @@ test_quick_run_writes_a_results_file() {
   done
   # The GPU bench ran (a table naming the renderer) or the file says why not.
   grep -q -E "^### GPU query \(|^Not run: " "$WORK/r.md" || fail "the results file says nothing of the GPU bench"
+  # The WebGPU query ran (both queries, the adapter named) or the file says why not.
+  if grep -q -F "### GPU query through WebGPU (" "$WORK/r.md"; then
+    for q in "nearest occluded" "interpolated visibility"; do
+      grep -q -E "^\| $q \| 2\^[0-9]+ \| [0-9.,]+ \| 0\.[0-9]{4} \|$" "$WORK/r.md" || fail "no WebGPU row '$q'"
+    done
+  else
+    grep -A2 -E "^### webgpu$" "$WORK/r.md" | grep -q "^Not run: " || fail "the results file says nothing of the WebGPU step"
+  fi
   # The Python module's step ran (its table, each path against the C++ batch) or the file says why not.
   if grep -q -F "### Python and vff-query against the C++ batch" "$WORK/r.md"; then
     for path in "C++ batch" "vff-query, .npy in and out, end to end" "Python FieldQuery.intersect, numpy in and out"; do

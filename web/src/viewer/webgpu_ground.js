@@ -30,7 +30,8 @@ export async function openWebGpu({ allowFallback = false } = {}) {
     const keys = ['maxTextureArrayLayers', 'maxTextureDimension2D', 'maxTextureDimension3D', 'maxStorageBufferBindingSize', 'maxBufferSize'];
     const device = await adapter.requestDevice({ requiredLimits: Object.fromEntries(keys.map((k) => [k, adapter.limits[k]])) });
     const info = adapter.info ?? {};
-    const name = [info.vendor, info.architecture, info.device].filter(Boolean).join(' ') || 'unnamed adapter';
+    const soft = adapter.isFallbackAdapter || info.isFallbackAdapter ? ', a software adapter' : '';
+    const name = ([info.vendor, info.architecture, info.device].filter(Boolean).join(' ') || 'unnamed adapter') + soft;
     const l = device.limits;
     return { device, name, limits: { maxTextureSize: l.maxTextureDimension2D, maxLayers: l.maxTextureArrayLayers, max3d: l.maxTextureDimension3D } };
   } catch (e) {
@@ -166,8 +167,11 @@ fn shade(@builtin(position) fc: vec4<f32>) -> @location(0) vec4<f32> {
 }
 `;
 
-/** The field's resources at the WGSL include's bindings (group 0), from field_three's result.gpu. */
-function uploadField(device, g) {
+/**
+ * The field's resources at the WGSL include's bindings (group 0: entries for createBindGroup), from
+ * field_three's result.gpu; destroy() frees them. (Also tools/bench-webgpu.mjs's upload.)
+ */
+export function uploadField(device, g) {
   const dimension = g.is3d ? '3d' : '2d';
   const plane = (p) => {
     const tex = device.createTexture({
