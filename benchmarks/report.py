@@ -820,10 +820,10 @@ def full_block(runs, newest, base):
              f"From {link(path, base)}: {machine['cpu']}, {machine['cores']} cores, commit {machine['commit']}, "
              f"{machine['mesh']}, field {machine['field']}; the query table has a row for each CPU on record. "
              "Figures differ between CPUs: `bash benchmarks/run.sh` measures yours.", ""]
-    main = sections(machine, {k: v for k, v in steps.items() if k not in ("sdf", "three")}, "###", list(latest.values()),
+    main = sections(machine, {k: v for k, v in steps.items() if k not in ("sdf", "three", "webgpu")}, "###", list(latest.values()),
                     machine["field"])
-    # The distance-field comparison and the three.js frame time: each from the newest file that has it
-    # (a whole run, or --only sdf / --only three).
+    # The distance-field comparison, the WebGPU query and the three.js frame time: each from the newest
+    # file that has it (a whole run, or --only sdf / --only webgpu / --only three).
     ssteps, source = newest_with(runs, "sdf", base)
     if ssteps:
         d = ssteps["sdf"]
@@ -835,6 +835,13 @@ def full_block(runs, newest, base):
             main += ["The refined field (`vff-bake --refine`, `Reconstruction::kRefined`) at the distance field's "
                      "memory (its maps, unsure bits and exact step together), from the same run:", "",
                      *refined_summary(d), ""]
+    wsteps, source = newest_with(runs, "webgpu", base)
+    if wsteps:
+        w = wsteps["webgpu"]
+        main += [f"### GPU query through WebGPU ({w['adapter']})", "",
+                 f"{source}; the WGSL generated from the GLSL query ({w['kernel']}) in headless Chromium, on "
+                 "ground-AO rays; each answer carries both reconstructions and the lookup, 80 bytes a ray.", "",
+                 *webgpu_table(w), ""]
     tsteps, source = newest_with(runs, "three", base)
     if tsteps:
         t = tsteps["three"]
