@@ -53,7 +53,14 @@ async function openPage(query, viewport = { width: 1280, height: 800 }, b = brow
 }
 
 const backendOf = (page) => page.evaluate(() => ({ backend: window.vffViewer.view.backend, label: document.getElementById('backend').textContent }));
-const waitWebGpu = (page) => page.waitForFunction(() => window.vffViewer.view.backend === 'webgpu', null, { timeout: 300000 });
+// Whether the page got a WebGPU device (a browser without an adapter leaves the ground to WebGL2);
+// then waits until its ground is drawn through it (the pipelines compiled).
+async function waitWebGpu(page) {
+  const has = await page.evaluate(async () => { await window.vffViewer.gpuOpened; return !!window.vffViewer.view.gpuGround; });
+  if (has) await page.waitForFunction(() => window.vffViewer.view.backend === 'webgpu', null, { timeout: 300000 });
+  return has;
+}
+const NO_ADAPTER = 'this chromium offers no WebGPU adapter (--enable-unsafe-webgpu)';
 
 /** The view after `frames` accumulation steps, as RGBA bytes of the composited canvas (view.png). */
 async function accumulated(page, frames, file) {
@@ -69,9 +76,9 @@ async function accumulated(page, frames, file) {
   });
 }
 
-test('the ground is drawn through WebGPU, its reference view matches libvff and equals WebGL2\'s', { skip: SKIP || false }, async () => {
+test('the ground is drawn through WebGPU, its reference view matches libvff and equals WebGL2\'s', { skip: SKIP || false }, async (t) => {
   const page = await openPage('?ground=webgpu');
-  await waitWebGpu(page);
+  if (!await waitWebGpu(page)) { console.log(`SKIP: ${NO_ADAPTER}`); t.skip(NO_ADAPTER); return; }
   const b = await backendOf(page);
   console.log(`backend: ${b.backend} (${b.label})`);
   assert.match(b.label, /ground: WebGPU \(/);
@@ -101,10 +108,10 @@ test('the ground is drawn through WebGPU, its reference view matches libvff and 
   await page.close();
 });
 
-test('the WebGPU ground is the WebGL2 ground, at a desktop and a phone size', { skip: SKIP || false }, async () => {
+test('the WebGPU ground is the WebGL2 ground, at a desktop and a phone size', { skip: SKIP || false }, async (t) => {
   for (const [name, viewport] of [['desktop', { width: 1280, height: 800 }], ['phone', { width: 390, height: 844 }]]) {
     const gpuPage = await openPage('?ground=webgpu', viewport);
-    await waitWebGpu(gpuPage);
+    if (!await waitWebGpu(gpuPage)) { console.log(`SKIP: ${NO_ADAPTER}`); t.skip(NO_ADAPTER); return; }
     const a = await accumulated(gpuPage, FRAMES, `webgpu-${name}.png`);
     const glPage = await openPage('?ground=webgl2', viewport);
     assert.equal((await backendOf(glPage)).backend, 'webgl2');
