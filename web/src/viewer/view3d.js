@@ -64,6 +64,7 @@ export class FieldView {
     this.field = null;
     this.gpuGround = null;  // webgpu_ground.js's WebGpuGround, while the page has a WebGPU device
     this.gpuField = false;  // whether the ground of this field is the WebGPU one
+    this.gpuPending = false;  // whether it will be, once the WebGPU passes are compiled
     this.targets = [];
     this.kept = [];     // this field's pass materials, retired with it
     this.retired = [];  // the previous field's materials, disposed once this field has drawn
@@ -120,8 +121,7 @@ export class FieldView {
   get backend() { return this.gpuField ? 'webgpu' : 'webgl2'; }
   get backendName() {
     if (this.gpuField) return `WebGPU (${this.gpuGround.name})`;
-    const src = this.field?.source;
-    return this.gpuGround && src && !this.gpuGround.ready(src.is3d) && this.fitsWebGpu(src) ? 'WebGL2 (the WebGPU passes are compiling)' : 'WebGL2';
+    return this.gpuPending ? 'WebGL2 (the WebGPU passes are compiling)' : 'WebGL2';
   }
 
   /** Whether a field's slices fit the WebGPU device's limits (else its ground stays WebGL2). */
@@ -134,12 +134,14 @@ export class FieldView {
   /** The ground of the current field: the WebGPU one where it can be, else the WebGL2 mesh. */
   placeGround() {
     const g = this.gpuGround, src = this.field.source;
-    this.gpuField = !!g && !!src && this.fitsWebGpu(src) && g.ready(src.is3d);
+    const fits = !!g && !!src && this.fitsWebGpu(src);
+    this.gpuField = fits && g.ready(src.is3d);
+    this.gpuPending = fits && !this.gpuField;
     // Until the passes are compiled (3D fields' on first use), WebGL2 draws the ground.
-    if (g && src && !g.ready(src.is3d) && this.fitsWebGpu(src))
+    if (this.gpuPending)
       g.compile(src.is3d).then(() => { if (this.field?.source === src && this.gpuGround === g) { this.placeGround(); this.invalidate(); } },
-        (e) => console.warn(`the WebGPU ground failed to compile (${e.message}); it stays WebGL2`));
-    this.gpuGround?.setField(this.gpuField ? this.field.source : null);
+        (e) => { this.gpuPending = false; console.warn(`the WebGPU ground failed to compile (${e.message}); it stays WebGL2`); });
+    g?.setField(this.gpuField ? src : null);
     this.ground.visible = !this.gpuField;
     this.scene.background = this.gpuField ? null : new THREE.Color(0xcfd8e3);
     this.renderer.setClearColor(0xcfd8e3, this.gpuField ? 0 : 1);
@@ -210,7 +212,7 @@ export class FieldView {
     for (const m of this.retired) for (const u of Object.values(m.uniforms ?? {})) if (u.value?.isTexture) u.value = null;
     this.field?.dispose();
     this.gpuGround?.setField(null);
-    this.gpuField = false;
+    this.gpuField = this.gpuPending = false;
     this.impostor = this.ground = this.grid = this.accumulate = this.field = null;
     this.invalidate();
   }
@@ -254,12 +256,17 @@ export class FieldView {
     if (!this.raf) this.raf = requestAnimationFrame(() => { this.raf = 0; this.draw(); });
   }
 
+  /** The camera's inverse view-projection into m (both grounds cast their pixels' rays with it). */
+  invViewProjection(m) {
+    this.camera.updateMatrixWorld();
+    return m.multiplyMatrices(this.camera.projectionMatrix, this.camera.matrixWorldInverse).invert();
+  }
+
   /** What the WebGPU ground's passes take for the current camera, light and options. */
   groundParams() {
     const o = this.options, g = this.groundMaterial.uniforms;
-    this.camera.updateMatrixWorld();
     return {
-      invViewProjection: new THREE.Matrix4().multiplyMatrices(this.camera.projectionMatrix, this.camera.matrixWorldInverse).invert(),
+      invViewProjection: this.invViewProjection(new THREE.Matrix4()),
       light: lightDirection(o.lightAzimuth, o.lightElevation), lightAngle: o.lightAngle, color: g.uColor.value, fade: g.uFade.value,
       sky: g.uSky.value, groundY: this.groundY, aim: this.controls.target, aoRange: 4 * this.field.radius,
       frame: this.frame, aoRays: o.aoRaysPerFrame, shadowRays: o.shadowRaysPerFrame, interpolated: o.interpolated, show: o.show,
@@ -278,8 +285,7 @@ export class FieldView {
     if (!this.gpuField && this.field && this.frame < o.maxFrames) {
       const [prev, next] = this.targets;
       const u = this.accumulate.material.uniforms;
-      this.camera.updateMatrixWorld();
-      u.uInvViewProjection.value.multiplyMatrices(this.camera.projectionMatrix, this.camera.matrixWorldInverse).invert();
+      this.invViewProjection(u.uInvViewProjection.value);
       u.uResolution.value.set(next.width, next.height);
       u.uGroundY.value = this.groundY;
       u.uFrame.value = this.frame;
