@@ -56,7 +56,7 @@ const gpuOpened = (groundParam === 'webgl2' ? Promise.resolve({ reason: '?ground
   showBackend();
   return view.backend;
 });
-function showBackend() { $('backend').textContent = state?.result?.ok ? `· ground: ${view.backendName}` : ''; }
+function showBackend() { $('backend').textContent = state?.result?.ok ? `ground: ${view.backendName}` : ''; }
 const sheet = new ContactSheet($('sheet'), $('under'), askTexel);
 
 let state = null, loads = 0;
