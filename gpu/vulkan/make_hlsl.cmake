@@ -1,6 +1,8 @@
 # The HLSL of one vff_vk kernel, generated from its SPIR-V (cmake -P, from gpu/vulkan/CMakeLists.txt):
 #   cmake -DSPIRV_CROSS=<spirv-cross> -DIN=<kernel.spv> -DOUT=<kernel.hlsl> -DPRELUDE=<prelude.hlsl>
-#         -DVARIANT=<name> [-DSOURCE=<kernel.comp, its name in the header>] -P make_hlsl.cmake
+#         -DVARIANT=<name> [-DSOURCE=<kernel.comp, its name in the header>] [-DGLSL=<what it includes>]
+#         -P make_hlsl.cmake
+# (SOURCE: a name in gpu/vulkan/shaders, or a path from the repository root.)
 # spirv-cross writes HLSL for shader model 6.0 with the SPIR-V's names and bindings (register(bN),
 # tN, uN, space0 for set 0, binding N). Two fixes make that text compile for Vulkan with glslang's
 # HLSL front end, and both are checked so that a different spirv-cross fails here, not at run time:
@@ -32,14 +34,21 @@ get_filename_component(_in_name ${IN} NAME)
 if(NOT SOURCE)
   set(SOURCE vff_vk_query.comp)
 endif()
-# The GLSL that the kernel includes: the scene kernel's vff_scene.glsl includes vff_query.glsl.
-if(SOURCE MATCHES "scene")
+set(_source_path "gpu/vulkan/shaders/${SOURCE}")
+if(SOURCE MATCHES "/")
+  set(_source_path "${SOURCE}")
+endif()
+# The GLSL that the kernel includes (-DGLSL=... names it for other kernels): the scene kernel's
+# vff_scene.glsl includes vff_query.glsl.
+if(GLSL)
+  set(_glsl "${GLSL}")
+elseif(SOURCE MATCHES "scene")
   set(_glsl "gpu/glsl/vff_scene.glsl and vff_query.glsl")
 else()
   set(_glsl "gpu/glsl/vff_query.glsl")
 endif()
 file(WRITE ${OUT}.tmp
-  "// Generated at build time from ${_in_name} (gpu/vulkan/shaders/${SOURCE} with\n"
+  "// Generated at build time from ${_in_name} (${_source_path} with\n"
   "// ${_glsl}, variant ${VARIANT}) by spirv-cross --hlsl --shader-model 60 and\n"
   "// gpu/vulkan/make_hlsl.cmake. Do not edit: change the GLSL. Compile for Vulkan with\n"
   "//   glslangValidator -D -V -S comp -e main\n"
