@@ -2,31 +2,25 @@
 // Vulkan, as GLSL and as HLSL, against the CPU tracer (sdf/src/sdf_field.cpp) with the GL suite's
 // rays and tolerances (sdf_cases.h), the Khronos validation layer on.
 //
-// The kernels are compiled when the case runs, from the text the GL path compiles (sdfShaderDefines
-// and sdfShaderSource give the grid type and the trace constants from the C++ side): GLSL ->
-// glslangValidator -V -> SPIR-V; that SPIR-V -> spirv-cross --hlsl (gpu/vulkan/make_hlsl.cmake, as
-// the query's HLSL is made) -> glslangValidator -D -V (glslang's HLSL front end) -> SPIR-V. So a
-// change to vff_sdf.glsl reaches both languages' tests. The pipeline and the dispatch are vff_vk's
-// (gpu/vulkan/src/compute.h): the grid is a storage buffer at binding 8, the block (SdfBlock, std140)
-// a uniform buffer at binding 9, the rays and answers storage buffers at bindings 3 and 4.
+// The kernels are compiled when the case runs (vk_compile.h), from the text the GL path compiles
+// (sdfShaderDefines and sdfShaderSource give the grid type and the trace constants from the C++
+// side), so a change to vff_sdf.glsl reaches both languages' tests. The grid is a storage buffer at
+// binding 8, the block (SdfBlock, std140) a uniform buffer at binding 9, the rays and answers
+// storage buffers at bindings 3 and 4.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <vector>
 
-#include "compute.h"
 #include "sdf_cases.h"
 #include "sdf_gl.h"
 #include "vff/bake/mesh.h"
 #include "vff/bake/procedural.h"
+#include "vk_compile.h"
 #include "vk_env.h"
 
 namespace {
@@ -36,6 +30,8 @@ using namespace vff::sdftest;
 using vff::vk::ShaderLanguage;
 using vff::vktest::languageName;
 using vff::vktest::vkEnv;
+using vff::vktest::makeTestKernel;
+using vff::vktest::readText;
 
 const char* kVkRayMain = R"(
 layout(local_size_x = 64) in;
@@ -52,93 +48,19 @@ void main() {
 }
 )";
 
-std::string readText(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
-// Runs a command with its output in `log`; the output when it fails.
-bool run(const std::string& command, const fs::path& log, std::string* why) {
-  const int rc = std::system((command + " > '" + log.string() + "' 2>&1").c_str());
-  if (rc == 0) return true;
-  *why = command + " failed (" + std::to_string(rc) + "):\n" + readText(log);
-  return false;
-}
-
-// A scratch folder for one case's compiles, removed with it.
-struct Scratch {
-  fs::path dir;
-  Scratch() {
-    std::string t = (fs::temp_directory_path() / "vff-vk-sdf-XXXXXX").string();
-    if (mkdtemp(t.data())) dir = t;
-  }
-  ~Scratch() {
-    std::error_code ec;
-    if (!dir.empty()) fs::remove_all(dir, ec);
-  }
-};
-
-// The kernel's SPIR-V words for `sdf`'s grid in `language`; empty with *why on failure.
-std::vector<uint32_t> compileKernel(const vffx::SdfField& sdf, ShaderLanguage language, const Scratch& s,
-                                    std::string* why) {
-  const std::string glsl = "#version 450\n" + vffx::gl::sdfShaderDefines(sdf) +
-                           vffx::gl::sdfShaderSource(readText(fs::path(VFF_GLSL_DIR) / "vff_sdf.glsl")) + kVkRayMain;
-  const fs::path comp = s.dir / "vff_vk_sdf.comp", spv = s.dir / "glsl.spv", log = s.dir / "log.txt";
-  std::ofstream(comp, std::ios::binary) << glsl;
-  if (!run(std::string("'") + VFF_GLSLANG + "' -V -S comp -o '" + spv.string() + "' '" + comp.string() + "'", log, why))
-    return {};
-  fs::path words = spv;
-  if (language == ShaderLanguage::kHlsl) {
-    const fs::path hlsl = s.dir / "vff_sdf.hlsl", hspv = s.dir / "hlsl.spv";
-    const std::string variant = sdf.values() == vffx::SdfValues::kFp8 ? "fp8" : "float";
-    if (!run(std::string("'") + VFF_CMAKE + "' -DSPIRV_CROSS='" + VFF_SPIRV_CROSS + "' -DIN='" + spv.string() +
-                 "' -DOUT='" + hlsl.string() + "' -DVARIANT=" + variant +
-                 " -DSOURCE=tests/gpu/test_vk_sdf.cpp -DGLSL=gpu/glsl/vff_sdf.glsl -DPRELUDE='" + VFF_HLSL_PRELUDE +
-                 "' -P '" + VFF_MAKE_HLSL + "'",
-             log, why))
-      return {};
-    if (!run(std::string("'") + VFF_GLSLANG + "' -D -V -S comp -e main -o '" + hspv.string() + "' '" + hlsl.string() + "'",
-             log, why))
-      return {};
-    words = hspv;
-  }
-  const std::string bytes = readText(words);
-  std::vector<uint32_t> code(bytes.size() / 4);
-  std::memcpy(code.data(), bytes.data(), code.size() * 4);
-  if (code.empty()) *why = words.string() + " is empty";
-  return code;
-}
-
-#define VFF_REQUIRE_TOOLS(language)                                                               \
-  do {                                                                                            \
-    if (std::string(VFF_GLSLANG).empty()) GTEST_SKIP() << "glslangValidator was not found";      \
-    if (language == ShaderLanguage::kHlsl && std::string(VFF_SPIRV_CROSS).empty())                \
-      GTEST_SKIP() << "spirv-cross was not found when the tests were configured (HLSL is made with it)"; \
-  } while (0)
-
 namespace d = vff::vk::detail;
 
 // The kernel for grids of `sdf`'s value type in `language`; null after a failure (reported).
 std::unique_ptr<d::Kernel> makeSdfKernel(const vffx::SdfField& sdf, ShaderLanguage language) {
-  Scratch scratch;
-  EXPECT_FALSE(scratch.dir.empty()) << "no scratch folder";
-  std::string why;
-  const std::vector<uint32_t> code = compileKernel(sdf, language, scratch, &why);
-  EXPECT_FALSE(code.empty()) << why;
-  if (code.empty()) return nullptr;
   static constexpr VkDescriptorType kBindings[] = {
       VK_DESCRIPTOR_TYPE_MAX_ENUM,       VK_DESCRIPTOR_TYPE_MAX_ENUM,       VK_DESCRIPTOR_TYPE_MAX_ENUM,
       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_MAX_ENUM,
       VK_DESCRIPTOR_TYPE_MAX_ENUM,       VK_DESCRIPTOR_TYPE_MAX_ENUM,       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
       VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER};
-  auto kernel = std::make_unique<d::Kernel>();
-  if (vff::Status st = d::makeKernel(*vkEnv().ctx, kBindings, code.data(), code.size(), kernel.get()); !st) {
-    ADD_FAILURE() << st.error().toString();
-    return nullptr;
-  }
-  return kernel;
+  const std::string glsl = "#version 450\n" + vffx::gl::sdfShaderDefines(sdf) +
+                           vffx::gl::sdfShaderSource(readText(fs::path(VFF_GLSL_DIR) / "vff_sdf.glsl")) + kVkRayMain;
+  return makeTestKernel(glsl, language, sdf.values() == vffx::SdfValues::kFp8 ? "fp8" : "float",
+                        "gpu/glsl/vff_sdf.glsl", kBindings);
 }
 
 // kVkRayMain over `rays` through `sdf`'s grid traced with `options`: hit, t, steps, visibility per
