@@ -22,7 +22,8 @@
 //   one the same way (both counts must be non-zero).
 //
 // The kernels answer a GpuRay with a GpuOut: the refined answer (with whether the exact step gave
-// it), the refined occlusion, and kNearest's answer (kMainBody, after a kernel's ray head).
+// it), the refined occlusion, and kNearest's answer (gpu/vulkan/shaders/vff_vk_refine.comp's
+// VffVkRay and VffVkRefinedAnswer; the GL suite's main makes the same calls).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -47,21 +48,6 @@ inline constexpr double kT = 1e-5;       // fraction of R
 inline constexpr double kNormal = 1e-5;  // per component
 inline constexpr uint64_t kMaxFlagMismatches = 4;  // per shape and answer (intersect, occluded)
 
-// The body of every kernel's main, after its head has read the ray `r` (a GpuRay) and before it
-// writes `o` to its answer: one ray per invocation.
-inline const char* const kMainBody = R"(
-  VffHit h = vffIntersectRefined(r.origin.xyz, r.direction.xyz, r.range.x, r.range.y, r.range.z);
-  bool occluded = vffOccludedRefined(r.origin.xyz, r.direction.xyz, r.range.x, r.range.y, r.range.z);
-  bool exact;
-  VffHit x = vffQueryRefined(r.origin.xyz, r.direction.xyz, r.range.x, r.range.y, r.range.z, false, exact);
-  VffHit n = vffIntersect(r.origin.xyz, r.direction.xyz, r.range.x, r.range.y, r.range.z);
-  TestOut o;
-  o.refined = vec4(h.hit ? 1.0 : 0.0, h.t, occluded ? 1.0 : 0.0, h.hasNormal ? 1.0 : 0.0);
-  o.normal = vec4(h.normal, x.hit == h.hit && (!h.hit || x.t == h.t) ? 1.0 : 0.0);
-  o.nearest = vec4(n.hit ? 1.0 : 0.0, n.t, 0.0, 0.0);
-  o.lookup = uvec4(exact ? 1u : 0u, x.looked ? x.sampleIndex : 0xffffffffu, x.texel);
-)";
-inline const char* const kTestOut = "struct TestOut { vec4 refined; vec4 normal; vec4 nearest; uvec4 lookup; };\n";
 
 struct GpuRay {
   float origin[4], direction[4], range[4];  // range: tmin, tmax, intraBias (-2: VFF_OFF_OBJECT)

@@ -30,6 +30,22 @@ namespace {
 
 using namespace refinetest;
 
+// The main of gpu/vulkan/shaders/vff_vk_refine.comp on GL (no push constant, no #include): the
+// same calls, after rayShaderHead has read the ray `r`.
+const char* const kMainBody = R"(
+  VffHit h = vffIntersectRefined(r.origin.xyz, r.direction.xyz, r.range.x, r.range.y, r.range.z);
+  bool occluded = vffOccludedRefined(r.origin.xyz, r.direction.xyz, r.range.x, r.range.y, r.range.z);
+  bool exact;
+  VffHit x = vffQueryRefined(r.origin.xyz, r.direction.xyz, r.range.x, r.range.y, r.range.z, false, exact);
+  VffHit n = vffIntersect(r.origin.xyz, r.direction.xyz, r.range.x, r.range.y, r.range.z);
+  TestOut o;
+  o.refined = vec4(h.hit ? 1.0 : 0.0, h.t, occluded ? 1.0 : 0.0, h.hasNormal ? 1.0 : 0.0);
+  o.normal = vec4(h.normal, x.hit == h.hit && (!h.hit || x.t == h.t) ? 1.0 : 0.0);
+  o.nearest = vec4(n.hit ? 1.0 : 0.0, n.t, 0.0, 0.0);
+  o.lookup = uvec4(exact ? 1u : 0u, x.looked ? x.sampleIndex : 0xffffffffu, x.texel);
+)";
+const char* const kTestOut = "struct TestOut { vec4 refined; vec4 normal; vec4 nearest; uvec4 lookup; };\n";
+
 const std::string kMain = std::string(kTestOut) + test::rayShaderHead(5, 6) + kMainBody + "  outs[id] = o;\n}\n";
 
 GLuint buildProgram(const std::string& defines) {

@@ -2,12 +2,12 @@
 // HLSL, against the CPU's Reconstruction::kRefined with the GL suite's shapes, rays and checks
 // (refine_cases.h), the Khronos validation layer on.
 //
-// The kernel is the GL path's text (shaderDefines and refinementShaderDefines, then the two
-// includes and refine_cases.h's main), compiled when the case runs (vk_compile.h), so a change to
+// The kernel is gpu/vulkan/shaders/vff_vk_refine.comp after the GL loader's defines (shaderDefines,
+// refinementShaderDefines), compiled when the case runs (vk_compile.h), so a change to
 // vff_refine.glsl or vff_query.glsl reaches both languages' tests. The field is vff::vk::loadField's
-// (bindings 0 to 3); the refinement is what vff::gl::loadRefinement uploads
-// (makeRefinementBuffers), as storage buffers at bindings 10 to 13 and the VffRefineBlock uniform
-// at 14; the rays and answers are storage buffers at bindings 4 and 5.
+// (bindings 0 to 3); the refinement is what vff::gl::loadRefinement uploads (makeRefinementBuffers),
+// as storage buffers at bindings 10 to 13 and the VffRefineBlock uniform at 14; the rays and
+// answers (refine_cases.h's GpuRay and GpuOut) are storage buffers at bindings 4 and 5.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -34,18 +34,6 @@ using vktest::vkEnv;
 namespace d = vk::detail;
 using gl::RefinementBuffers;
 
-const char* const kVkHead = R"(
-layout(local_size_x = 64) in;
-struct TestRay { vec4 origin; vec4 direction; vec4 range; };
-layout(std430, binding = 4) readonly buffer TestRays { TestRay rays[]; };
-layout(std430, binding = 5) writeonly buffer TestOuts { TestOut outs[]; };
-layout(push_constant) uniform VffVkPush { uint which; uint firstRay; uint rayCount; } vffVkPush;
-void main() {
-  uint id = gl_GlobalInvocationID.x + vffVkPush.firstRay;
-  if (id >= vffVkPush.rayCount) return;
-  TestRay r = rays[id];
-)";
-
 constexpr VkDescriptorType kNone = VK_DESCRIPTOR_TYPE_MAX_ENUM, kStorage = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                            kUniform = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
                            kImage = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
@@ -68,13 +56,16 @@ std::vector<GpuOut> runRays(const RefinedShape& s, ShaderLanguage language, cons
   EXPECT_TRUE(buffers.ok()) << (buffers.ok() ? "" : buffers.error().toString());
   if (!field.ok() || !buffers.ok()) return {};
   EXPECT_GT(buffers->block.triangleCount, 0u);
-  const std::string glsl = std::string("#version 450\n") + gl::shaderDefines(f, s.file->layout()) +
-                           gl::refinementShaderDefines(buffers->block) +
-                           vktest::readText(std::filesystem::path(VFF_GLSL_DIR) / "vff_query.glsl") + "\n" +
-                           vktest::readText(std::filesystem::path(VFF_GLSL_DIR) / "vff_refine.glsl") + kTestOut +
-                           kVkHead + kMainBody + "  outs[id] = o;\n}\n";
+  // The kernel with the loader's defines after its #version line.
+  std::string glsl = vktest::readText(std::filesystem::path(VFF_VK_SHADERS) / "vff_vk_refine.comp");
+  const size_t version = glsl.find("#version 430\n");
+  if (version == std::string::npos) {
+    ADD_FAILURE() << "vff_vk_refine.comp has no #version 430 line";
+    return {};
+  }
+  glsl.insert(version + 13, gl::shaderDefines(f, s.file->layout()) + gl::refinementShaderDefines(buffers->block));
   const std::unique_ptr<d::Kernel> kernel =
-      vktest::makeTestKernel(glsl, language, "refined", "gpu/glsl/vff_refine.glsl", kBindings);
+      vktest::makeTestKernel(glsl, language, "refined", "vff_vk_refine.comp", kBindings);
   if (!kernel) return {};
   d::DescriptorPool pool;
   auto set = d::allocateSet(*kernel, pool);

@@ -63,8 +63,9 @@ inline std::string missingTools(vk::ShaderLanguage language) {
   return {};
 }
 
-// The SPIR-V words of `glsl` (a whole compute shader) in `language`; `variant` and `source` name
-// the HLSL's variant and origin in its header. Empty with *why on failure.
+// The SPIR-V words of `glsl` (a whole compute shader; its #include lines found in gpu/glsl) in
+// `language`; `variant` and `source` name the HLSL's variant and origin in its header. Empty with
+// *why on failure.
 inline std::vector<uint32_t> compileKernel(const std::string& glsl, vk::ShaderLanguage language, const std::string& variant,
                                            const std::string& source, std::string* why) {
   namespace fs = std::filesystem;
@@ -75,7 +76,7 @@ inline std::vector<uint32_t> compileKernel(const std::string& glsl, vk::ShaderLa
   }
   const fs::path comp = s.dir / "kernel.comp", spv = s.dir / "glsl.spv", log = s.dir / "log.txt";
   std::ofstream(comp, std::ios::binary) << glsl;
-  if (!runTool(std::string("'") + VFF_GLSLANG + "' -V -S comp -o '" + spv.string() + "' '" + comp.string() + "'", log, why))
+  if (!runTool(std::string("'") + VFF_GLSLANG + "' -V -S comp -I'" + VFF_GLSL_DIR + "' -o '" + spv.string() + "' '" + comp.string() + "'", log, why))
     return {};
   fs::path words = spv;
   if (language == vk::ShaderLanguage::kHlsl) {

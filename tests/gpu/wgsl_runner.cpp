@@ -5,7 +5,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <cstring>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +16,7 @@
 
 #include "vff/bc4.h"
 #include "vff/gl/loader.h"
+#include "vff/gl/refine_loader.h"
 
 namespace vff::wgsltest {
 namespace fs = std::filesystem;
@@ -140,6 +143,8 @@ const char* kernelName(Kernel k) {
       return "vff_vk_query_3d.wgsl";
     case Kernel::kQueryBc4:
       return "vff_vk_query_bc4.wgsl";
+    case Kernel::kRefine:
+      return "vff_vk_refine.wgsl";
     default:
       return "vff_vk_scene.wgsl";
   }
@@ -206,7 +211,7 @@ size_t Job::addRun(Kernel kernel, const std::string& bindings, size_t items, siz
   return index;
 }
 
-Result<size_t> Job::addQuery(const File& file, std::span<const QueryRay> rays, uint32_t which) {
+Result<std::string> Job::fieldBindings(const File& file, std::span<const QueryRay> rays) {
   const FieldDesc& field = file.field();
   const LayoutDesc& layout = file.layout();
   auto block = gl::makeFieldBlock(field, layout);
@@ -239,11 +244,36 @@ Result<size_t> Job::addQuery(const File& file, std::span<const QueryRay> rays, u
     mapsBinding += ",\"fallback\":{\"format\":\"r8unorm\",\"file\":" +
                    jsonString(writeFile("maps-decoded", texels.data(), texels.size())) + "}}";
   }
-  const std::string bindings =
-      bufferBinding(0, "uniform", writeFile("field", &*block, sizeof(gl::FieldBlock))) + "," + mapsBinding + "," +
+  return bufferBinding(0, "uniform", writeFile("field", &*block, sizeof(gl::FieldBlock))) + "," + mapsBinding + "," +
       bufferBinding(2, "storage-read", writeFile("positions", positions->data(), positions->size() * 4)) + "," +
       normalsBinding + "," + bufferBinding(4, "storage-read", writeFile("rays", rays.data(), rays.size_bytes()));
-  return addRun(queryKernel(file), bindings, rays.size(), rays.size() * sizeof(QueryAnswer), which);
+}
+
+Result<size_t> Job::addQuery(const File& file, std::span<const QueryRay> rays, uint32_t which) {
+  auto bindings = fieldBindings(file, rays);
+  if (!bindings) return bindings.error();
+  return addRun(queryKernel(file), *bindings, rays.size(), rays.size() * sizeof(QueryAnswer), which);
+}
+
+Result<size_t> Job::addRefinedQuery(const File& file, std::span<const QueryRay> rays) {
+  if (queryKernel(file) != Kernel::kQuery2D)
+    return makeError(Code::kUnsupported, "the refined kernel is generated for 2D-array maps only");
+  auto bindings = fieldBindings(file, rays);
+  if (!bindings) return bindings.error();
+  auto b = gl::makeRefinementBuffers(file.field(), file.refinement());
+  if (!b) return b.error();
+  // (A buffer holds at least 16 bytes: WebGPU binds no empty buffer.)
+  auto words = [&](const char* stem, const auto& v) {
+    std::vector<uint8_t> bytes(std::max<size_t>(16, v.size() * 4), 0);
+    if (!v.empty()) std::memcpy(bytes.data(), v.data(), v.size() * 4);
+    return writeFile(stem, bytes.data(), bytes.size());
+  };
+  const std::string all = *bindings + "," + bufferBinding(10, "storage-read", words("unsure", b->unsure)) + "," +
+                          bufferBinding(11, "storage-read", words("vertices", b->vertices)) + "," +
+                          bufferBinding(12, "storage-read", words("bvh", b->nodes)) + "," +
+                          bufferBinding(13, "storage-read", words("triangles", b->triangles)) + "," +
+                          bufferBinding(14, "uniform", writeFile("refine", &b->block, sizeof b->block));
+  return addRun(Kernel::kRefine, all, rays.size(), rays.size() * kRefinedAnswerBytes, 0);
 }
 
 Result<SceneData> Job::addSceneFields(std::span<const gl::SceneField> fields) {

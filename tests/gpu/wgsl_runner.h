@@ -75,7 +75,7 @@ struct SceneRay {
 static_assert(sizeof(SceneRay) == 48);
 
 // The kernels, one per Vulkan variant.
-enum class Kernel { kQuery2D, kQuery3D, kQueryBc4, kScene };
+enum class Kernel { kQuery2D, kQuery3D, kQueryBc4, kScene, kRefine };
 const char* kernelName(Kernel k);  // "vff_vk_query.wgsl", ...
 std::string kernelPath(Kernel k);  // in the source tree's gpu/wgsl/kernels
 // The kernel a field needs (the Vulkan loader's MapsKind).
@@ -112,6 +112,12 @@ class Job {
   // `which` (bit 0 kNearest, bit 1 kInterpolated) in the push constant. Returns the run's index.
   Result<size_t> addQuery(const File& file, std::span<const QueryRay> rays, uint32_t which = 3);
 
+  // One refined field's query (gpu/vulkan/shaders/vff_vk_refine.comp's WGSL; 2D-array maps): the
+  // query's bindings, and the refinement as vff::gl::makeRefinementBuffers gives it, at 10 to 14.
+  // Its answers are kRefinedAnswerBytes a ray (refine_cases.h's GpuOut).
+  Result<size_t> addRefinedQuery(const File& file, std::span<const QueryRay> rays);
+  static constexpr size_t kRefinedAnswerBytes = 64;
+
   // The scene's fields (vff::vk::loadScene), then a run of the scene as `scene` is committed
   // (GpuScene::update) over `rays` (ScenePipeline::run: bindings 1 to 8, `which` all four queries).
   Result<SceneData> addSceneFields(std::span<const gl::SceneField> fields);
@@ -134,6 +140,8 @@ class Job {
 
  private:
   std::string writeFile(const std::string& stem, const void* data, size_t size);
+  // Bindings 0 to 4 of a query run (the field as vff::vk::loadField uploads it, the rays).
+  Result<std::string> fieldBindings(const File& file, std::span<const QueryRay> rays);
   size_t addRun(Kernel kernel, const std::string& bindings, size_t items, size_t answerBytes, uint32_t which);
 
   std::string folder_;
