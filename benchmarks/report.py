@@ -189,17 +189,19 @@ def parse_gpu(text):
     if not gpu or not queries or any("rms" not in q for q in queries.values()):
         raise ParseError("vff-gpu-bench output lacks its GL_RENDERER, its queries or its AO table")
     result = {"gpu": gpu.group(1), "queries": queries}
-    # --api vulkan: the same queries through the Vulkan pipeline, its device named.
-    vk = re.search(r"^Vulkan: (.*?); field queries/s", text, re.M)
-    if vk:
+    # --api vulkan, vulkan-hlsl: the same queries through the Vulkan pipeline, its device named, with
+    # the kernel from the GLSL ("vulkan") and from the HLSL generated from it ("vulkan_hlsl").
+    heads = list(re.finditer(r"^Vulkan: (.*?); field queries/s through .*?\(kernel from (GLSL|HLSL)\)", text, re.M))
+    for i, vk in enumerate(heads):
         rates = {}
-        for line in text[vk.end():].splitlines():
+        section = text[vk.end():heads[i + 1].start() if i + 1 < len(heads) else len(text)]
+        for line in section.splitlines():
             m = re.match(r"^\| 2\^(\d+) \| ([^|]+?) \| ([\d.e+]+) \| (\d+) \|$", line)
             if m and m.group(2) in queries and int(m.group(1)) >= rates.get(m.group(2), {}).get("log2", -1):
                 rates[m.group(2)] = {"log2": int(m.group(1)), "rate": float(m.group(3)), "differing": int(m.group(4))}
         if not rates:
-            raise ParseError("vff-gpu-bench --api vulkan output lacks its Vulkan table")
-        result["vulkan"] = {"device": vk.group(1), "queries": rates}
+            raise ParseError(f"vff-gpu-bench --api vulkan output lacks its Vulkan table ({vk.group(2)})")
+        result["vulkan" if vk.group(2) == "GLSL" else "vulkan_hlsl"] = {"device": vk.group(1), "queries": rates}
     # --sdf: the field's GLSL and a distance field's GLSL at equal memory, against the exact AO image.
     _, found, sdf_text = text.partition("at equal memory; max and RMS against the exact image")
     if found:
@@ -539,10 +541,10 @@ def gpu_table(g):
     return lines
 
 
-def gpu_vulkan_table(g):
+def gpu_vulkan_table(g, key="vulkan"):
     lines = ["| query | rays | Vulkan, Mrays/s | OpenGL, Mrays/s (at its largest count) | answers differing from the CPU |",
              "|---|---:|---:|---:|---:|"]
-    for name, q in g["vulkan"]["queries"].items():
+    for name, q in g[key]["queries"].items():
         lines.append(f"| {name} | 2^{q['log2']} | {rate(q['rate'] / 1e6)} | {rate(g['queries'][name]['gpu'] / 1e6)} | "
                      f"{q['differing']} |")
     return lines
@@ -683,12 +685,17 @@ def sections(machine, steps, heading, queries=None, only=None):
         renderer = steps["gpu"]["gpu"]
         soft = ": Mesa's software rasteriser, on the CPU" if "llvmpipe" in renderer else ""
         out += [f"{heading} GPU query ({renderer}{soft})", "", *gpu_table(steps["gpu"]), ""]
-        if "vulkan" in steps["gpu"]:
-            device = steps["gpu"]["vulkan"]["device"]
+        for key, what, how in (("vulkan", "", "The same vff_query.glsl compiled to SPIR-V (gpu/vulkan)"),
+                               ("vulkan_hlsl", ", kernel from the generated HLSL",
+                                "The HLSL generated from the same GLSL (spirv-cross), compiled by glslang's HLSL "
+                                "front end")):
+            if key not in steps["gpu"]:
+                continue
+            device = steps["gpu"][key]["device"]
             vsoft = ": Mesa's lavapipe, on the CPU" if "llvmpipe" in device else ""
-            out += [f"{heading} GPU query through Vulkan ({device}{vsoft})", "", *gpu_vulkan_table(steps["gpu"]), "",
-                    "The same vff_query.glsl compiled to SPIR-V (gpu/vulkan); each answer carries both "
-                    "reconstructions and the lookup, 80 bytes a ray.", ""]
+            out += [f"{heading} GPU query through Vulkan{what} ({device}{vsoft})", "",
+                    *gpu_vulkan_table(steps["gpu"], key), "",
+                    f"{how}; each answer carries both reconstructions and the lookup, 80 bytes a ray.", ""]
         if "sdf" in steps["gpu"]:
             d = steps["gpu"]["sdf"]
             out += [f"{heading} GPU ground AO, field against a distance field at equal memory ({renderer}{soft}; "

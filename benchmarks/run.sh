@@ -16,7 +16,8 @@
 #   gpu          vff-gpu-bench, where a headless OpenGL 4.3 context opens (it names the renderer),
 #                with --sdf: the ground AO by the field's GLSL and by a distance field's GLSL at
 #                equal memory, against the exact image; with --api vulkan where a Vulkan device answers:
-#                the same queries through the Vulkan pipeline (gpu/vulkan)
+#                the same queries through the Vulkan pipeline (gpu/vulkan), and with vulkan-hlsl its
+#                kernel from the generated HLSL where spirv-cross is installed
 #   python       benchmarks/python_query.py, where the Python module is built: a million rays through
 #                vff-query (.npy in and out, end to end) and through the Python batch, each against
 #                the C++ batch on the same rays and field in the same run
@@ -159,9 +160,16 @@ elif [[ -x $gpubench ]]; then
   # --sdf where the bench was built with the distance-field peer (its usage names the option).
   gpusdf=()
   if [[ $("$gpubench" --help 2>&1) == *--sdf* ]]; then gpusdf=(--mesh "$mesh" --sdf "${gpusdfargs[@]}"); fi
-  # --api vulkan where the bench was built with the Vulkan path and a Vulkan device answers.
+  # --api vulkan where the bench was built with the Vulkan path and a Vulkan device answers, and
+  # vulkan-hlsl beside it where the bench takes a list and spirv-cross (the HLSL's maker) is here.
   if [[ $("$gpubench" --help 2>&1) == *"--api gl|vulkan"* ]] && command -v vulkaninfo >/dev/null &&
-    vulkaninfo --summary >/dev/null 2>&1; then gpusdf+=(--api vulkan); fi
+    vulkaninfo --summary >/dev/null 2>&1; then
+    if [[ $("$gpubench" --help 2>&1) == *"vulkan-hlsl[,...]"* ]] && command -v spirv-cross >/dev/null; then
+      gpusdf+=(--api vulkan,vulkan-hlsl)
+    else
+      gpusdf+=(--api vulkan)
+    fi
+  fi
   skip_if="no headless OpenGL" step gpu "$gpubench" --field "$raw/field.vff" "${gpusdf[@]}" "${gpuargs[@]}"
 else
   echo "vff-gpu-bench is not built (no OpenGL or EGL development files)" >"$raw/gpu.skip"

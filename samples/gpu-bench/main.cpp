@@ -3,13 +3,14 @@
 // same rays in the same run as the baseline.
 //
 //   vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size 512] [--spp 256] [--threads N] [--scene N]
-//                 [--sdf [--sdf-size N] [--sdf-spp N]] [--api gl|vulkan|vulkan-hlsl]
+//                 [--sdf [--sdf-size N] [--sdf-spp N]] [--api gl|vulkan|vulkan-hlsl[,...]]
 //
 // --api vulkan adds the field's queries/s through the Vulkan pipeline (vk_bench.h, gpu/vulkan: the
 // same vff_query.glsl as SPIR-V) on the GL table's rays, printed after it with the Vulkan device's
-// name (built where Vulkan and glslangValidator are found). --api vulkan-hlsl runs the same table
+// name (built where Vulkan and glslangValidator are found). --api vulkan-hlsl adds the same table
 // with the kernel compiled from the generated HLSL (vff::vk::ShaderLanguage::kHlsl; built where
-// spirv-cross is found too).
+// spirv-cross is found too). A comma-separated list asks for several (--api vulkan,vulkan-hlsl);
+// the GL tables always run.
 // --scene N adds the scene benchmark (scene_bench.h): the ground AO under N instances of the field
 // through gpu/glsl/vff_scene.glsl against the CPU vff::Scene, and a frame's instance update.
 // --sdf adds the distance-field peer (sdf_bench.h): the same AO through gpu/glsl/vff_sdf.glsl at the
@@ -82,9 +83,9 @@ void main() {
 
 int usage() {
 #ifdef VFF_GPU_BENCH_SDF
-  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--ao-distance R] [--threads N] [--scene N] [--sdf [--sdf-size N] [--sdf-spp N]] [--api gl|vulkan|vulkan-hlsl]\n");
+  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--ao-distance R] [--threads N] [--scene N] [--sdf [--sdf-size N] [--sdf-spp N]] [--api gl|vulkan|vulkan-hlsl[,...]]\n");
 #else
-  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--ao-distance R] [--threads N] [--scene N] [--api gl|vulkan|vulkan-hlsl]\n");
+  std::fprintf(stderr, "usage: vff-gpu-bench [--field FILE.vff] [--mesh MESH] [--size N] [--spp N] [--ao-distance R] [--threads N] [--scene N] [--api gl|vulkan|vulkan-hlsl[,...]]\n");
 #endif
   return 1;
 }
@@ -100,7 +101,7 @@ struct BenchOptions {
   int sdfSize = 0, sdfSpp = 0;  // its image and rays per pixel (0: --size and --spp)
   bool meshGiven = false;  // --mesh was given
   bool vulkan = false;     // --api vulkan: also the queries through the Vulkan pipeline
-  bool hlsl = false;       // --api vulkan-hlsl: that pipeline with the kernel built from HLSL
+  bool hlsl = false;       // --api vulkan-hlsl: also that pipeline with the kernel built from HLSL
   unsigned threads = vff::parallel::resolveThreads(0);
 };
 
@@ -136,10 +137,21 @@ int parseOptions(int argc, char** argv, BenchOptions* o) {
       o->sdfSize = std::atoi(v);
     } else if (a == "--sdf-spp" && (v = next())) {
       o->sdfSpp = std::atoi(v);
-    } else if (a == "--api" && (v = next()) &&
-               (std::strcmp(v, "gl") == 0 || std::strcmp(v, "vulkan") == 0 || std::strcmp(v, "vulkan-hlsl") == 0)) {
-      o->vulkan = std::strcmp(v, "gl") != 0;
-      o->hlsl = std::strcmp(v, "vulkan-hlsl") == 0;
+    } else if (a == "--api" && (v = next())) {
+      std::string list = v;
+      for (size_t at = 0; at <= list.size();) {
+        const size_t end = std::min(list.find(',', at), list.size());
+        const std::string api = list.substr(at, end - at);
+        if (api == "vulkan") {
+          o->vulkan = true;
+        } else if (api == "vulkan-hlsl") {
+          o->hlsl = true;
+        } else if (api != "gl") {
+          std::fprintf(stderr, "vff-gpu-bench: --api: '%s' is not gl, vulkan or vulkan-hlsl\n", api.c_str());
+          return 1;
+        }
+        at = end + 1;
+      }
     } else if (a == "--threads" && (v = next())) {
       o->threads = unsigned(std::max(1, std::atoi(v)));
     } else {
@@ -161,7 +173,7 @@ int parseOptions(int argc, char** argv, BenchOptions* o) {
   }
 #endif
 #ifndef VFF_GPU_BENCH_VULKAN
-  if (o->vulkan) {
+  if (o->vulkan || o->hlsl) {
     std::fprintf(stderr, "vff-gpu-bench: error: --api vulkan: built without Vulkan (libvulkan-dev, glslangValidator)\n");
     return 1;
   }
@@ -401,12 +413,13 @@ int main(int argc, char** argv) {
 
   benchQueries(f, *gpu, *cpu, rayProg, o.threads);
 #ifdef VFF_GPU_BENCH_VULKAN
-  if (o.vulkan) {
-    auto makeRays = [&f](size_t n, uint64_t seed, std::vector<Ray>* rays) {
-      std::vector<float> unused;
-      makeRandomRays(f, n, seed, rays, &unused);
-    };
-    if (const int code = harness::benchVulkanQueries(*file, *cpu, makeRays, o.hlsl); code != 0) return code;
+  auto makeRays = [&f](size_t n, uint64_t seed, std::vector<Ray>* rays) {
+    std::vector<float> unused;
+    makeRandomRays(f, n, seed, rays, &unused);
+  };
+  for (const bool hlsl : {false, true}) {
+    if (!(hlsl ? o.hlsl : o.vulkan)) continue;
+    if (const int code = harness::benchVulkanQueries(*file, *cpu, makeRays, hlsl); code != 0) return code;
   }
 #endif
   benchAo(f, groundY, *gpu, *cpu, aoProg, o);

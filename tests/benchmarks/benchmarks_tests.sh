@@ -29,6 +29,16 @@ test_quick_run_writes_a_results_file() {
   done
   # The GPU bench ran (a table naming the renderer) or the file says why not.
   grep -q -E "^### GPU query \(|^Not run: " "$WORK/r.md" || fail "the results file says nothing of the GPU bench"
+  # Through Vulkan, both kernels (from the GLSL and from the generated HLSL), where a Vulkan device
+  # answers and spirv-cross is installed.
+  if grep -q -F "### GPU query (" "$WORK/r.md" && command -v vulkaninfo >/dev/null && vulkaninfo --summary >/dev/null 2>&1 &&
+     command -v spirv-cross >/dev/null; then
+    for h in "### GPU query through Vulkan (" "### GPU query through Vulkan, kernel from the generated HLSL ("; do
+      grep -q -F "$h" "$WORK/r.md" || fail "results file lacks '$h'"
+    done
+    [[ $(grep -c -E "^\| (nearest occluded|interpolated visibility) \| 2\^[0-9]+ \| [0-9.,]+ \| [0-9.,]+ \| [0-9]+ \|$" "$WORK/r.md") -ge 4 ]] ||
+      fail "fewer than two rows in each Vulkan table"
+  fi
   # The WebGPU query ran (both queries, the adapter named) or the file says why not.
   if grep -q -F "### GPU query through WebGPU (" "$WORK/r.md"; then
     for q in "nearest occluded" "interpolated visibility"; do
