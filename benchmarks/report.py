@@ -827,10 +827,14 @@ def full_block(runs, newest, base):
              f"From {link(path, base)}: {machine['cpu']}, {machine['cores']} cores, commit {machine['commit']}, "
              f"{machine['mesh']}, field {machine['field']}; the query table has a row for each CPU on record. "
              "Figures differ between CPUs: `bash benchmarks/run.sh` measures yours.", ""]
-    main = sections(machine, {k: v for k, v in steps.items() if k not in ("sdf", "three", "webgpu")}, "###", list(latest.values()),
-                    machine["field"])
-    # The distance-field comparison, the WebGPU query and the three.js frame time: each from the newest
-    # file that has it (a whole run, or --only sdf / --only webgpu / --only three).
+    main = sections(machine, {k: v for k, v in steps.items() if k not in ("sdf", "three", "webgpu", "gpu")}, "###",
+                    list(latest.values()), machine["field"])
+    # The GPU tables, the distance-field comparison, the WebGPU query and the three.js frame time: each
+    # from the newest file that has it (a whole run, or --only gpu / sdf / webgpu / three).
+    gsteps, source = newest_with(runs, "gpu", base)
+    if gsteps:
+        main += ["### GPU query and ground AO: OpenGL, and Vulkan with GLSL and HLSL kernels", "", f"{source}.", "",
+                 *sections(machine, {"gpu": gsteps["gpu"]}, "####")]
     ssteps, source = newest_with(runs, "sdf", base)
     if ssteps:
         d = ssteps["sdf"]
