@@ -46,7 +46,7 @@ Result<d::Buffer> filled(const void* data, size_t bytes, VkBufferUsageFlags usag
   return bytes ? d::makeFilledBuffer(*vkEnv().ctx, data, bytes, usage) : d::makeFilledBuffer(*vkEnv().ctx, &kZero, 4, usage);
 }
 
-// refine_cases.h's kernel over the shape's rays in `language`; empty after a failure (reported).
+// vff_vk_refine.comp over the shape's rays in `language`; empty after a failure (reported).
 std::vector<GpuOut> runRays(const RefinedShape& s, ShaderLanguage language, const std::vector<GpuRay>& rays) {
   const vk::Context& ctx = *vkEnv().ctx;
   const FieldDesc& f = s.file->field();
