@@ -34,25 +34,48 @@ const float VFF_SHADOW_LIFT = 0.05;
 in vec3 vWorld;
 out highp vec4 fragColor;
 
-void main() {
-  vec3 ro = (uWorldToObject * vec4(cameraPosition, 1.0)).xyz;
-  vec3 rd = normalize((uWorldToObject * vec4(vWorld, 1.0)).xyz - ro);
+// The camera ray through world point w (on the proxy sphere) cast through the field from ro (object
+// space); *pW: its hit (or the proxy point) in world space.
+VffHit vffCameraHit(vec3 ro, vec3 w, out vec3 pW) {
+  vec3 rd = normalize((uWorldToObject * vec4(w, 1.0)).xyz - ro);
   VffHit h;
   if (uInterpolated) h = vffIntersectInterpolated(ro, rd, 0.0, 1e30, VFF_OFF_OBJECT);
   else h = vffIntersect(ro, rd, 0.0, 1e30, VFF_OFF_OBJECT);
-  vec3 pObj = h.hit ? ro + rd * h.t : (uWorldToObject * vec4(vWorld, 1.0)).xyz;
-  vec3 pW = (modelMatrix * vec4(pObj, 1.0)).xyz;
-  // Without a normal plane: the normal of the hit surface from the neighbouring pixels' hits,
-  // unless a neighbour lies on another surface (a silhouette or a step), where it would be wrong.
-  vec3 dx = dFdx(pW), dy = dFdy(pW);
+  pW = h.hit ? (modelMatrix * vec4(ro + rd * h.t, 1.0)).xyz : w;
+  return h;
+}
+
+// The surface's step from hit p towards the next pixel along dw (a pixel's step on the proxy): the
+// nearer of the two one-sided differences, since the other may cross a step between sampling cells
+// (a screen-space derivative takes whichever side its 2x2 quad has, which dots the cells' seams).
+// *ok: false where neither neighbour hits.
+vec3 vffSurfaceStep(vec3 ro, vec3 p, vec3 dw, out bool ok) {
+  vec3 pa, pb;
+  bool hitA = vffCameraHit(ro, vWorld + dw, pa).hit, hitB = vffCameraHit(ro, vWorld - dw, pb).hit;
+  vec3 a = pa - p, b = p - pb;
+  ok = hitA || hitB;
+  return !hitA ? b : !hitB ? a : (dot(a, a) <= dot(b, b) ? a : b);
+}
+
+void main() {
+  vec3 ro = (uWorldToObject * vec4(cameraPosition, 1.0)).xyz;
+  // (The proxy's pixel steps, taken before any invocation of the quad discards.)
+  vec3 dwx = dFdx(vWorld), dwy = dFdy(vWorld);
+  vec3 pW;
+  VffHit h = vffCameraHit(ro, vWorld, pW);
   if (!h.hit) discard;
+  vec3 pObj = (uWorldToObject * vec4(pW, 1.0)).xyz;
   vec3 rdW = normalize(pW - cameraPosition);
   vec3 n;
   if (h.hasNormal) n = normalize(mat3(modelMatrix) * h.normal);
   else {
+    // Without a normal plane: the normal from the neighbouring pixels' hits, unless they lie on
+    // another surface (a silhouette or a large step), where it would be wrong.
+    bool okX, okY;
+    vec3 dx = vffSurfaceStep(ro, pW, dwx, okX), dy = vffSurfaceStep(ro, pW, dwy, okY);
     vec3 c = cross(dx, dy);
     float step = max(length(dx), length(dy));
-    n = (length(c) > 0.0 && step < 0.16 * uRadius) ? normalize(c) : -rdW;
+    n = (okX && okY && length(c) > 0.0 && step < 0.16 * uRadius) ? normalize(c) : -rdW;
   }
   if (dot(n, rdW) > 0.0) n = -n;
   float lit = max(dot(n, uLight), 0.0);
