@@ -43,12 +43,24 @@ export async function serve(extra = {}, options = {}) {
   return { server, url: `http://127.0.0.1:${server.address().port}` };
 }
 
+/** How long a page's actions (screenshots, clicks) wait by default: a software renderer on a loaded machine draws slowly. */
+export const ACTION_TIMEOUT_MS = 300000;
+
 /**
  * Headless Chromium on SwiftShader; {webgpu: true} also turns on WebGPU (its SwiftShader adapter),
- * with Vulkan compositing: without it a WebGPU canvas's first frame loses the GPU process.
+ * with Vulkan compositing: without it a WebGPU canvas's first frame loses the GPU process. Its
+ * pages' actions wait up to ACTION_TIMEOUT_MS (Playwright's default, 30 s, is short of a frame of
+ * the viewer when the suites run side by side on two cores).
  */
 export async function launch({ webgpu = false } = {}) {
   const args = ['--headless=new', '--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist'];
   if (webgpu) args.push('--enable-unsafe-webgpu', '--enable-features=Vulkan', '--use-vulkan=swiftshader');
-  return chromium.launch({ executablePath: process.env.VFF_CHROMIUM_PATH ?? '/usr/bin/chromium', args });
+  const browser = await chromium.launch({ executablePath: process.env.VFF_CHROMIUM_PATH ?? '/usr/bin/chromium', args });
+  const newPage = browser.newPage.bind(browser);
+  browser.newPage = async (options) => {
+    const page = await newPage(options);
+    page.setDefaultTimeout(ACTION_TIMEOUT_MS);
+    return page;
+  };
+  return browser;
 }
