@@ -57,6 +57,8 @@ const gpuOpened = (groundParam === 'webgl2' ? Promise.resolve({ reason: '?ground
   return view.backend;
 });
 function showBackend() { $('backend').textContent = state?.result?.ok ? `ground: ${view.backendName}` : ''; }
+// (At once, not at the next frame: a page that draws no more frames still names its ground.)
+view.onBackend = showBackend;
 const sheet = new ContactSheet($('sheet'), $('under'), askTexel);
 
 let state = null, loads = 0;

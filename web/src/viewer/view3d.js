@@ -46,6 +46,7 @@ export class FieldView {
     this.canvas = canvas;
     this.container = container;
     this.onFrame = onFrame;
+    this.onBackend = () => {};  // called when backendName changes (the ground moved to WebGPU or back)
     // (alpha: over a WebGPU ground the canvas is cleared to transparent; otherwise to the sky.)
     this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true, alpha: true });
     this.renderer.setPixelRatio(window.devicePixelRatio || 1);
@@ -140,11 +141,12 @@ export class FieldView {
     // Until the passes are compiled (3D fields' on first use), WebGL2 draws the ground.
     if (this.gpuPending)
       g.compile(src.is3d).then(() => { if (this.field?.source === src && this.gpuGround === g) { this.placeGround(); this.invalidate(); } },
-        (e) => { this.gpuPending = false; console.warn(`the WebGPU ground failed to compile (${e.message}); it stays WebGL2`); });
+        (e) => { this.gpuPending = false; console.warn(`the WebGPU ground failed to compile (${e.message}); it stays WebGL2`); this.onBackend(); });
     g?.setField(this.gpuField ? src : null);
     this.ground.visible = !this.gpuField;
     this.scene.background = this.gpuField ? null : new THREE.Color(0xcfd8e3);
     this.renderer.setClearColor(0xcfd8e3, this.gpuField ? 0 : 1);
+    this.onBackend();
   }
 
   /** Shows a field (field_three.js's resources); returns {groundY, lowest}. */
