@@ -42,6 +42,8 @@ endif()
 # vff_scene.glsl includes vff_query.glsl.
 if(GLSL)
   set(_glsl "${GLSL}")
+elseif(SOURCE MATCHES "refine")
+  set(_glsl "gpu/glsl/vff_query.glsl and vff_refine.glsl")
 elseif(SOURCE MATCHES "scene")
   set(_glsl "gpu/glsl/vff_scene.glsl and vff_query.glsl")
 else()

@@ -2,26 +2,21 @@
 // HLSL, against the CPU's Reconstruction::kRefined with the GL suite's shapes, rays and checks
 // (refine_cases.h), the Khronos validation layer on.
 //
-// The kernel is gpu/vulkan/shaders/vff_vk_refine.comp after the GL loader's defines (shaderDefines,
-// refinementShaderDefines), compiled when the case runs (vk_compile.h), so a change to
-// vff_refine.glsl or vff_query.glsl reaches both languages' tests. The field is vff::vk::loadField's
-// (bindings 0 to 3); the refinement is what vff::gl::loadRefinement uploads (makeRefinementBuffers),
-// as storage buffers at bindings 10 to 13 and the VffRefineBlock uniform at 14; the rays and
-// answers (refine_cases.h's GpuRay and GpuOut) are storage buffers at bindings 4 and 5.
+// Through the library's API (vff/vk/refine.h): vff::vk::loadField, vff::vk::loadRefinement and
+// RefinedPipeline, whose kernels (gpu/vulkan/shaders/vff_vk_refine.comp and spirv-cross's HLSL of
+// it) are compiled when vff_vk is built, so a change to vff_refine.glsl or vff_query.glsl reaches
+// both languages' tests. Also: a file without a refinement, and a refinement run with another field.
 #include <gtest/gtest.h>
 
+#include <cstddef>
 #include <cstring>
-#include <filesystem>
-#include <memory>
 #include <ostream>
 #include <string>
 #include <vector>
 
 #include "refine_cases.h"
-#include "vff/gl/loader.h"
-#include "vff/gl/refine_loader.h"
 #include "vff/vk/field.h"
-#include "vk_compile.h"
+#include "vff/vk/refine.h"
 #include "vk_env.h"
 
 namespace vff {
@@ -31,75 +26,35 @@ using namespace refinetest;
 using vk::ShaderLanguage;
 using vktest::languageName;
 using vktest::vkEnv;
-namespace d = vk::detail;
-using gl::RefinementBuffers;
 
-constexpr VkDescriptorType kNone = VK_DESCRIPTOR_TYPE_MAX_ENUM, kStorage = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                           kUniform = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
-                           kImage = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-constexpr VkDescriptorType kBindings[] = {kUniform, kImage, kStorage, kImage,   kStorage, kStorage, kNone, kNone,
-                                          kNone,    kNone,  kStorage, kStorage, kStorage, kStorage, kUniform};
+// The test's structs are the API's, byte for byte (refine_cases.h is shared with the GL and WebGPU
+// suites, which have no vff::vk).
+static_assert(sizeof(GpuRay) == sizeof(vk::QueryRay) && sizeof(GpuOut) == sizeof(vk::RefinedAnswer));
+static_assert(offsetof(vk::RefinedAnswer, nearestHit) == offsetof(GpuOut, nearest) &&
+              offsetof(vk::RefinedAnswer, exact) == offsetof(GpuOut, lookup));
 
-// A host buffer holding `bytes` (at least 4 bytes: Vulkan has no empty buffer).
-Result<d::Buffer> filled(const void* data, size_t bytes, VkBufferUsageFlags usage) {
-  static const uint32_t kZero = 0;
-  return bytes ? d::makeFilledBuffer(*vkEnv().ctx, data, bytes, usage) : d::makeFilledBuffer(*vkEnv().ctx, &kZero, 4, usage);
-}
-
-// vff_vk_refine.comp over the shape's rays in `language`; empty after a failure (reported).
+// vff::vk::RefinedPipeline (shaders/vff_vk_refine.comp, embedded) over the shape's rays in
+// `language`; empty after a failure (reported).
 std::vector<GpuOut> runRays(const RefinedShape& s, ShaderLanguage language, const std::vector<GpuRay>& rays) {
   const vk::Context& ctx = *vkEnv().ctx;
-  const FieldDesc& f = s.file->field();
   auto field = vk::loadField(ctx, *s.file);
   EXPECT_TRUE(field.ok()) << (field.ok() ? "" : field.error().toString());
-  auto buffers = gl::makeRefinementBuffers(f, s.file->refinement());
-  EXPECT_TRUE(buffers.ok()) << (buffers.ok() ? "" : buffers.error().toString());
-  if (!field.ok() || !buffers.ok()) return {};
-  EXPECT_GT(buffers->block.triangleCount, 0u);
-  // The kernel with the loader's defines after its #version line.
-  std::string glsl = vktest::readText(std::filesystem::path(VFF_VK_SHADERS) / "vff_vk_refine.comp");
-  const size_t version = glsl.find("#version 430\n");
-  if (version == std::string::npos) {
-    ADD_FAILURE() << "vff_vk_refine.comp has no #version 430 line";
-    return {};
-  }
-  glsl.insert(version + 13, gl::shaderDefines(f, s.file->layout()) + gl::refinementShaderDefines(buffers->block));
-  const std::unique_ptr<d::Kernel> kernel =
-      vktest::makeTestKernel(glsl, language, "refined", "vff_vk_refine.comp", kBindings);
-  if (!kernel) return {};
-  d::DescriptorPool pool;
-  auto set = d::allocateSet(*kernel, pool);
-  const RefinementBuffers& b = *buffers;
-  auto unsure = filled(b.unsure.data(), b.unsure.size() * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  auto vertices = filled(b.vertices.data(), b.vertices.size() * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  auto nodes = filled(b.nodes.data(), b.nodes.size() * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  auto triangles = filled(b.triangles.data(), b.triangles.size() * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  auto block = filled(&b.block, sizeof b.block, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
-  auto in = filled(rays.data(), rays.size() * sizeof(GpuRay), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  auto out = d::makeHostBuffer(ctx, rays.size() * sizeof(GpuOut), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  for (const Error* e : {set.ok() ? nullptr : &set.error(), unsure.ok() ? nullptr : &unsure.error(),
-                         vertices.ok() ? nullptr : &vertices.error(), nodes.ok() ? nullptr : &nodes.error(),
-                         triangles.ok() ? nullptr : &triangles.error(), block.ok() ? nullptr : &block.error(),
-                         in.ok() ? nullptr : &in.error(), out.ok() ? nullptr : &out.error()})
-    if (e) {
-      ADD_FAILURE() << e->toString();
-      return {};
-    }
-  field->write(*set);
-  d::writeBuffer(ctx.device(), *set, 4, in->buffer);
-  d::writeBuffer(ctx.device(), *set, 5, out->buffer);
-  d::writeBuffer(ctx.device(), *set, 10, unsure->buffer);
-  d::writeBuffer(ctx.device(), *set, 11, vertices->buffer);
-  d::writeBuffer(ctx.device(), *set, 12, nodes->buffer);
-  d::writeBuffer(ctx.device(), *set, 13, triangles->buffer);
-  d::writeBuffer(ctx.device(), *set, 14, block->buffer, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER);
-  if (Status st = d::dispatchRays(ctx, *kernel, *set, 0, rays.size(), 1); !st) {
-    ADD_FAILURE() << st.error().toString();
-    return {};
-  }
-  std::vector<GpuOut> answers(rays.size());
-  std::memcpy(answers.data(), out->mapped, answers.size() * sizeof(GpuOut));
-  return answers;
+  auto refinement = vk::loadRefinement(ctx, *s.file);
+  EXPECT_TRUE(refinement.ok()) << (refinement.ok() ? "" : refinement.error().toString());
+  if (!field.ok() || !refinement.ok()) return {};
+  EXPECT_GT(refinement->block().triangleCount, 0u);
+  auto pipe = vk::RefinedPipeline::create(ctx, field->kind(), {.language = language});
+  EXPECT_TRUE(pipe.ok()) << (pipe.ok() ? "" : pipe.error().toString());
+  if (!pipe.ok()) return {};
+  EXPECT_EQ(pipe->language(), language);
+  std::vector<vk::QueryRay> in(rays.size());
+  std::memcpy(in.data(), rays.data(), rays.size() * sizeof(GpuRay));
+  auto answers = pipe->run(ctx, *field, *refinement, in);
+  EXPECT_TRUE(answers.ok()) << (answers.ok() ? "" : answers.error().toString());
+  if (!answers.ok()) return {};
+  std::vector<GpuOut> out(answers->size());
+  std::memcpy(out.data(), answers->data(), out.size() * sizeof(GpuOut));
+  return out;
 }
 
 struct Case {
@@ -113,7 +68,7 @@ class VkRefine : public ::testing::TestWithParam<Case> {};
 
 TEST_P(VkRefine, MatchesCpu) {
   VFF_REQUIRE_VK();
-  VFF_REQUIRE_TOOLS(GetParam().language);
+  VFF_REQUIRE_LANGUAGE(GetParam().language);
   const RefinedShape& s = refinedShape(GetParam().shape);
   ASSERT_TRUE(s.file.has_value());
   ASSERT_FALSE(s.file->refinement().empty());
@@ -135,6 +90,72 @@ INSTANTIATE_TEST_SUITE_P(Shapes, VkRefine,
                              if (c == '-') c = '_';
                            return n;
                          });
+
+// Without a REFN section the kernel answers every ray as kNearest (triangleCount 0), as the CPU
+// query does, and the exact step never runs.
+TEST(VkRefineApi, WithoutRefinementEveryRayIsNearest) {
+  VFF_REQUIRE_VK();
+  const vk::Context& ctx = *vkEnv().ctx;
+  const RefinedShape& s = refinedShape("torus-knot");
+  const test::BakedShape& b = *s.baked;
+  auto bytes = writeMemory(b.field.field, b.field.distance, b.field.normals, WriteOptions{});
+  ASSERT_TRUE(bytes.ok()) << bytes.error().toString();
+  auto file = File::openBuffer(std::move(*bytes));
+  ASSERT_TRUE(file.ok()) << file.error().toString();
+  ASSERT_TRUE(file->refinement().empty());
+  auto field = vk::loadField(ctx, *file);
+  auto refinement = vk::loadRefinement(ctx, *file);
+  ASSERT_TRUE(field.ok() && refinement.ok());
+  EXPECT_EQ(refinement->block().triangleCount, 0u);
+  auto pipe = vk::RefinedPipeline::create(ctx, field->kind());
+  ASSERT_TRUE(pipe.ok()) << pipe.error().toString();
+  const std::vector<GpuRay> rays = makeRays(s, 512, 20261206);
+  std::vector<vk::QueryRay> in(rays.size());
+  std::memcpy(in.data(), rays.data(), rays.size() * sizeof(GpuRay));
+  auto answers = pipe->run(ctx, *field, *refinement, in);
+  ASSERT_TRUE(answers.ok()) << answers.error().toString();
+  size_t hits = 0, exact = 0, differ = 0;
+  for (const vk::RefinedAnswer& a : *answers) {
+    hits += a.hit != 0;
+    exact += a.exact;
+    differ += a.hit != a.nearestHit || (a.hit != 0 && a.t != a.nearestT);
+  }
+  EXPECT_GT(hits, rays.size() / 8);
+  EXPECT_EQ(exact, 0u);
+  EXPECT_EQ(differ, 0u);
+  vktest::expectNoValidationMessages();
+}
+
+// A refinement run with another field (other maps) is refused with a message, not read out of
+// range; so is a field of another variant than the pipeline's.
+TEST(VkRefineApi, RefinementOfAnotherFieldIsRefused) {
+  VFF_REQUIRE_VK();
+  const vk::Context& ctx = *vkEnv().ctx;
+  const RefinedShape& s = refinedShape("torus-knot");
+  const auto other = test::bakeShape("bowl", 6, 12);
+  auto bytes = writeMemory(other->field.field, other->field.distance, other->field.normals, WriteOptions{});
+  ASSERT_TRUE(bytes.ok()) << bytes.error().toString();
+  auto otherFile = File::openBuffer(std::move(*bytes));
+  ASSERT_TRUE(otherFile.ok());
+  auto otherField = vk::loadField(ctx, *otherFile);
+  auto refinement = vk::loadRefinement(ctx, *s.file);
+  ASSERT_TRUE(otherField.ok() && refinement.ok());
+  auto pipe = vk::RefinedPipeline::create(ctx, otherField->kind());
+  ASSERT_TRUE(pipe.ok()) << pipe.error().toString();
+  const std::vector<vk::QueryRay> in(4, vk::QueryRay{{0, 0, 3, 0}, {0, 0, -1, 0}, {0, 100, -1, 0}});
+  auto refused = pipe->run(ctx, *otherField, *refinement, in);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.error().code, Code::kInvalidArgument);
+  EXPECT_NE(refused.error().message.find("the refinement covers"), std::string::npos) << refused.error().message;
+  auto pipe3d = vk::RefinedPipeline::create(ctx, vk::MapsKind::kTexture3D);
+  ASSERT_TRUE(pipe3d.ok()) << pipe3d.error().toString();
+  auto field = vk::loadField(ctx, *s.file);
+  ASSERT_TRUE(field.ok());
+  auto wrongVariant = pipe3d->run(ctx, *field, *refinement, in);
+  ASSERT_FALSE(wrongVariant.ok());
+  EXPECT_EQ(wrongVariant.error().code, Code::kInvalidArgument);
+  vktest::expectNoValidationMessages();
+}
 
 }  // namespace
 }  // namespace vff

@@ -1,14 +1,14 @@
 // A compute shader of the refined query (gpu/glsl/vff_refine.glsl after vff_query.glsl): one ray per
 // invocation, the refined answer, the refined occlusion, whether the exact step answered, and
-// kNearest's answer beside them, for checking and for a port to start from. Not built into vff_vk:
-// the Vulkan suite compiles it when a case runs, after the defines the GL loader gives (gl::
-// shaderDefines, refinementShaderDefines: VFF_REFINE_STACK for the BVH's depth), as GLSL and through
-// spirv-cross as HLSL (tests/gpu/test_vk_refine.cpp); web/tools/gen-wgsl.mjs makes its WGSL
-// (gpu/wgsl/kernels/vff_vk_refine.wgsl, the stack at its default depth) for the WebGPU suite.
+// kNearest's answer beside them, for checking and for a port to start from. vff_vk compiles it at
+// build time per MapsKind, as GLSL and through spirv-cross as HLSL, with the stack at its default
+// depth (VFF_REFINE_STACK, the deepest BVH the loader takes), and runs it as
+// vff::vk::RefinedPipeline (vff/vk/refine.h); web/tools/gen-wgsl.mjs makes its WGSL
+// (gpu/wgsl/kernels/vff_vk_refine.wgsl) for the WebGPU suite.
 //
 // Set 0: the field's bindings 0 to 3 (vff/vk/field.h), the rays at 4 (QueryRay, vff/vk/query.h),
-// the answers at 5, the refinement's storage buffers at 10 to 13 and its uniform block at 14
-// (vff/gl/refine_loader.h: makeRefinementBuffers).
+// the answers at 5 (RefinedAnswer, vff/vk/refine.h), the refinement's storage buffers at 10 to 13
+// and its uniform block at 14 (vff/vk/refine.h: vff::vk::loadRefinement).
 #version 430
 #extension GL_GOOGLE_include_directive : require
 #include "vff_query.glsl"
