@@ -45,16 +45,27 @@ VffHit vffCameraHit(vec3 ro, vec3 w, out vec3 pW) {
   return h;
 }
 
-// The surface's step from hit p towards the next pixel along dw (a pixel's step on the proxy): the
-// nearer of the two one-sided differences, since the other may cross a step between sampling cells
-// (a screen-space derivative takes whichever side its 2x2 quad has, which dots the cells' seams).
+// Whether two camera hits come from the same sampling cell: the same nearest sample and, for
+// kNearest, the same texel. Within a cell the surface has no step between sampling cells.
+bool vffSameCell(VffHit a, VffHit b) {
+  return a.sampleIndex == b.sampleIndex && (uInterpolated || a.texel == b.texel);
+}
+
+// The surface's step from hit h (at p) towards the next pixel along dw (a pixel's step on the
+// proxy): the forward difference where that pixel's hit lies in h's sampling cell; else the nearer
+// of the two one-sided differences, since the other may cross a step between sampling cells (a
+// screen-space derivative takes whichever side its 2x2 quad has, which dots the cells' seams).
 // *ok: false where neither neighbour hits.
-vec3 vffSurfaceStep(vec3 ro, vec3 p, vec3 dw, out bool ok) {
+vec3 vffSurfaceStep(vec3 ro, VffHit h, vec3 p, vec3 dw, out bool ok) {
   vec3 pa, pb;
-  bool hitA = vffCameraHit(ro, vWorld + dw, pa).hit, hitB = vffCameraHit(ro, vWorld - dw, pb).hit;
-  vec3 a = pa - p, b = p - pb;
-  ok = hitA || hitB;
-  return !hitA ? b : !hitB ? a : (dot(a, a) <= dot(b, b) ? a : b);
+  VffHit ha = vffCameraHit(ro, vWorld + dw, pa);
+  vec3 a = pa - p;
+  ok = true;
+  if (ha.hit && vffSameCell(ha, h)) return a;
+  bool hitB = vffCameraHit(ro, vWorld - dw, pb).hit;
+  vec3 b = p - pb;
+  ok = ha.hit || hitB;
+  return !ha.hit ? b : !hitB ? a : (dot(a, a) <= dot(b, b) ? a : b);
 }
 
 void main() {
@@ -72,7 +83,7 @@ void main() {
     // Without a normal plane: the normal from the neighbouring pixels' hits, unless they lie on
     // another surface (a silhouette or a large step), where it would be wrong.
     bool okX, okY;
-    vec3 dx = vffSurfaceStep(ro, pW, dwx, okX), dy = vffSurfaceStep(ro, pW, dwy, okY);
+    vec3 dx = vffSurfaceStep(ro, h, pW, dwx, okX), dy = vffSurfaceStep(ro, h, pW, dwy, okY);
     vec3 c = cross(dx, dy);
     float step = max(length(dx), length(dy));
     n = (okX && okY && length(c) > 0.0 && step < 0.16 * uRadius) ? normalize(c) : -rdW;
