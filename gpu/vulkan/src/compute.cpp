@@ -2,6 +2,7 @@
 #include "compute.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 #include <vector>
 
@@ -159,6 +160,32 @@ Status dispatchRays(const Context& ctx, const Kernel& k, VkDescriptorSet set, ui
     vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &mb, 0, nullptr, 0,
                          nullptr);
   });
+}
+
+Status requireLanguage(ShaderLanguage language) {
+  if (QueryPipeline::available(language)) return {};
+  return makeError(Code::kUnsupported,
+                   "vff_vk: this build has no HLSL kernels (spirv-cross was not found when it was configured)");
+}
+
+Status runBatch(const Context& ctx, const Kernel& kernel, const Batch& b,
+                const std::function<void(VkDescriptorSet)>& writeSet, double* seconds) {
+  auto in = makeFilledBuffer(ctx, b.rays, b.rayBytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (!in) return in.error();
+  auto answers = makeHostBuffer(ctx, b.answerBytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (!answers) return answers.error();
+  DescriptorPool pool;
+  auto set = allocateSet(kernel, pool);
+  if (!set) return set.error();
+  writeSet(*set);
+  writeBuffer(ctx.device(), *set, b.raysBinding, in->buffer);
+  writeBuffer(ctx.device(), *set, b.answersBinding, answers->buffer);
+  const auto start = std::chrono::steady_clock::now();
+  Status st = dispatchRays(ctx, kernel, *set, b.which, b.rayCount, b.repeat);
+  if (seconds) *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!st) return st;
+  std::memcpy(b.answers, answers->mapped, b.answerBytes);
+  return {};
 }
 
 Result<Buffer> makeFilledBuffer(const Context& ctx, const void* data, size_t size, VkBufferUsageFlags usage) {

@@ -3,8 +3,6 @@
 // shaders/vff_vk_refine.comp (compute.h's kernel and dispatch, as the query's).
 #include "vff/vk/refine.h"
 
-#include <chrono>
-#include <cstring>
 #include <string>
 #include <utility>
 
@@ -12,27 +10,14 @@
 
 namespace vff::vk {
 namespace detail {
-// Generated at build time (gpu/vulkan/CMakeLists.txt, embed_spirv.cmake).
-extern const uint32_t kRefineSpirvArray2D[];
-extern const size_t kRefineSpirvArray2DWords;
-extern const uint32_t kRefineSpirvTexture3D[];
-extern const size_t kRefineSpirvTexture3DWords;
-extern const uint32_t kRefineSpirvBc4[];
-extern const size_t kRefineSpirvBc4Words;
+// Generated at build time (gpu/vulkan/CMakeLists.txt, embed_spirv.cmake, make_hlsl.cmake).
+VFF_VK_DECLARE_VARIANTS(kRefineSpirv)
 #if VFF_VK_HLSL
-extern const uint32_t kRefineSpirvHlslArray2D[];
-extern const size_t kRefineSpirvHlslArray2DWords;
-extern const uint32_t kRefineSpirvHlslTexture3D[];
-extern const size_t kRefineSpirvHlslTexture3DWords;
-extern const uint32_t kRefineSpirvHlslBc4[];
-extern const size_t kRefineSpirvHlslBc4Words;
+VFF_VK_DECLARE_VARIANTS(kRefineSpirvHlsl)
 #endif
-}  // namespace detail
 
 namespace {
 
-constexpr uint32_t kRaysBinding = 4;
-constexpr uint32_t kAnswersBinding = 5;
 constexpr VkDescriptorType kNone = VK_DESCRIPTOR_TYPE_MAX_ENUM, kStorage = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                            kUniform = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
                            kImage = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
@@ -41,32 +26,17 @@ constexpr VkDescriptorType kNone = VK_DESCRIPTOR_TYPE_MAX_ENUM, kStorage = VK_DE
 constexpr VkDescriptorType kBindings[] = {kUniform, kImage, kStorage, kImage,   kStorage, kStorage, kNone,   kNone,
                                           kNone,    kNone,  kStorage, kStorage, kStorage, kStorage, kUniform};
 
-std::pair<const uint32_t*, size_t> spirv(MapsKind kind, ShaderLanguage language) {
+Spirv spirv(MapsKind kind, ShaderLanguage language) {
 #if VFF_VK_HLSL
-  if (language == ShaderLanguage::kHlsl) {
-    switch (kind) {
-      case MapsKind::kTexture3D:
-        return {detail::kRefineSpirvHlslTexture3D, detail::kRefineSpirvHlslTexture3DWords};
-      case MapsKind::kBc4:
-        return {detail::kRefineSpirvHlslBc4, detail::kRefineSpirvHlslBc4Words};
-      default:
-        return {detail::kRefineSpirvHlslArray2D, detail::kRefineSpirvHlslArray2DWords};
-    }
-  }
+  if (language == ShaderLanguage::kHlsl) return VFF_VK_VARIANTS(kRefineSpirvHlsl)[kind];
 #else
   (void)language;
 #endif
-  switch (kind) {
-    case MapsKind::kTexture3D:
-      return {detail::kRefineSpirvTexture3D, detail::kRefineSpirvTexture3DWords};
-    case MapsKind::kBc4:
-      return {detail::kRefineSpirvBc4, detail::kRefineSpirvBc4Words};
-    default:
-      return {detail::kRefineSpirvArray2D, detail::kRefineSpirvArray2DWords};
-  }
+  return VFF_VK_VARIANTS(kRefineSpirv)[kind];
 }
 
 }  // namespace
+}  // namespace detail
 
 struct GpuRefinement::State {
   VkDevice device = VK_NULL_HANDLE;
@@ -153,16 +123,14 @@ ShaderLanguage RefinedPipeline::language() const noexcept {
 }
 
 Result<RefinedPipeline> RefinedPipeline::create(const Context& ctx, MapsKind kind, const PipelineOptions& options) {
-  if (!QueryPipeline::available(options.language))
-    return makeError(Code::kUnsupported,
-                     "vff_vk: this build has no HLSL kernels (spirv-cross was not found when it was configured)");
+  if (Status st = detail::requireLanguage(options.language); !st) return st.error();
   RefinedPipeline p;
   p.s_ = std::make_unique<State>();
   State& s = *p.s_;
   s.kind = kind;
   s.language = options.language;
-  const auto [code, words] = spirv(kind, options.language);
-  if (Status st = detail::makeKernel(ctx, kBindings, code, words, &s.kernel); !st) return st.error();
+  const detail::Spirv code = detail::spirv(kind, options.language);
+  if (Status st = detail::makeKernel(ctx, detail::kBindings, code.code, code.words, &s.kernel); !st) return st.error();
   return p;
 }
 
@@ -170,32 +138,28 @@ Result<std::vector<RefinedAnswer>> RefinedPipeline::run(const Context& ctx, cons
                                                         const GpuRefinement& refinement, std::span<const QueryRay> rays,
                                                         const RunOptions& options, double* seconds) const {
   const State& s = *s_;
+  const GpuRefinement::State& r = *refinement.s_;
   if (field.kind() != s.kind)
     return makeError(Code::kInvalidArgument, "the field needs another shader variant than this RefinedPipeline's");
-  if (refinement.s_->mapCount != field.block().mapCount || refinement.s_->mapResolution != field.block().mapResolution)
-    return makeError(Code::kInvalidArgument, "the refinement covers " + std::to_string(refinement.s_->mapCount) +
-                                                 " maps of " + std::to_string(refinement.s_->mapResolution) +
-                                                 "^2 texels, the field has " + std::to_string(field.block().mapCount) +
-                                                 " of " + std::to_string(field.block().mapResolution) + "^2");
+  if (r.mapCount != field.block().mapCount || r.mapResolution != field.block().mapResolution)
+    return makeError(Code::kInvalidArgument, "the refinement covers " + std::to_string(r.mapCount) + " maps of " +
+                                                 std::to_string(r.mapResolution) + "^2 texels, the field has " +
+                                                 std::to_string(field.block().mapCount) + " of " +
+                                                 std::to_string(field.block().mapResolution) + "^2");
   if (Status st = detail::checkBatch(ctx, rays.size(), sizeof(RefinedAnswer)); !st) return st.error();
   std::vector<RefinedAnswer> out(rays.size());
   if (rays.empty()) return out;
-  auto in = detail::makeFilledBuffer(ctx, rays.data(), rays.size_bytes(), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  if (!in) return in.error();
-  auto answers = detail::makeHostBuffer(ctx, out.size() * sizeof(RefinedAnswer), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  if (!answers) return answers.error();
-  detail::DescriptorPool pool;
-  auto set = detail::allocateSet(s.kernel, pool);
-  if (!set) return set.error();
-  field.write(*set);
-  refinement.write(*set);
-  detail::writeBuffer(ctx.device(), *set, kRaysBinding, in->buffer);
-  detail::writeBuffer(ctx.device(), *set, kAnswersBinding, answers->buffer);
-  const auto start = std::chrono::steady_clock::now();
-  Status st = detail::dispatchRays(ctx, s.kernel, *set, 0, rays.size(), options.repeat);
-  if (seconds) *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!st) return st.error();
-  std::memcpy(out.data(), answers->mapped, out.size() * sizeof(RefinedAnswer));
+  const detail::Batch batch{.rays = rays.data(),
+                            .rayCount = rays.size(),
+                            .rayBytes = rays.size_bytes(),
+                            .answers = out.data(),
+                            .answerBytes = out.size() * sizeof(RefinedAnswer),
+                            .repeat = options.repeat};
+  auto write = [&](VkDescriptorSet set) {
+    field.write(set);
+    refinement.write(set);
+  };
+  if (Status st = detail::runBatch(ctx, s.kernel, batch, write, seconds); !st) return st.error();
   return out;
 }
 
